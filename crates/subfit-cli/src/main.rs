@@ -1,0 +1,2 @@
+//! The `subfit` command-line tool.
+fn main() {}

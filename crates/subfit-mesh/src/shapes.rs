@@ -1,0 +1,1 @@
+//! Generated shapes for the demo, tests and benchmarks (placeholder until implemented).

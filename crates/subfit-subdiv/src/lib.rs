@@ -1,0 +1,1 @@
+//! subfit-subdiv (being written).

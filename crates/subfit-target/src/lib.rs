@@ -1,0 +1,1 @@
+//! subfit-target (being written).
