@@ -7,6 +7,8 @@
 pub mod ids;
 pub mod polygons;
 pub mod shapes;
+pub mod tags;
 
 pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
 pub use polygons::{bounding_box, PolyMesh, Polygons};
+pub use tags::{Tags, SHARPNESS_INFINITE};
