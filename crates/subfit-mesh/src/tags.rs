@@ -79,7 +79,7 @@ impl Tags {
     /// All crease tags as `((a, b), sharpness)` with `a < b`, sorted.
     pub fn creases(&self) -> Vec<((u32, u32), f64)> {
         let mut v: Vec<_> = self.creases.iter().map(|(&k, &s)| (k, s)).collect();
-        v.sort_by(|x, y| x.0.cmp(&y.0));
+        v.sort_by_key(|x| x.0);
         v
     }
 
