@@ -1,1 +1,34 @@
-//! subfit-subdiv (being written).
+//! Subdivision surfaces for subfit: Loop and Catmull-Clark schemes with OpenSubdiv's boundary,
+//! crease and corner rules, expressed as sparse linear operators.
+//!
+//! * [`scheme`] — [`Scheme`], [`BoundaryRule`], [`Options`], the vertex rules and the
+//!   storage-free [`Neighborhood`] a scheme reads (OpenSubdiv `Sdc` vocabulary).
+//! * [`mask`] — refinement and limit masks (Loop 1987; Catmull & Clark 1978; Hoppe et al. 1994;
+//!   Halstead et al. 1993; OpenSubdiv 3.5 tangent masks).
+//! * [`stencil`] — [`StencilMatrix`], CSR rows of weights over control points.
+//! * [`topology`] — the edge and vertex-ring adjacency the rules need.
+//! * [`refine`] — one level of uniform refinement as a matrix, with a documented child order.
+//! * [`limit`] — limit position and tangent stencils at every vertex.
+//! * [`sample`] — the sampling operator `C = L_l · M_l ⋯ M_1` (DESIGN §3.1).
+//!
+//! Topology never owns positions: functions take a [`subfit_mesh::Polygons`] face list, a vertex
+//! count and [`subfit_mesh::Tags`], and return matrices to apply to `#V by 3` positions.
+//! Everything is checked against OpenSubdiv's limit values (`tests/golden.rs`).
+
+pub mod error;
+pub mod limit;
+pub mod mask;
+pub mod refine;
+pub mod sample;
+pub mod scheme;
+pub mod stencil;
+pub mod topology;
+
+pub use error::SubdivError;
+pub use limit::{limit_stencils, LimitStencils};
+pub use mask::{EdgeMask, FaceWeights, Mask};
+pub use refine::{refine, Refinement};
+pub use sample::{normals_from_tangents, sampling_operator, LimitSamples, SamplingOperator};
+pub use scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
+pub use stencil::StencilMatrix;
+pub use topology::Topology;

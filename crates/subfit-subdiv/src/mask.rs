@@ -1,0 +1,389 @@
+//! Masks: the weights a scheme assigns to a vertex's neighbourhood, filled independently of mesh
+//! storage (OpenSubdiv `Sdc::Scheme` style).
+//!
+//! * Refinement masks — Loop 1987 (vertex β of Loop's thesis,
+//!   `β = (5/8 − (3/8 + 1/4 cos 2π/n)²)/n`; edge points 3/8, 3/8, 1/8, 1/8) and Catmull & Clark
+//!   1978 (vertex point `(n−2)/n V + 1/n² Σ E + 1/n² Σ F` over ring vertices and face points;
+//!   edge point ¼ of ends and face points); crease and corner rules of Hoppe et al. 1994
+//!   (crease edge: midpoint; crease vertex: 1/8, 3/4, 1/8; corner: fixed).
+//! * Limit masks — Halstead et al. 1993 for Catmull-Clark positions (`n² V + 4 Σ E + Σ F` over
+//!   `n(n+5)`, with F the diagonal vertices of the quads), Loop's limit
+//!   (`1/(n + 3/(8β))` per neighbour); the cubic B-spline 1/6, 2/3, 1/6 on creases; tangents as
+//!   OpenSubdiv 3.5 `sdc/loopScheme.h` and `sdc/catmarkScheme.h` (cos/sin weights around the
+//!   ring; Biermann et al. 2000 cross-boundary tangents), including OpenSubdiv's scale factors,
+//!   so that `normalize(t1 × t2)` reproduces OpenSubdiv's normals and follows the face winding.
+
+use crate::scheme::{EdgeNeighborhood, Neighborhood, Scheme, VertexRule};
+use std::f64::consts::PI;
+
+/// What the face weights of a [`Mask`] refer to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FaceWeights {
+    /// The centroid of each incident face (its Catmull-Clark face point).
+    #[default]
+    Centers,
+    /// The vertex two corners away from the centre vertex in each incident face (the diagonal
+    /// vertex of a quad). Used by Catmull-Clark limit masks, which require quads.
+    Opposite,
+}
+
+/// Weights over a vertex neighbourhood: the vertex itself, its ring vertices (one per incident
+/// edge, in [`Neighborhood`] order) and its incident faces.
+///
+/// Buffers are reused between calls (`fill` methods clear and resize them), so one `Mask` per
+/// thread serves a whole mesh without allocating.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mask {
+    /// Weight of the centre vertex.
+    pub vertex: f64,
+    /// Weight of the far end of each incident edge (`num_edges` entries).
+    pub edges: Vec<f64>,
+    /// Weight of each incident face (`num_faces` entries, or none), interpreted as `face_weights`.
+    pub faces: Vec<f64>,
+    /// What `faces` refers to.
+    pub face_weights: FaceWeights,
+}
+
+impl Mask {
+    fn reset(&mut self, num_edges: usize, num_faces: usize, face_weights: FaceWeights) {
+        self.vertex = 0.0;
+        self.edges.clear();
+        self.edges.resize(num_edges, 0.0);
+        self.faces.clear();
+        self.faces.resize(num_faces, 0.0);
+        self.face_weights = face_weights;
+    }
+
+    /// Sum of all weights (1 for position masks, 0 for tangent masks).
+    pub fn sum(&self) -> f64 {
+        self.vertex + self.edges.iter().sum::<f64>() + self.faces.iter().sum::<f64>()
+    }
+}
+
+/// The weights of an edge point: both ends get `end`, each incident face gets `face`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeMask {
+    /// Weight of each end vertex.
+    pub end: f64,
+    /// Weight of each incident face, interpreted as `face_weights`: for Loop the vertex of the
+    /// triangle opposite the edge, for Catmull-Clark the face point.
+    pub face: f64,
+    /// What `face` refers to: [`FaceWeights::Opposite`] (Loop) or [`FaceWeights::Centers`]
+    /// (Catmull-Clark).
+    pub face_weights: FaceWeights,
+}
+
+/// Loop's β for a smooth vertex of valence `n` (Loop 1987): `(5/8 − (3/8 + ¼ cos 2π/n)²) / n`.
+pub fn loop_beta(n: usize) -> f64 {
+    let c = 0.375 + 0.25 * (2.0 * PI / n as f64).cos();
+    (0.625 - c * c) / n as f64
+}
+
+impl Scheme {
+    /// Fills the mask of the child vertex of a vertex (its "vertex point"). Face weights, when
+    /// present, refer to face centres. Cost O(valence).
+    pub fn vertex_point_mask(self, hood: &Neighborhood, mask: &mut Mask) {
+        let n = hood.num_edges;
+        match hood.rule {
+            VertexRule::Corner => {
+                mask.reset(n, 0, FaceWeights::Centers);
+                mask.vertex = 1.0;
+            }
+            VertexRule::Crease => {
+                mask.reset(n, 0, FaceWeights::Centers);
+                mask.vertex = 0.75;
+                mask.edges[hood.crease_ends[0]] = 0.125;
+                mask.edges[hood.crease_ends[1]] = 0.125;
+            }
+            VertexRule::Smooth | VertexRule::Dart => match self {
+                Scheme::Loop => {
+                    mask.reset(n, 0, FaceWeights::Centers);
+                    let (v, e) = if n == 6 {
+                        (0.625, 0.0625)
+                    } else {
+                        let b = loop_beta(n);
+                        (1.0 - n as f64 * b, b)
+                    };
+                    mask.vertex = v;
+                    mask.edges.fill(e);
+                }
+                Scheme::CatmullClark => {
+                    let nf = hood.num_faces;
+                    mask.reset(n, nf, FaceWeights::Centers);
+                    let nn = n as f64;
+                    mask.vertex = (nn - 2.0) / nn;
+                    mask.edges.fill(1.0 / (nn * nn));
+                    mask.faces.fill(1.0 / (nn * nn));
+                }
+            },
+        }
+    }
+
+    /// The mask of the child vertex of an edge (its "edge point"). Cost O(1).
+    pub fn edge_point_mask(self, edge: &EdgeNeighborhood) -> EdgeMask {
+        let face_weights = match self {
+            Scheme::Loop => FaceWeights::Opposite,
+            Scheme::CatmullClark => FaceWeights::Centers,
+        };
+        if edge.sharp || edge.num_faces < 2 {
+            return EdgeMask {
+                end: 0.5,
+                face: 0.0,
+                face_weights,
+            };
+        }
+        match self {
+            Scheme::Loop => EdgeMask {
+                end: 0.375,
+                face: 0.125,
+                face_weights,
+            },
+            Scheme::CatmullClark => EdgeMask {
+                end: 0.25,
+                face: 0.5 / edge.num_faces as f64,
+                face_weights,
+            },
+        }
+    }
+
+    /// Fills the limit position mask and the two limit tangent masks of a vertex.
+    ///
+    /// Requires the regular face size around the vertex for Catmull-Clark (quads: face weights
+    /// are [`FaceWeights::Opposite`]). Tangent conventions are OpenSubdiv's: at a smooth vertex
+    /// `t1` points toward ring edge 0 and `t2` is rotated toward edge 1; at a crease `t1` runs
+    /// along the crease toward the leading crease edge and `t2` points across the surface into the
+    /// span between the crease edges; at a corner `t1`, `t2` point along edges 0 and 1. With the
+    /// counter-clockwise ring of [`Neighborhood`], `t1 × t2` points to the side the face winding
+    /// makes the front. Magnitudes are OpenSubdiv's (only directions are meaningful). A vertex
+    /// without edges gets zero tangents. Cost O(valence).
+    pub fn limit_masks(self, hood: &Neighborhood, pos: &mut Mask, t1: &mut Mask, t2: &mut Mask) {
+        let n = hood.num_edges;
+        let nf = hood.num_faces;
+        let rule = match hood.rule {
+            VertexRule::Smooth | VertexRule::Dart if nf == 2 && n == 2 => VertexRule::Corner,
+            r => r,
+        };
+        match rule {
+            VertexRule::Corner => {
+                pos.reset(n, 0, FaceWeights::Opposite);
+                pos.vertex = 1.0;
+                t1.reset(n, 0, FaceWeights::Opposite);
+                t2.reset(n, 0, FaceWeights::Opposite);
+                if n >= 2 {
+                    let s = match self {
+                        Scheme::Loop => 3.0,
+                        Scheme::CatmullClark => 1.0,
+                    };
+                    t1.vertex = -s;
+                    t1.edges[0] = s;
+                    t2.vertex = -s;
+                    t2.edges[1] = s;
+                }
+            }
+            VertexRule::Crease => {
+                pos.reset(n, 0, FaceWeights::Opposite);
+                pos.vertex = 2.0 / 3.0;
+                pos.edges[hood.crease_ends[0]] = 1.0 / 6.0;
+                pos.edges[hood.crease_ends[1]] = 1.0 / 6.0;
+                match self {
+                    Scheme::Loop => loop_crease_tangents(hood, t1, t2),
+                    Scheme::CatmullClark => catmark_crease_tangents(hood, t1, t2),
+                }
+            }
+            VertexRule::Smooth | VertexRule::Dart => match self {
+                Scheme::Loop => loop_smooth_limit(n, pos, t1, t2),
+                Scheme::CatmullClark => catmark_smooth_limit(n, pos, t1, t2),
+            },
+        }
+    }
+}
+
+fn loop_smooth_limit(n: usize, pos: &mut Mask, t1: &mut Mask, t2: &mut Mask) {
+    pos.reset(n, 0, FaceWeights::Opposite);
+    let (v, e) = if n == 6 {
+        (0.5, 1.0 / 12.0)
+    } else {
+        let e = 1.0 / (n as f64 + 3.0 / (8.0 * loop_beta(n)));
+        (1.0 - n as f64 * e, e)
+    };
+    pos.vertex = v;
+    pos.edges.fill(e);
+    t1.reset(n, 0, FaceWeights::Opposite);
+    t2.reset(n, 0, FaceWeights::Opposite);
+    if n == 6 {
+        let r = 0.5 * 3f64.sqrt();
+        t1.edges.copy_from_slice(&[1.0, 0.5, -0.5, -1.0, -0.5, 0.5]);
+        t2.edges.copy_from_slice(&[0.0, r, r, 0.0, -r, -r]);
+    } else {
+        let alpha = 2.0 * PI / n as f64;
+        for i in 0..n {
+            let a = alpha * i as f64;
+            t1.edges[i] = a.cos();
+            t2.edges[i] = a.sin();
+        }
+    }
+}
+
+fn catmark_smooth_limit(n: usize, pos: &mut Mask, t1: &mut Mask, t2: &mut Mask) {
+    pos.reset(n, n, FaceWeights::Opposite);
+    let (v, e, f) = if n == 4 {
+        (4.0 / 9.0, 1.0 / 9.0, 1.0 / 36.0)
+    } else {
+        let nn = n as f64;
+        let f = 1.0 / (nn * (nn + 5.0));
+        let e = 4.0 * f;
+        (1.0 - nn * (e + f), e, f)
+    };
+    pos.vertex = v;
+    pos.edges.fill(e);
+    pos.faces.fill(f);
+    t1.reset(n, n, FaceWeights::Opposite);
+    t2.reset(n, n, FaceWeights::Opposite);
+    if n == 4 {
+        t1.edges.copy_from_slice(&[4.0, 0.0, -4.0, 0.0]);
+        t1.faces.copy_from_slice(&[1.0, -1.0, -1.0, 1.0]);
+        t2.edges.copy_from_slice(&[0.0, 4.0, 0.0, -4.0]);
+        t2.faces.copy_from_slice(&[1.0, 1.0, -1.0, -1.0]);
+        return;
+    }
+    let theta = 2.0 * PI / n as f64;
+    let (ct, cht) = (theta.cos(), (0.5 * theta).cos());
+    // Subdominant eigenvalue of the Catmull-Clark subdivision matrix.
+    let lambda = 5.0 / 16.0 + (ct + cht * (2.0 * (9.0 + ct)).sqrt()) / 16.0;
+    let fscale = 1.0 / (4.0 * lambda - 1.0);
+    for i in 0..n {
+        let (ci, ci1) = ((theta * i as f64).cos(), (theta * (i + 1) as f64).cos());
+        t1.edges[i] = 4.0 * ci;
+        t1.faces[i] = fscale * (ci + ci1);
+    }
+    // t2 is t1 rotated one step toward edge 1.
+    for i in 0..n {
+        let j = (i + n - 1) % n;
+        t2.edges[i] = t1.edges[j];
+        t2.faces[i] = t1.faces[j];
+    }
+}
+
+fn loop_crease_tangents(hood: &Neighborhood, t1: &mut Mask, t2: &mut Mask) {
+    let n = hood.num_edges;
+    let [c0, c1] = hood.crease_ends;
+    t1.reset(n, 0, FaceWeights::Opposite);
+    t1.edges[c0] = 1.5;
+    t1.edges[c1] = -1.5;
+    t2.reset(n, 0, FaceWeights::Opposite);
+    let interior = c1 - c0 - 1;
+    match interior {
+        0 => {
+            t2.vertex = -6.0;
+            t2.edges[c0] = 3.0;
+            t2.edges[c1] = 3.0;
+        }
+        1 => {
+            t2.vertex = -3.0;
+            t2.edges[c0 + 1] = 3.0;
+        }
+        2 => {
+            let r3 = 3f64.sqrt();
+            t2.vertex = -r3;
+            t2.edges[c0] = -0.5 * r3;
+            t2.edges[c1] = -0.5 * r3;
+            t2.edges[c0 + 1] = r3;
+            t2.edges[c0 + 2] = r3;
+        }
+        k => {
+            let theta = PI / (k + 1) as f64;
+            let cw = -3.0 * theta.sin();
+            let ecoef = -3.0 * (2.0 * theta.cos() - 2.0);
+            t2.edges[c0] = cw;
+            t2.edges[c1] = cw;
+            for i in 1..=k {
+                t2.edges[c0 + i] = ecoef * (i as f64 * theta).sin();
+            }
+        }
+    }
+}
+
+fn catmark_crease_tangents(hood: &Neighborhood, t1: &mut Mask, t2: &mut Mask) {
+    let (n, nf) = (hood.num_edges, hood.num_faces);
+    let [c0, c1] = hood.crease_ends;
+    t1.reset(n, nf, FaceWeights::Opposite);
+    t1.edges[c0] = 0.5;
+    t1.edges[c1] = -0.5;
+    t2.reset(n, nf, FaceWeights::Opposite);
+    let interior = c1 - c0 - 1;
+    match interior {
+        0 => {
+            t2.vertex = -6.0;
+            t2.edges[c0] = 3.0;
+            t2.edges[c1] = 3.0;
+        }
+        1 => {
+            // Regular boundary: the uniform B-spline cross tangent.
+            t2.vertex = -4.0 / 6.0;
+            t2.edges[c0] = -1.0 / 6.0;
+            t2.edges[c0 + 1] = 4.0 / 6.0;
+            t2.edges[c1] = -1.0 / 6.0;
+            t2.faces[c0] = 1.0 / 6.0;
+            t2.faces[c0 + 1] = 1.0 / 6.0;
+        }
+        _ => {
+            // Biermann et al. 2000, as OpenSubdiv.
+            let k = (interior + 1) as f64;
+            let theta = PI / k;
+            let (ct, st) = (theta.cos(), theta.sin());
+            let denom = 1.0 / (k * (3.0 + ct));
+            let r = (ct + 1.0) / st;
+            t2.vertex = 4.0 * r * (ct - 1.0) * denom;
+            let cw = -r * (1.0 + 2.0 * ct) * denom;
+            t2.edges[c0] = cw;
+            t2.edges[c1] = cw;
+            t2.faces[c0] = st * denom;
+            let mut s_next = st;
+            for i in 1..=interior {
+                let s_i = s_next;
+                s_next = ((i + 1) as f64 * theta).sin();
+                t2.edges[c0 + i] = 4.0 * s_i * denom;
+                t2.faces[c0 + i] = (s_i + s_next) * denom;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hood(n: usize, nf: usize, rule: VertexRule, ends: [usize; 2]) -> Neighborhood {
+        Neighborhood {
+            num_edges: n,
+            num_faces: nf,
+            rule,
+            crease_ends: ends,
+        }
+    }
+
+    #[test]
+    fn masks_sum_to_one_and_tangents_to_zero() {
+        let mut m = Mask::default();
+        let (mut p, mut a, mut b) = (Mask::default(), Mask::default(), Mask::default());
+        for scheme in [Scheme::Loop, Scheme::CatmullClark] {
+            for n in 3..12 {
+                let hs = [
+                    hood(n, n, VertexRule::Smooth, [0, 0]),
+                    hood(n, n - 1, VertexRule::Crease, [0, n - 1]),
+                    hood(n, n, VertexRule::Crease, [1, n - 1]),
+                    hood(n, n, VertexRule::Corner, [0, 0]),
+                ];
+                for h in &hs {
+                    scheme.vertex_point_mask(h, &mut m);
+                    assert!((m.sum() - 1.0).abs() < 1e-14);
+                    scheme.limit_masks(h, &mut p, &mut a, &mut b);
+                    assert!((p.sum() - 1.0).abs() < 1e-14);
+                    assert!(a.sum().abs() < 1e-13 && b.sum().abs() < 1e-13, "{h:?}");
+                }
+            }
+        }
+        assert_eq!(loop_beta(6), 1.0 / 16.0);
+        assert!((loop_beta(3) - 3.0 / 16.0).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,257 @@
+//! Uniform refinement: one level of Loop or Catmull-Clark subdivision as a sparse matrix.
+//!
+//! Loop 1987 (1→4 triangle split); Catmull & Clark 1978 (an `n`-gon becomes `n` quads);
+//! Hoppe et al. 1994 sharp creases and corners; OpenSubdiv 3.5 `Far::TopologyRefiner` for the
+//! vertex rules and boundary interpolation. The masks come from [`crate::mask`].
+//!
+//! # Child vertex order (stable, documented)
+//! With `V`, `E`, `F` the parent's vertex, edge and face counts, child vertex
+//! * `v` (`0 ≤ v < V`) is the vertex point of parent vertex `v` — so control-vertex ids persist
+//!   through all levels;
+//! * `V + e` (`0 ≤ e < E`) is the edge point of parent edge `e`, edges numbered in order of first
+//!   appearance when faces are scanned in order and each face's corners in winding order (face
+//!   edge `i` joins face vertices `i` and `i + 1`), see [`Topology`];
+//! * `V + E + f` (`0 ≤ f < F`, Catmull-Clark only) is the face point of parent face `f`.
+//!
+//! (OpenSubdiv orders face points, edge points, vertex points; compare point sets, not indices.)
+//!
+//! # Child face order
+//! Children of parent face `f` are consecutive, in parent face order. Loop: triangle
+//! `(a, b, c)` with edge points `ab, bc, ca` gives `(a, ab, ca)`, `(b, bc, ab)`, `(c, ca, bc)`,
+//! `(ab, bc, ca)`. Catmull-Clark: face `(v_0 … v_{n−1})` with face point `F` gives, for each `i`,
+//! the quad `(v_i, e_{i,i+1}, F, e_{i−1,i})`. Winding is preserved.
+
+use crate::error::SubdivError;
+use crate::mask::{FaceWeights, Mask};
+use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
+use crate::stencil::StencilMatrix;
+use crate::topology::Topology;
+use subfit_mesh::{Polygons, Tags, SHARPNESS_INFINITE};
+
+/// One level of uniform refinement.
+#[derive(Clone, Debug)]
+pub struct Refinement {
+    /// The child faces (order in the module docs).
+    pub faces: Polygons,
+    /// Number of child vertices (`V + E` for Loop, `V + E + F` for Catmull-Clark).
+    pub num_vertices: usize,
+    /// Tags carried to the child mesh: infinitely sharp creases on both child edges of a sharp
+    /// parent edge, finite sharpness decremented by one, corner tags on the same vertex ids.
+    pub tags: Tags,
+    /// The refinement operator, `num_vertices × parent vertices`: child positions =
+    /// `matrix.apply(parent positions)`.
+    pub matrix: StencilMatrix,
+}
+
+/// Checks that `faces` suit `scheme` (Loop needs triangles) and builds their adjacency.
+pub(crate) fn topology_for(
+    faces: &Polygons,
+    num_vertices: usize,
+    scheme: Scheme,
+) -> Result<Topology, SubdivError> {
+    if scheme == Scheme::Loop {
+        if let Some((face, f)) = faces.iter().enumerate().find(|(_, f)| f.len() != 3) {
+            return Err(SubdivError::NotTriangles { face, len: f.len() });
+        }
+    }
+    Topology::new(faces, num_vertices)
+}
+
+/// Whether each edge is infinitely sharp: boundary edges, and edges tagged with sharpness
+/// `>= SHARPNESS_INFINITE`. Cost O(#E) (plus one hash lookup per edge when tags exist).
+pub(crate) fn sharp_edges(topo: &Topology, tags: &Tags) -> Vec<bool> {
+    (0..topo.num_edges() as u32)
+        .map(|e| {
+            topo.is_boundary_edge(e) || {
+                let [a, b] = topo.edge_vertices(e);
+                !tags.is_empty() && tags.is_sharp_edge(a, b)
+            }
+        })
+        .collect()
+}
+
+/// The [`Neighborhood`] (rule and crease ends) of every vertex. Cost O(#corners).
+pub(crate) fn neighborhoods(
+    topo: &Topology,
+    sharp: &[bool],
+    tags: &Tags,
+    boundary: BoundaryRule,
+) -> Vec<Neighborhood> {
+    (0..topo.num_vertices() as u32)
+        .map(|v| {
+            let edges = topo.vertex_edges(v);
+            let num_faces = topo.vertex_corners(v).len();
+            let mut ends = [0usize; 2];
+            let mut nsharp = 0;
+            for (i, &e) in edges.iter().enumerate() {
+                if sharp[e as usize] {
+                    if nsharp < 2 {
+                        ends[nsharp] = i;
+                    }
+                    nsharp += 1;
+                }
+            }
+            let corner = edges.is_empty()
+                || nsharp > 2
+                || (!tags.is_empty() && tags.is_corner(v))
+                || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && edges.len() == 2);
+            let rule = match (corner, nsharp) {
+                (true, _) => VertexRule::Corner,
+                (false, 2) => VertexRule::Crease,
+                (false, 1) => VertexRule::Dart,
+                _ => VertexRule::Smooth,
+            };
+            Neighborhood {
+                num_edges: edges.len(),
+                num_faces,
+                rule,
+                crease_ends: ends,
+            }
+        })
+        .collect()
+}
+
+/// Refines `faces` (over `num_vertices` vertices, with crease/corner `tags`) by one level of
+/// `options.scheme`.
+///
+/// Errors: see [`SubdivError`] (bad topology; non-triangles for Loop). Cost O(#corners ·
+/// max valence); the matrix has about `V·(1 + valence) + 4E + Σ|f|` entries.
+pub fn refine(
+    faces: &Polygons,
+    num_vertices: usize,
+    tags: &Tags,
+    options: &Options,
+) -> Result<Refinement, SubdivError> {
+    let topo = topology_for(faces, num_vertices, options.scheme)?;
+    Ok(refine_topology(&topo, tags, options))
+}
+
+/// [`refine`] on an already built adjacency (which must suit the scheme).
+pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
+    let scheme = options.scheme;
+    let (nv, ne, nf) = (topo.num_vertices(), topo.num_edges(), topo.num_faces());
+    let sharp = sharp_edges(topo, tags);
+    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
+    let num_child = nv
+        + ne
+        + if scheme == Scheme::CatmullClark {
+            nf
+        } else {
+            0
+        };
+    let mut m = StencilMatrix::new(nv);
+    let mut row: Vec<(u32, f64)> = Vec::with_capacity(64);
+    let mut mask = Mask::default();
+    for v in 0..nv as u32 {
+        scheme.vertex_point_mask(&hoods[v as usize], &mut mask);
+        row.clear();
+        row.push((v, mask.vertex));
+        for (&u, &w) in topo.vertex_ring(v).iter().zip(&mask.edges) {
+            row.push((u, w));
+        }
+        debug_assert!(mask.faces.is_empty() || mask.face_weights == FaceWeights::Centers);
+        for (&c, &w) in topo.vertex_corners(v).iter().zip(&mask.faces) {
+            push_face_center(topo, topo.corner_face(c) as usize, w, &mut row);
+        }
+        m.push_row(&mut row);
+    }
+    for e in 0..ne as u32 {
+        let corners = topo.edge_corners(e);
+        let num_faces = if corners[1] == u32::MAX { 1 } else { 2 };
+        let em = scheme.edge_point_mask(&EdgeNeighborhood {
+            num_faces,
+            sharp: sharp[e as usize],
+        });
+        let [a, b] = topo.edge_vertices(e);
+        row.clear();
+        row.push((a, em.end));
+        row.push((b, em.end));
+        if em.face != 0.0 {
+            for &c in &corners[..num_faces] {
+                match em.face_weights {
+                    FaceWeights::Opposite => {
+                        row.push((topo.corner_vertex(topo.corner_prev(c)), em.face));
+                    }
+                    FaceWeights::Centers => {
+                        push_face_center(topo, topo.corner_face(c) as usize, em.face, &mut row);
+                    }
+                }
+            }
+        }
+        m.push_row(&mut row);
+    }
+    if scheme == Scheme::CatmullClark {
+        for f in 0..nf {
+            row.clear();
+            push_face_center(topo, f, 1.0, &mut row);
+            m.push_row(&mut row);
+        }
+    }
+    Refinement {
+        faces: child_faces(topo, scheme),
+        num_vertices: num_child,
+        tags: child_tags(topo, tags),
+        matrix: m,
+    }
+}
+
+fn push_face_center(topo: &Topology, f: usize, w: f64, row: &mut Vec<(u32, f64)>) {
+    let face = topo.face(f);
+    let wf = w / face.len() as f64;
+    row.extend(face.iter().map(|&u| (u, wf)));
+}
+
+fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
+    let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
+    let nf = topo.num_faces();
+    match scheme {
+        Scheme::Loop => {
+            let mut out = Polygons::with_capacity(4 * nf, 12 * nf);
+            for f in 0..nf {
+                let v = topo.face(f);
+                let e = topo.face_edges(f);
+                let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
+                out.push(&[v[0], ab, ca]);
+                out.push(&[v[1], bc, ab]);
+                out.push(&[v[2], ca, bc]);
+                out.push(&[ab, bc, ca]);
+            }
+            out
+        }
+        Scheme::CatmullClark => {
+            let nc = topo.face_first_corner(nf);
+            let mut out = Polygons::with_capacity(nc, 4 * nc);
+            for f in 0..nf {
+                let v = topo.face(f);
+                let e = topo.face_edges(f);
+                let n = v.len();
+                let fp = nv + ne + f as u32;
+                for i in 0..n {
+                    out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
+                }
+            }
+            out
+        }
+    }
+}
+
+fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
+    let mut out = Tags::new();
+    let nv = topo.num_vertices() as u32;
+    for ((a, b), s) in tags.creases() {
+        let child_s = if s >= SHARPNESS_INFINITE { s } else { s - 1.0 };
+        if child_s <= 0.0 || a as usize >= topo.num_vertices() {
+            continue;
+        }
+        let ring = topo.vertex_ring(a);
+        if let Some(i) = ring.iter().position(|&u| u == b) {
+            let ep = nv + topo.vertex_edges(a)[i];
+            out.set_crease(a, ep, child_s);
+            out.set_crease(ep, b, child_s);
+        }
+    }
+    for (v, s) in tags.corners() {
+        out.set_corner(v, s);
+    }
+    out
+}

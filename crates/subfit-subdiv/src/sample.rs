@@ -1,0 +1,144 @@
+//! The sampling operator `C = L_l · M_l ⋯ M_1` (Lavoué et al., §5.1; DESIGN §3.1): limit
+//! positions and limit tangents of all level-`l` vertices as sparse rows over the control points.
+//!
+//! `M_k` are the refinement matrices of [`crate::refine`], `L_l` the limit stencils of
+//! [`crate::limit`] at level `l`. Products are accumulated right to left
+//! (`P_k = M_k · P_{k−1}`, then `L_l · P_l`), so every intermediate row is over the control
+//! points and stays short (its support is the control-mesh neighbourhood of the vertex).
+
+use crate::error::SubdivError;
+use crate::limit::limit_topology;
+use crate::refine::{refine_topology, topology_for};
+use crate::scheme::Options;
+use crate::stencil::StencilMatrix;
+use crate::topology::Topology;
+use subfit_mesh::{Polygons, Tags};
+
+/// Limit stencils of the level-`l` vertices over the control points.
+#[derive(Clone, Debug)]
+pub struct SamplingOperator {
+    /// The refinement level `l` (0 = the control mesh itself).
+    pub level: usize,
+    /// Faces of the level-`l` mesh (vertex ids are row indices below).
+    pub faces: Polygons,
+    /// Number of level-`l` vertices (rows of the matrices).
+    pub num_vertices: usize,
+    /// Tags of the level-`l` mesh.
+    pub tags: Tags,
+    /// Limit positions, `#V_l × #V_0`; rows sum to 1.
+    pub position: StencilMatrix,
+    /// First limit tangents, `#V_l × #V_0`; rows sum to 0.
+    pub tangent1: StencilMatrix,
+    /// Second limit tangents, `#V_l × #V_0`; rows sum to 0.
+    pub tangent2: StencilMatrix,
+}
+
+/// Limit positions, tangents and unit normals of sample points (`#samples by 3` each).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LimitSamples {
+    /// Limit positions (units of the control points).
+    pub positions: Vec<[f64; 3]>,
+    /// First limit tangents (direction only is meaningful).
+    pub tangent1: Vec<[f64; 3]>,
+    /// Second limit tangents.
+    pub tangent2: Vec<[f64; 3]>,
+    /// Unit normals `normalize(t1 × t2)`; zero where the tangents are parallel or zero.
+    pub normals: Vec<[f64; 3]>,
+}
+
+/// Builds the sampling operator of `faces` (over `num_vertices` control points, with `tags`) at
+/// refinement `level`.
+///
+/// Errors: bad topology, or non-triangles for Loop (see [`SubdivError`]).
+/// Cost: `l` refinements, then three sparse products; memory about `3 · #V_l · s` entries with
+/// `s` ≈ 10–30 control points per row. A 10k-face control mesh at level 3 (≈ 320k Loop /
+/// 640k Catmull-Clark rows) builds in well under a second in release builds (see
+/// `benches/stencils.rs`).
+pub fn sampling_operator(
+    faces: &Polygons,
+    num_vertices: usize,
+    tags: &Tags,
+    options: &Options,
+    level: usize,
+) -> Result<SamplingOperator, SubdivError> {
+    let mut topo = topology_for(faces, num_vertices, options.scheme)?;
+    let mut level_faces = faces.clone();
+    let mut level_tags = tags.clone();
+    let mut product: Option<StencilMatrix> = None;
+    for _ in 0..level {
+        let r = refine_topology(&topo, &level_tags, options);
+        product = Some(match product {
+            None => r.matrix,
+            Some(p) => r.matrix.compose(&p),
+        });
+        topo = Topology::new(&r.faces, r.num_vertices)
+            .expect("the refinement of a valid mesh is valid");
+        level_faces = r.faces;
+        level_tags = r.tags;
+    }
+    let l = limit_topology(&topo, &level_tags, options);
+    let (position, tangent1, tangent2) = match &product {
+        None => (l.position, l.tangent1, l.tangent2),
+        Some(p) => {
+            let (pos, (t1, t2)) = rayon::join(
+                || l.position.compose(p),
+                || rayon::join(|| l.tangent1.compose(p), || l.tangent2.compose(p)),
+            );
+            (pos, t1, t2)
+        }
+    };
+    Ok(SamplingOperator {
+        level,
+        faces: level_faces,
+        num_vertices: topo.num_vertices(),
+        tags: level_tags,
+        position,
+        tangent1,
+        tangent2,
+    })
+}
+
+impl SamplingOperator {
+    /// Applies the operator to control points (`#V_0 by 3`). Cost O(nnz).
+    ///
+    /// # Panics
+    /// If `control.len()` differs from the control-point count.
+    #[track_caller]
+    pub fn evaluate(&self, control: &[[f64; 3]]) -> LimitSamples {
+        let positions = self.position.apply(control);
+        let tangent1 = self.tangent1.apply(control);
+        let tangent2 = self.tangent2.apply(control);
+        let normals = normals_from_tangents(&tangent1, &tangent2);
+        LimitSamples {
+            positions,
+            tangent1,
+            tangent2,
+            normals,
+        }
+    }
+}
+
+/// Unit normals `normalize(t1 × t2)` row by row; a zero vector where the cross product vanishes.
+///
+/// # Panics
+/// If the slices differ in length.
+#[track_caller]
+pub fn normals_from_tangents(t1: &[[f64; 3]], t2: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    assert_eq!(t1.len(), t2.len(), "tangent arrays differ in length");
+    t1.iter()
+        .zip(t2)
+        .map(|(a, b)| {
+            let n = [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ];
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if len > 0.0 && len.is_finite() {
+                [n[0] / len, n[1] / len, n[2] / len]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect()
+}

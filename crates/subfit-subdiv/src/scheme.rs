@@ -1,0 +1,138 @@
+//! Subdivision schemes, boundary rules and options, in OpenSubdiv's `Sdc` vocabulary.
+//!
+//! Sources: Loop 1987 (*Smooth subdivision surfaces based on triangles*, MSc thesis, Utah);
+//! Catmull & Clark 1978 (*Recursively generated B-spline surfaces on arbitrary topological
+//! meshes*); Hoppe et al. 1994 (*Piecewise smooth surface reconstruction*) for sharp creases and
+//! corners; OpenSubdiv 3.5 `sdc/` documentation ("Subdivision Surfaces" and "Sharpness and
+//! creasing") for the vocabulary (vertex rules Smooth / Dart / Crease / Corner and the
+//! `VTX_BOUNDARY_*` interpolation rules).
+//!
+//! Nothing here knows about mesh storage: a vertex is described to the scheme by a
+//! [`Neighborhood`] (how many edges and faces surround it, which rule applies, where the crease
+//! edges are in its ring), and the scheme fills masks from it (see [`crate::mask`]).
+
+/// A subdivision scheme.
+///
+/// A future `QuadTriangle` variant (the Stam–Loop quad/triangle hybrid, Stam & Loop 2003) belongs
+/// here: it would use the Catmull-Clark rules on quads, Loop's on triangles and the mixed vertex
+/// rule of Stam & Loop §3 at vertices where both meet; refinement splits quads 1→4 and triangles
+/// 1→4 without face points for triangles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Scheme {
+    /// Loop 1987: triangle meshes only; 1→4 triangle split; box-spline (quartic) regular patches.
+    #[default]
+    Loop,
+    /// Catmull & Clark 1978: any polygons; every `n`-gon is split into `n` quads at the first
+    /// level (face point + edge points), after which the mesh is all quads; bicubic B-spline
+    /// regular patches.
+    CatmullClark,
+}
+
+impl Scheme {
+    /// The face size of the regular case (3 for Loop, 4 for Catmull-Clark).
+    pub fn regular_face_size(self) -> usize {
+        match self {
+            Scheme::Loop => 3,
+            Scheme::CatmullClark => 4,
+        }
+    }
+
+    /// The valence of a regular interior vertex (6 for Loop, 4 for Catmull-Clark).
+    pub fn regular_valence(self) -> usize {
+        match self {
+            Scheme::Loop => 6,
+            Scheme::CatmullClark => 4,
+        }
+    }
+}
+
+/// How boundary vertices and edges are treated, as OpenSubdiv's `VtxBoundaryInterpolation`.
+///
+/// In both rules every boundary edge is an infinitely sharp crease, so the limit boundary is the
+/// uniform cubic B-spline of the boundary polygon (between corners).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum BoundaryRule {
+    /// `VTX_BOUNDARY_EDGE_ONLY`: boundary edges are sharp; boundary vertices on a single face
+    /// (valence 2) follow the crease rule like any other boundary vertex (they are smooth
+    /// along the boundary curve, not corners).
+    #[default]
+    EdgeOnly,
+    /// `VTX_BOUNDARY_EDGE_AND_CORNER`: as `EdgeOnly`, and every boundary vertex on exactly one
+    /// face is an infinitely sharp corner (it is interpolated).
+    EdgeAndCorner,
+}
+
+/// Options for refinement and limit evaluation.
+///
+/// Semi-sharp creases: a crease or corner tag counts as sharp when its sharpness is at least
+/// [`subfit_mesh::SHARPNESS_INFINITE`] (10, OpenSubdiv's infinite value); tags with a smaller,
+/// finite sharpness are treated as smooth (OpenSubdiv's decrementing semi-sharp rule is not
+/// implemented). Refinement still propagates finite sharpness to child edges decremented by one,
+/// as OpenSubdiv does, so the tags stay meaningful to other tools.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Options {
+    /// The subdivision scheme. Default: [`Scheme::Loop`].
+    pub scheme: Scheme,
+    /// The boundary interpolation rule. Default: [`BoundaryRule::EdgeOnly`].
+    pub boundary: BoundaryRule,
+}
+
+impl Options {
+    /// Options for `scheme` with the default boundary rule.
+    pub fn new(scheme: Scheme) -> Self {
+        Self {
+            scheme,
+            boundary: BoundaryRule::default(),
+        }
+    }
+
+    /// Builder-style setter for the boundary rule.
+    pub fn with_boundary(mut self, boundary: BoundaryRule) -> Self {
+        self.boundary = boundary;
+        self
+    }
+}
+
+/// The rule that applies at a vertex (OpenSubdiv `Sdc::Crease::Rule`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum VertexRule {
+    /// No sharp incident edge: the smooth rule.
+    Smooth,
+    /// Exactly one sharp incident edge (interior): the smooth rule applies.
+    Dart,
+    /// Exactly two sharp incident edges (including boundary edges): the crease rule
+    /// (1/8, 3/4, 1/8; the limit is the cubic B-spline of the crease polygon).
+    Crease,
+    /// A corner tag, three or more sharp edges, an `EdgeAndCorner` boundary vertex on one face,
+    /// or an isolated vertex: the vertex is fixed.
+    Corner,
+}
+
+/// What a scheme needs to know about a vertex to fill its masks.
+///
+/// The vertex's ring is ordered counter-clockwise (seen with the face winding counter-clockwise):
+/// edge `i` joins the vertex to its `i`-th ring neighbour and face `i` lies between edges `i` and
+/// `i + 1`. At a boundary vertex edge 0 is the leading boundary edge, so there is one more edge
+/// than faces. This is OpenSubdiv's `Vtr` ordering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Neighborhood {
+    /// Number of incident edges (the valence).
+    pub num_edges: usize,
+    /// Number of incident faces (`num_edges` for an interior vertex, `num_edges - 1` at a
+    /// boundary).
+    pub num_faces: usize,
+    /// The rule at the vertex.
+    pub rule: VertexRule,
+    /// For [`VertexRule::Crease`]: the ring positions of the two sharp edges, ascending; the
+    /// first is the "leading" crease edge. Ignored for other rules.
+    pub crease_ends: [usize; 2],
+}
+
+/// What a scheme needs to know about an edge to fill its mask.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EdgeNeighborhood {
+    /// Number of incident faces (1 on a boundary, 2 inside).
+    pub num_faces: usize,
+    /// Whether the edge is infinitely sharp (boundary edges always are).
+    pub sharp: bool,
+}

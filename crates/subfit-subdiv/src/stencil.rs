@@ -1,0 +1,311 @@
+//! `StencilMatrix`: a sparse row-major (CSR) matrix of f64 weights over control points.
+//!
+//! Every subdivision operation of this crate — one level of refinement, limit positions, limit
+//! tangents, their compositions — is such a matrix (OpenSubdiv `Far::StencilTable`). Rows are
+//! results (refined or limit vertices), columns are inputs (parent or control vertices).
+//! Products use row-by-row accumulation into a dense scratch row with a list of touched columns
+//! (Gustavson's algorithm), parallel over row blocks with rayon.
+
+use rayon::prelude::*;
+
+/// Entries with `|w| <= DROP_TOLERANCE * max_row |w|` are dropped by [`StencilMatrix::compose`]
+/// (round-off left by cancelling weights, e.g. in tangent rows). Relative, dimensionless.
+pub const DROP_TOLERANCE: f64 = 1e-15;
+
+/// A sparse matrix in compressed-row form with f64 weights.
+///
+/// Shape `nrows × ncols`. Invariants (upheld by every constructor): `offsets` has `nrows + 1`
+/// non-decreasing entries starting at 0 and ending at `nnz`; column indices are `< ncols`, and
+/// sorted and unique within each row.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StencilMatrix {
+    ncols: usize,
+    offsets: Vec<usize>,
+    indices: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+impl StencilMatrix {
+    /// An empty matrix with `ncols` columns and no rows.
+    pub fn new(ncols: usize) -> Self {
+        Self {
+            ncols,
+            offsets: vec![0],
+            indices: Vec::new(),
+            weights: Vec::new(),
+        }
+    }
+
+    /// The `n × n` identity.
+    pub fn identity(n: usize) -> Self {
+        Self {
+            ncols: n,
+            offsets: (0..=n).collect(),
+            indices: (0..n as u32).collect(),
+            weights: vec![1.0; n],
+        }
+    }
+
+    /// Builds a matrix from raw CSR arrays; `None` if the invariants above do not hold.
+    pub fn from_raw(
+        ncols: usize,
+        offsets: Vec<usize>,
+        indices: Vec<u32>,
+        weights: Vec<f64>,
+    ) -> Option<Self> {
+        let ok = offsets.first() == Some(&0)
+            && offsets.last() == Some(&indices.len())
+            && indices.len() == weights.len()
+            && offsets.windows(2).all(|w| {
+                w[0] <= w[1]
+                    && indices[w[0]..w[1]].windows(2).all(|p| p[0] < p[1])
+                    && indices[w[0]..w[1]].iter().all(|&c| (c as usize) < ncols)
+            });
+        ok.then_some(Self {
+            ncols,
+            offsets,
+            indices,
+            weights,
+        })
+    }
+
+    /// Appends a row given as `(column, weight)` pairs in any order; repeated columns are summed
+    /// and exact zeros dropped. Cost O(k log k) for `k` pairs.
+    ///
+    /// # Panics
+    /// If a column is `>= ncols` (a broken invariant).
+    #[track_caller]
+    pub fn push_row(&mut self, entries: &mut [(u32, f64)]) {
+        entries.sort_unstable_by_key(|e| e.0);
+        let mut last = u32::MAX;
+        for &(c, w) in entries.iter() {
+            assert!((c as usize) < self.ncols, "column {c} >= {}", self.ncols);
+            if c == last {
+                *self.weights.last_mut().expect("a previous entry") += w;
+            } else {
+                self.indices.push(c);
+                self.weights.push(w);
+                last = c;
+            }
+        }
+        // Drop exact zeros of this row.
+        let start = *self.offsets.last().expect("offsets start at 0");
+        let mut k = start;
+        for i in start..self.indices.len() {
+            if self.weights[i] != 0.0 {
+                self.indices[k] = self.indices[i];
+                self.weights[k] = self.weights[i];
+                k += 1;
+            }
+        }
+        self.indices.truncate(k);
+        self.weights.truncate(k);
+        self.offsets.push(k);
+    }
+
+    /// Number of rows.
+    #[inline]
+    pub fn nrows(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Number of columns.
+    #[inline]
+    pub fn ncols(&self) -> usize {
+        self.ncols
+    }
+
+    /// Number of stored entries.
+    #[inline]
+    pub fn nnz(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Row `i` as `(columns, weights)`, columns ascending.
+    ///
+    /// # Panics
+    /// If `i >= nrows`.
+    #[inline]
+    #[track_caller]
+    pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let (a, b) = (self.offsets[i], self.offsets[i + 1]);
+        (&self.indices[a..b], &self.weights[a..b])
+    }
+
+    /// The row offsets (`nrows + 1` entries).
+    pub fn offsets(&self) -> &[usize] {
+        &self.offsets
+    }
+
+    /// All column indices, row after row.
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// All weights, row after row.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// Sum of the weights of each row (`nrows` entries): 1 for position stencils, 0 for tangent
+    /// stencils.
+    pub fn row_sums(&self) -> Vec<f64> {
+        (0..self.nrows())
+            .map(|i| self.row(i).1.iter().sum())
+            .collect()
+    }
+
+    /// Multiplies every weight by `s`.
+    pub fn scale(&mut self, s: f64) {
+        self.weights.iter_mut().for_each(|w| *w *= s);
+    }
+
+    /// Keeps only the first `n` rows.
+    pub fn truncate_rows(&mut self, n: usize) {
+        if n < self.nrows() {
+            self.offsets.truncate(n + 1);
+            let nnz = self.offsets[n];
+            self.indices.truncate(nnz);
+            self.weights.truncate(nnz);
+        }
+    }
+
+    /// `y = self · x` for 3-vectors: `x` is `ncols by 3`, the result `nrows by 3`.
+    /// Cost O(nnz), parallel over rows.
+    ///
+    /// # Panics
+    /// If `x.len() != ncols`.
+    #[track_caller]
+    pub fn apply(&self, x: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let mut y = vec![[0.0; 3]; self.nrows()];
+        self.apply_into(x, &mut y);
+        y
+    }
+
+    /// As [`Self::apply`], writing into `y` (`nrows by 3`).
+    ///
+    /// # Panics
+    /// If `x.len() != ncols` or `y.len() != nrows`.
+    #[track_caller]
+    pub fn apply_into(&self, x: &[[f64; 3]], y: &mut [[f64; 3]]) {
+        assert_eq!(x.len(), self.ncols, "input has the wrong number of rows");
+        assert_eq!(y.len(), self.nrows(), "output has the wrong number of rows");
+        y.par_iter_mut()
+            .with_min_len(4096)
+            .enumerate()
+            .for_each(|(i, yi)| {
+                let (cols, ws) = self.row(i);
+                let mut acc = [0.0; 3];
+                for (&c, &w) in cols.iter().zip(ws) {
+                    let p = &x[c as usize];
+                    acc[0] += w * p[0];
+                    acc[1] += w * p[1];
+                    acc[2] += w * p[2];
+                }
+                *yi = acc;
+            });
+    }
+
+    /// The sparse product `self · rhs` (`nrows × rhs.ncols`). Entries below
+    /// [`DROP_TOLERANCE`] relative to their row's largest are dropped.
+    ///
+    /// Cost O(Σ over entries (i, j) of `self` of nnz(row j of rhs)), parallel over blocks of rows;
+    /// scratch O(rhs.ncols) per thread. Deterministic (columns sorted within each row).
+    ///
+    /// # Panics
+    /// If `self.ncols != rhs.nrows`.
+    #[track_caller]
+    pub fn compose(&self, rhs: &StencilMatrix) -> StencilMatrix {
+        assert_eq!(self.ncols, rhs.nrows(), "inner dimensions differ");
+        const BLOCK: usize = 2048;
+        let nrows = self.nrows();
+        let nblocks = nrows.div_ceil(BLOCK);
+        let blocks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..nblocks)
+            .into_par_iter()
+            .map_init(
+                || (vec![0.0f64; rhs.ncols], vec![false; rhs.ncols], Vec::new()),
+                |(acc, mark, touched), b| {
+                    let rows = b * BLOCK..((b + 1) * BLOCK).min(nrows);
+                    let mut lens = Vec::with_capacity(rows.len());
+                    let mut idx = Vec::new();
+                    let mut wts = Vec::new();
+                    for i in rows {
+                        let (cols, ws) = self.row(i);
+                        for (&j, &w) in cols.iter().zip(ws) {
+                            let (c2, w2) = rhs.row(j as usize);
+                            for (&c, &u) in c2.iter().zip(w2) {
+                                let c = c as usize;
+                                if !mark[c] {
+                                    mark[c] = true;
+                                    touched.push(c as u32);
+                                }
+                                acc[c] += w * u;
+                            }
+                        }
+                        touched.sort_unstable();
+                        let big = touched
+                            .iter()
+                            .fold(0.0f64, |m, &c| m.max(acc[c as usize].abs()));
+                        let before = idx.len();
+                        for &c in touched.iter() {
+                            let w = acc[c as usize];
+                            if w.abs() > DROP_TOLERANCE * big {
+                                idx.push(c);
+                                wts.push(w);
+                            }
+                            acc[c as usize] = 0.0;
+                            mark[c as usize] = false;
+                        }
+                        touched.clear();
+                        lens.push(idx.len() - before);
+                    }
+                    (lens, idx, wts)
+                },
+            )
+            .collect();
+        let nnz = blocks.iter().map(|b| b.1.len()).sum();
+        let mut out = StencilMatrix {
+            ncols: rhs.ncols,
+            offsets: Vec::with_capacity(nrows + 1),
+            indices: Vec::with_capacity(nnz),
+            weights: Vec::with_capacity(nnz),
+        };
+        out.offsets.push(0);
+        let mut end = 0;
+        for (lens, idx, wts) in blocks {
+            for l in lens {
+                end += l;
+                out.offsets.push(end);
+            }
+            out.indices.extend_from_slice(&idx);
+            out.weights.extend_from_slice(&wts);
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn compose_matches_dense_product() {
+        let mut a = StencilMatrix::new(3);
+        a.push_row(&mut [(2, 0.5), (0, 0.25), (2, 0.25)]);
+        a.push_row(&mut [(1, 1.0), (0, 0.0)]);
+        let mut b = StencilMatrix::new(2);
+        b.push_row(&mut [(0, 1.0)]);
+        b.push_row(&mut [(0, 0.5), (1, 0.5)]);
+        b.push_row(&mut [(1, 2.0)]);
+        assert_eq!(a.row(0), (&[0u32, 2][..], &[0.25, 0.75][..]));
+        assert_eq!(a.nnz(), 3);
+        let c = a.compose(&b);
+        assert_eq!(c.row(0), (&[0u32, 1][..], &[0.25, 1.5][..]));
+        assert_eq!(c.row(1), (&[0u32, 1][..], &[0.5, 0.5][..]));
+        let y = c.apply(&[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        assert_eq!(y[0], [0.25, 1.5, 0.0]);
+        let i = StencilMatrix::identity(2);
+        assert_eq!(c.compose(&i), c);
+        assert!(StencilMatrix::from_raw(2, vec![0, 2], vec![1, 0], vec![1.0, 1.0]).is_none());
+    }
+}

@@ -1,0 +1,347 @@
+//! The adjacency the subdivision rules need, built from a [`Polygons`] face list: numbered
+//! undirected edges and, for each vertex, its ring of edges and faces in OpenSubdiv's `Vtr` order.
+//!
+//! Built locally (half-edges found through per-vertex lists of outgoing directed edges) so the
+//! ring order matches OpenSubdiv exactly: counter-clockwise, face `i` between ring edges `i` and
+//! `i + 1`, and at a boundary vertex ring edge 0 is the leading boundary edge (see
+//! [`crate::Neighborhood`]).
+
+use crate::error::SubdivError;
+use subfit_mesh::Polygons;
+
+const NONE: u32 = u32::MAX;
+
+/// Edge and vertex-ring adjacency of a manifold, consistently oriented polygon mesh.
+///
+/// A *corner* is a (face, vertex) incidence, numbered as positions in `Polygons::indices()`;
+/// corner `c` of a face also names the directed edge from its vertex to the next vertex of the
+/// face. Edges are numbered in order of first appearance when faces are scanned in order and each
+/// face's corners in winding order. Memory O(#corners + #V).
+#[derive(Clone, Debug)]
+pub struct Topology {
+    num_vertices: usize,
+    offsets: Vec<u32>,
+    indices: Vec<u32>,
+    corner_face: Vec<u32>,
+    corner_edge: Vec<u32>,
+    edge_verts: Vec<[u32; 2]>,
+    edge_corners: Vec<[u32; 2]>,
+    ring_offsets: Vec<u32>,
+    ring_edges: Vec<u32>,
+    ring_verts: Vec<u32>,
+    face_ring_offsets: Vec<u32>,
+    ring_corners: Vec<u32>,
+}
+
+impl Topology {
+    /// Builds the adjacency of `faces` over `num_vertices` vertices. Vertices without faces are
+    /// allowed (they have empty rings).
+    ///
+    /// Errors: faces with fewer than 3 vertices, repeated or out-of-range vertex ids, a directed
+    /// edge used twice (non-manifold edge or inconsistent orientation), a vertex whose faces form
+    /// several fans. Cost O(#corners · max valence).
+    pub fn new(faces: &Polygons, num_vertices: usize) -> Result<Self, SubdivError> {
+        let offsets = faces.offsets().to_vec();
+        let indices = faces.indices().to_vec();
+        let nc = indices.len();
+        if num_vertices >= NONE as usize || nc >= NONE as usize {
+            return Err(SubdivError::TooLarge {
+                what: "vertices or face indices",
+                count: num_vertices.max(nc),
+            });
+        }
+        let mut corner_face = vec![0u32; nc];
+        for (f, w) in offsets.windows(2).enumerate() {
+            let face = &indices[w[0] as usize..w[1] as usize];
+            if face.len() < 3 {
+                return Err(SubdivError::DegenerateFace {
+                    face: f,
+                    len: face.len(),
+                });
+            }
+            for (i, &v) in face.iter().enumerate() {
+                if v as usize >= num_vertices {
+                    return Err(SubdivError::VertexOutOfRange {
+                        face: f,
+                        vertex: v,
+                        num_vertices,
+                    });
+                }
+                if face[..i].contains(&v) {
+                    return Err(SubdivError::RepeatedVertex { face: f, vertex: v });
+                }
+            }
+            corner_face[w[0] as usize..w[1] as usize].fill(f as u32);
+        }
+        let mut t = Topology {
+            num_vertices,
+            offsets,
+            indices,
+            corner_face,
+            corner_edge: vec![NONE; nc],
+            edge_verts: Vec::new(),
+            edge_corners: Vec::new(),
+            ring_offsets: Vec::new(),
+            ring_edges: Vec::new(),
+            ring_verts: Vec::new(),
+            face_ring_offsets: Vec::new(),
+            ring_corners: Vec::new(),
+        };
+        // Outgoing corners per vertex (CSR by counting sort), ascending corner order.
+        let mut out_off = vec![0u32; num_vertices + 1];
+        for &v in &t.indices {
+            out_off[v as usize + 1] += 1;
+        }
+        for i in 0..num_vertices {
+            out_off[i + 1] += out_off[i];
+        }
+        let mut fill = out_off.clone();
+        let mut out = vec![0u32; nc];
+        for (c, &v) in t.indices.iter().enumerate() {
+            out[fill[v as usize] as usize] = c as u32;
+            fill[v as usize] += 1;
+        }
+        let outgoing =
+            |v: u32| &out[out_off[v as usize] as usize..out_off[v as usize + 1] as usize];
+        t.build_edges(&outgoing)?;
+        t.build_rings(&outgoing)?;
+        Ok(t)
+    }
+
+    fn build_edges<'a>(&mut self, outgoing: &impl Fn(u32) -> &'a [u32]) -> Result<(), SubdivError> {
+        for c in 0..self.indices.len() as u32 {
+            let (a, b) = (self.indices[c as usize], self.corner_next_vertex(c));
+            let mut same = outgoing(a)
+                .iter()
+                .filter(|&&o| self.corner_next_vertex(o) == b);
+            if same.nth(1).is_some() {
+                return Err(SubdivError::NonManifoldEdge { a, b });
+            }
+            if self.corner_edge[c as usize] != NONE {
+                continue;
+            }
+            let e = self.edge_verts.len() as u32;
+            self.corner_edge[c as usize] = e;
+            let twin = outgoing(b)
+                .iter()
+                .copied()
+                .find(|&o| self.corner_next_vertex(o) == a)
+                .unwrap_or(NONE);
+            if twin != NONE {
+                self.corner_edge[twin as usize] = e;
+            }
+            self.edge_verts.push([a, b]);
+            self.edge_corners.push([c, twin]);
+        }
+        Ok(())
+    }
+
+    fn build_rings<'a>(&mut self, outgoing: &impl Fn(u32) -> &'a [u32]) -> Result<(), SubdivError> {
+        let nv = self.num_vertices;
+        self.ring_offsets = Vec::with_capacity(nv + 1);
+        self.face_ring_offsets = Vec::with_capacity(nv + 1);
+        self.ring_offsets.push(0);
+        self.face_ring_offsets.push(0);
+        self.ring_edges.reserve(self.indices.len() + nv);
+        self.ring_corners.reserve(self.indices.len());
+        for v in 0..nv as u32 {
+            let outs = outgoing(v);
+            if let Some(&first) = outs.first() {
+                // A boundary vertex starts at the face whose leading edge has no twin.
+                let start = outs
+                    .iter()
+                    .copied()
+                    .find(|&c| self.is_boundary_edge(self.corner_edge[c as usize]))
+                    .unwrap_or(first);
+                let mut cur = start;
+                let mut count = 0usize;
+                loop {
+                    count += 1;
+                    if count > outs.len() {
+                        return Err(SubdivError::NonManifoldVertex { vertex: v });
+                    }
+                    self.ring_corners.push(cur);
+                    self.ring_edges.push(self.corner_edge[cur as usize]);
+                    self.ring_verts.push(self.corner_next_vertex(cur));
+                    let pc = self.corner_prev(cur);
+                    let p = self.indices[pc as usize];
+                    match outgoing(v)
+                        .iter()
+                        .copied()
+                        .find(|&o| self.corner_next_vertex(o) == p)
+                    {
+                        Some(c2) if c2 == start => break,
+                        Some(c2) => cur = c2,
+                        None => {
+                            self.ring_edges.push(self.corner_edge[pc as usize]);
+                            self.ring_verts.push(p);
+                            break;
+                        }
+                    }
+                }
+                if count != outs.len() {
+                    return Err(SubdivError::NonManifoldVertex { vertex: v });
+                }
+            }
+            self.ring_offsets.push(self.ring_edges.len() as u32);
+            self.face_ring_offsets.push(self.ring_corners.len() as u32);
+        }
+        Ok(())
+    }
+
+    /// Number of vertices.
+    #[inline]
+    pub fn num_vertices(&self) -> usize {
+        self.num_vertices
+    }
+
+    /// Number of faces.
+    #[inline]
+    pub fn num_faces(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Number of undirected edges.
+    #[inline]
+    pub fn num_edges(&self) -> usize {
+        self.edge_verts.len()
+    }
+
+    /// Vertex ids of face `f` in winding order.
+    #[inline]
+    pub fn face(&self, f: usize) -> &[u32] {
+        &self.indices[self.offsets[f] as usize..self.offsets[f + 1] as usize]
+    }
+
+    /// Index of the first corner of face `f` (its corners are consecutive).
+    #[inline]
+    pub fn face_first_corner(&self, f: usize) -> usize {
+        self.offsets[f] as usize
+    }
+
+    /// Edge ids of face `f`: entry `i` joins face vertices `i` and `i + 1`.
+    #[inline]
+    pub fn face_edges(&self, f: usize) -> &[u32] {
+        &self.corner_edge[self.offsets[f] as usize..self.offsets[f + 1] as usize]
+    }
+
+    /// The face containing corner `c`.
+    #[inline]
+    pub fn corner_face(&self, c: u32) -> u32 {
+        self.corner_face[c as usize]
+    }
+
+    /// The vertex of corner `c`.
+    #[inline]
+    pub fn corner_vertex(&self, c: u32) -> u32 {
+        self.indices[c as usize]
+    }
+
+    /// The corner after `c` in its face's winding.
+    #[inline]
+    pub fn corner_next(&self, c: u32) -> u32 {
+        let f = self.corner_face[c as usize] as usize;
+        if c + 1 == self.offsets[f + 1] {
+            self.offsets[f]
+        } else {
+            c + 1
+        }
+    }
+
+    /// The corner before `c` in its face's winding.
+    #[inline]
+    pub fn corner_prev(&self, c: u32) -> u32 {
+        let f = self.corner_face[c as usize] as usize;
+        if c == self.offsets[f] {
+            self.offsets[f + 1] - 1
+        } else {
+            c - 1
+        }
+    }
+
+    /// The vertex after corner `c`'s vertex in its face.
+    #[inline]
+    pub fn corner_next_vertex(&self, c: u32) -> u32 {
+        self.indices[self.corner_next(c) as usize]
+    }
+
+    /// End vertices of edge `e`, in the direction of the first face that uses it.
+    #[inline]
+    pub fn edge_vertices(&self, e: u32) -> [u32; 2] {
+        self.edge_verts[e as usize]
+    }
+
+    /// The (one or two) corners whose directed edge is `e`: `[c, u32::MAX]` on a boundary.
+    #[inline]
+    pub fn edge_corners(&self, e: u32) -> [u32; 2] {
+        self.edge_corners[e as usize]
+    }
+
+    /// Whether edge `e` has a single face.
+    #[inline]
+    pub fn is_boundary_edge(&self, e: u32) -> bool {
+        self.edge_corners[e as usize][1] == NONE
+    }
+
+    /// Ring edges of vertex `v`, counter-clockwise (see [`crate::Neighborhood`]).
+    #[inline]
+    pub fn vertex_edges(&self, v: u32) -> &[u32] {
+        let (a, b) = (
+            self.ring_offsets[v as usize],
+            self.ring_offsets[v as usize + 1],
+        );
+        &self.ring_edges[a as usize..b as usize]
+    }
+
+    /// Far ends of the ring edges of `v` (same order as [`Self::vertex_edges`]).
+    #[inline]
+    pub fn vertex_ring(&self, v: u32) -> &[u32] {
+        let (a, b) = (
+            self.ring_offsets[v as usize],
+            self.ring_offsets[v as usize + 1],
+        );
+        &self.ring_verts[a as usize..b as usize]
+    }
+
+    /// Corners of `v` in its incident faces, counter-clockwise: entry `i` is face `i` of the ring.
+    #[inline]
+    pub fn vertex_corners(&self, v: u32) -> &[u32] {
+        let (a, b) = (
+            self.face_ring_offsets[v as usize],
+            self.face_ring_offsets[v as usize + 1],
+        );
+        &self.ring_corners[a as usize..b as usize]
+    }
+
+    /// Whether `v` lies on the boundary (it has more ring edges than faces).
+    #[inline]
+    pub fn is_boundary_vertex(&self, v: u32) -> bool {
+        self.vertex_edges(v).len() > self.vertex_corners(v).len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rings_are_counter_clockwise_and_boundaries_start_at_the_leading_edge() {
+        // Two triangles sharing edge 1-2: 0 1 2, 2 1 3.
+        let p = Polygons::from_triangles(&[[0, 1, 2], [2, 1, 3]]);
+        let t = Topology::new(&p, 4).unwrap();
+        assert_eq!(t.num_edges(), 5);
+        // Vertex 1 starts at face 1, whose leading edge 1->3 is a boundary edge.
+        assert_eq!(t.vertex_ring(1), &[3, 2, 0]);
+        assert!(t.is_boundary_vertex(1));
+        let bad = Polygons::from_triangles(&[[0, 1, 2], [0, 1, 3]]);
+        assert!(matches!(
+            Topology::new(&bad, 4),
+            Err(SubdivError::NonManifoldEdge { .. })
+        ));
+        let bowtie = Polygons::from_triangles(&[[0, 1, 2], [0, 3, 4]]);
+        assert!(matches!(
+            Topology::new(&bowtie, 5),
+            Err(SubdivError::NonManifoldVertex { vertex: 0 })
+        ));
+    }
+}
