@@ -4,70 +4,9 @@ mod common;
 
 use common::*;
 use subfit_mesh::{
-    diagnose, face_components, EdgeId, FaceId, HalfEdgeId, HalfEdgeMesh, MeshReport, Polygons,
-    Tags, TopologyError, VertexId, SHARPNESS_INFINITE,
+    diagnose, face_components, EdgeId, FaceId, HalfEdgeMesh, MeshReport, Polygons, Tags,
+    TopologyError, VertexId, SHARPNESS_INFINITE,
 };
-
-/// Checks the half-edge invariants and that navigation agrees with the face list.
-fn check_invariants(faces: &Polygons, nv: usize) -> HalfEdgeMesh {
-    let m = HalfEdgeMesh::new(faces, nv).expect("valid mesh");
-    assert_eq!(m.num_faces(), faces.len());
-    assert_eq!(m.num_half_edges(), faces.indices().len());
-    for h in (0..m.num_half_edges() as u32).map(HalfEdgeId) {
-        assert_eq!(m.next(m.prev(h)), h);
-        assert_eq!(m.prev(m.next(h)), h);
-        assert_eq!(m.face(m.next(h)), m.face(h));
-        if let Some(t) = m.twin(h) {
-            assert_eq!(m.twin(t), Some(h));
-            assert_eq!(m.origin(t), m.dest(h));
-            assert_eq!(m.edge(t), m.edge(h));
-        }
-        let [a, b] = m.edge_vertices(m.edge(h));
-        assert!((a, b) == (m.origin(h), m.dest(h)) || (b, a) == (m.origin(h), m.dest(h)));
-    }
-    let mut valence_sum = 0;
-    let mut faces_sum = 0;
-    for v in (0..nv as u32).map(VertexId) {
-        let ring: Vec<_> = m.vertex_neighbors(v).collect();
-        let fs: Vec<_> = m.vertex_faces(v).collect();
-        assert_eq!(ring.len(), m.valence(v));
-        valence_sum += ring.len();
-        faces_sum += fs.len();
-        if m.vertex_half_edge(v).is_none() {
-            assert!(ring.is_empty());
-            continue;
-        }
-        assert_eq!(ring.len(), fs.len() + usize::from(m.is_boundary_vertex(v)));
-        // Face i of the fan holds v → ring[i] and ring[i+1] → v in its winding order.
-        for (i, h) in m.outgoing(v).enumerate() {
-            assert_eq!(m.origin(h), v);
-            assert_eq!(m.face(h), fs[i]);
-            assert_eq!(m.dest(h), ring[i]);
-            assert_eq!(m.origin(m.prev(h)), ring[(i + 1) % ring.len()]);
-        }
-        let distinct: std::collections::BTreeSet<_> = ring.iter().collect();
-        assert_eq!(
-            distinct.len(),
-            ring.len(),
-            "one-ring of {v} repeats a vertex"
-        );
-    }
-    assert_eq!(valence_sum, 2 * m.num_edges());
-    assert_eq!(faces_sum, m.num_half_edges());
-    let mut boundary = 0;
-    for lp in m.boundary_loops() {
-        for i in 0..lp.len() {
-            let h = m
-                .find_half_edge(lp[i], lp[(i + 1) % lp.len()])
-                .expect("loop edge");
-            assert!(m.is_boundary_half_edge(h));
-            assert!(m.is_boundary_vertex(lp[i]));
-        }
-        boundary += lp.len();
-    }
-    assert_eq!(boundary, m.num_boundary_edges());
-    m
-}
 
 /// Checks that the diagnostics agree with the half-edge view on a valid mesh.
 fn check_report(faces: &Polygons, nv: usize, genus: u32, loops: usize) -> MeshReport {
