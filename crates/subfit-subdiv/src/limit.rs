@@ -6,6 +6,12 @@
 //! (1/6, 2/3, 1/6) on creases and boundaries (Hoppe et al. 1994); corners are fixed. Tangent masks
 //! follow OpenSubdiv 3.5 (`sdc/*Scheme.h`, `Far::PrimvarRefiner::Limit`), see [`crate::mask`].
 //!
+//! Exactness: limit positions are exact everywhere except at darts (an interior vertex with one
+//! sharp edge), where the smooth mask is used as in OpenSubdiv; tangent directions are exact at
+//! smooth vertices and regular boundaries, and at irregular creases and corners they are
+//! OpenSubdiv's formulas (reproduced to round-off, see `tests/golden.rs`), which are
+//! approximations there.
+//!
 //! Catmull-Clark limit masks need quads around the vertex. When the mesh has other faces, the
 //! limit of a vertex is taken as the limit of its vertex point after one refinement step (the
 //! same point, exactly), with tangents scaled by 2 to undo the halving of the ring. (OpenSubdiv's
