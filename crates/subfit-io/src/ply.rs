@@ -521,8 +521,11 @@ impl Sink {
                     v.reserve(n);
                 }
             }
-            Role::Face => self.faces = Polygons::with_capacity(n, n.saturating_mul(3)),
-            Role::Strips | Role::Other => {}
+            // Only before the first face: a `tristrips` element may already have filled it.
+            Role::Face if self.faces.is_empty() => {
+                self.faces = Polygons::with_capacity(n, n.saturating_mul(3))
+            }
+            Role::Face | Role::Strips | Role::Other => {}
         }
     }
 
@@ -551,10 +554,22 @@ impl Sink {
                 for &i in &rec.list {
                     self.face.push(self.check_index(i)?);
                 }
+                self.room_for(self.face.len())?;
                 self.faces.push(&self.face);
             }
             Role::Strips => self.strips(&rec.list)?,
             Role::Other => {}
+        }
+        Ok(())
+    }
+
+    /// Whether `n` more corners still fit the `u32` offsets of [`Polygons`].
+    #[inline]
+    fn room_for(&self, n: usize) -> std::result::Result<(), ErrorKind> {
+        if self.faces.indices().len() + n > u32::MAX as usize {
+            return Err(ErrorKind::BadCount(
+                "more than 2^32 - 1 face corners in total".into(),
+            ));
         }
         Ok(())
     }
@@ -585,6 +600,7 @@ impl Sink {
                 if a == b || b == c || a == c {
                     continue;
                 }
+                self.room_for(3)?;
                 if j % 2 == 0 {
                     self.faces.push(&[a, b, c]);
                 } else {

@@ -648,3 +648,16 @@ fn shared_data_files_have_the_documented_counts() {
         }
     }
 }
+
+#[test]
+fn tristrips_and_faces_together_keep_both() {
+    let ascii = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+        property float z\nelement tristrips 1\nproperty list int int vertex_indices\n\
+        element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+        0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 2 3\n3 3 2 0\n";
+    let m = read_ok(ascii.as_bytes());
+    assert_eq!(
+        m.faces,
+        Polygons::from_triangles(&[[0, 1, 2], [2, 1, 3], [3, 2, 0]])
+    );
+}
