@@ -32,3 +32,5 @@ pub use sample::{normals_from_tangents, sampling_operator, LimitSamples, Samplin
 pub use scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
 pub use stencil::StencilMatrix;
 pub use topology::Topology;
+
+pub mod patch;
