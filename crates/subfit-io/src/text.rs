@@ -80,11 +80,7 @@ pub(crate) fn parse_i64(tok: &[u8]) -> Option<i64> {
 /// A syntax error at a line, quoting the offending token (shortened).
 pub(crate) fn syntax(path: &Path, line: u64, what: &str, tok: &[u8]) -> Error {
     let shown = String::from_utf8_lossy(&tok[..tok.len().min(40)]).into_owned();
-    Error::at_line(
-        path,
-        line,
-        ErrorKind::Syntax(format!("{what}: `{shown}`")),
-    )
+    Error::at_line(path, line, ErrorKind::Syntax(format!("{what}: `{shown}`")))
 }
 
 /// Appends the shortest decimal that parses back to exactly `v`.
@@ -96,6 +92,96 @@ pub(crate) fn push_f64(out: &mut Vec<u8>, v: f64) {
     let mut buf = ryu::Buffer::new();
     let s = buf.format(v);
     out.extend_from_slice(s.strip_suffix(".0").unwrap_or(s).as_bytes());
+}
+
+/// The 1-based line that byte offset `at` lies on, counting line endings as [`NumberedLines`]
+/// does (`\n`, `\r\n`, lone `\r`). Cost: O(at).
+pub(crate) fn line_of(bytes: &[u8], at: usize) -> u64 {
+    let head = &bytes[..at.min(bytes.len())];
+    let mut line = 1;
+    for (i, &c) in head.iter().enumerate() {
+        if c == b'\n' || (c == b'\r' && bytes.get(i + 1) != Some(&b'\n')) {
+            line += 1;
+        }
+    }
+    line
+}
+
+/// Checks that a text file is valid UTF-8; otherwise a syntax error at the line of the first
+/// invalid byte. Cost: O(file size), done once per file so that token parsing can rely on it.
+pub(crate) fn check_utf8(bytes: &[u8], path: &Path) -> Result<(), Error> {
+    match std::str::from_utf8(bytes) {
+        Ok(_) => Ok(()),
+        Err(e) => {
+            let at = e.valid_up_to();
+            let bad = &bytes[at..bytes.len().min(at + 4)];
+            Err(Error::at_line(
+                path,
+                line_of(bytes, at),
+                ErrorKind::Syntax(format!(
+                    "not UTF-8 text (byte {at}: {bad:02x?}); is this a binary file?"
+                )),
+            ))
+        }
+    }
+}
+
+/// Parses a float token that must be finite: a [`ErrorKind::Syntax`] error quoting the token
+/// when it is not a number, [`ErrorKind::NonFinite`] when it is NaN or infinite. `what` names
+/// the value in messages (`vertex coordinate`, `normal component`…).
+pub(crate) fn finite_f64(tok: &[u8], path: &Path, line: u64, what: &str) -> Result<f64, Error> {
+    match parse_f64(tok) {
+        Some(v) if v.is_finite() => Ok(v),
+        Some(_) => Err(Error::at_line(
+            path,
+            line,
+            ErrorKind::NonFinite(format!("{what} `{}`", String::from_utf8_lossy(tok))),
+        )),
+        None => Err(syntax(
+            path,
+            line,
+            &format!("expected a number ({what})"),
+            tok,
+        )),
+    }
+}
+
+/// Cuts a line at the first `#` (the comment character of OBJ, OFF and XYZ).
+pub(crate) fn strip_hash_comment(line: &[u8]) -> &[u8] {
+    match line.iter().position(|&c| c == b'#') {
+        Some(i) => &line[..i],
+        None => line,
+    }
+}
+
+/// Appends an unsigned integer in decimal.
+pub(crate) fn push_u64(out: &mut Vec<u8>, mut v: u64) {
+    let mut buf = [0u8; 20];
+    let mut i = buf.len();
+    loop {
+        i -= 1;
+        buf[i] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    out.extend_from_slice(&buf[i..]);
+}
+
+/// An 8-bit colour channel from a float in 0..1 (clamped, rounded to nearest).
+pub(crate) fn unit_to_u8(v: f64) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// Like [`push_f64`], but keeps the sign of zero (`-0`), so that every finite f64 reads back
+/// bit for bit.
+pub(crate) fn push_f64_exact(out: &mut Vec<u8>, v: f64) {
+    if v == 0.0 && v.is_sign_negative() {
+        out.extend_from_slice(b"-0");
+    } else {
+        push_f64(out, v);
+    }
 }
 
 #[cfg(test)]
@@ -119,7 +205,15 @@ mod tests {
 
     #[test]
     fn floats_round_trip() {
-        for v in [0.1, -1.0 / 3.0, 1e-300, 6.02e23, 12.5, -0.0, f64::MIN_POSITIVE] {
+        for v in [
+            0.1,
+            -1.0 / 3.0,
+            1e-300,
+            6.02e23,
+            12.5,
+            -0.0,
+            f64::MIN_POSITIVE,
+        ] {
             let mut out = Vec::new();
             push_f64(&mut out, v);
             let back = parse_f64(&out).unwrap();
