@@ -1,1 +1,56 @@
-//! subfit-target (being written).
+//! The shape being fitted (DESIGN.md §2 `subfit-target`, §3.2).
+//!
+//! A [`Target`] is a point cloud or mesh scaled uniformly into the unit cube (Cheng 2004 §3
+//! step 1), with exact duplicates merged, a kd-tree ([`neighbors`]), a unit normal and a local
+//! quadric per point ([`estimate`], [`quadric`]; Cheng 2004 §4.1, Cheng 2007 §II-C), normals
+//! oriented by minimum-spanning-tree propagation ([`orient`]; Hoppe et al. 1992), foot-point
+//! queries with the signed distance, frame and curvature radii of the SD term ([`project`];
+//! Cheng 2007 §II-D3), the IMLS distance ([`imls`]; Xie et al. 2023 eq. 2–3) and, for meshes,
+//! exact closest points on the triangles ([`closest`]).
+//!
+//! Everything inside is in normalized units; [`Normalization`] maps back. The library prints
+//! nothing: progress goes through [`ProgressFn`], figures through [`TargetStats`].
+//!
+//! ```
+//! use subfit_target::{Target, TargetOptions};
+//! // A 20×20 grid on a paraboloid.
+//! let pts: Vec<[f64; 3]> = (0..400)
+//!     .map(|i| {
+//!         let (x, y) = ((i % 20) as f64 / 19.0 - 0.5, (i / 20) as f64 / 19.0 - 0.5);
+//!         [x, y, 0.5 * (x * x + y * y)]
+//!     })
+//!     .collect();
+//! let t = Target::from_points(&pts, None, &TargetOptions::default()).unwrap();
+//! let f = t.foot_point(t.to_normalized([0.0, 0.0, 0.1]));
+//! assert!(f.distance > 0.0 && f.normal[2] > 0.99);
+//! ```
+
+// `!(x > 0.0)` is used deliberately: it is true for NaN, which must take the fallback branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+pub mod closest;
+mod error;
+pub mod estimate;
+pub mod imls;
+pub mod neighbors;
+mod normalize;
+mod options;
+pub mod orient;
+pub mod project;
+pub mod quadric;
+mod target;
+mod vec3;
+
+pub use closest::{MeshClosestPoint, TriangleBvh};
+pub use error::TargetError;
+pub use estimate::Neighborhood;
+pub use imls::ImlsValue;
+pub use neighbors::{Neighbor, PointIndex};
+pub use normalize::Normalization;
+pub use options::{
+    NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
+    TargetTimings,
+};
+pub use project::{alpha_plus, FootPoint};
+pub use quadric::{FitQuality, LocalQuadric, SurfaceFrame};
+pub use target::{PointAttributes, Target, MIN_POINTS};

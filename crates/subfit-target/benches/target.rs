@@ -1,0 +1,2 @@
+//! Benchmark of target construction and foot-point queries (being written).
+fn main() {}

@@ -1,0 +1,179 @@
+//! Neighbour search over the target's points: k-nearest and radius queries on a kd-tree
+//! (`kiddo` 6, immutable tree), single and batched in parallel with rayon.
+//!
+//! All distances taken and returned here are **Euclidean (not squared)**, in the units of the
+//! points given (normalized units inside a [`crate::Target`]). kiddo itself works with squared
+//! distances; the conversion happens here.
+
+use std::num::NonZeroUsize;
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
+
+/// One neighbour: index of the point in the indexed slice and its Euclidean distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Neighbor {
+    /// Index into the point slice the index was built from.
+    pub index: u32,
+    /// Euclidean distance to the query point (not squared).
+    pub distance: f64,
+}
+
+/// A kd-tree over a fixed set of 3-D points.
+///
+/// Built once in O(n log n); a nearest query costs about 1 µs, a k-nearest query grows with `k`.
+/// The points themselves are not stored (only the tree), so the caller keeps them.
+pub struct PointIndex {
+    tree: ImmutableKdTree<f64, 3>,
+    len: usize,
+}
+
+impl std::fmt::Debug for PointIndex {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PointIndex")
+            .field("len", &self.len)
+            .finish()
+    }
+}
+
+impl PointIndex {
+    /// Builds the tree over `points` (`#P by 3`).
+    ///
+    /// Returns `None` when `points` is empty or has more than `u32::MAX` entries. Coordinates are
+    /// not checked for finiteness (the [`crate::Target`] constructor rejects NaN/Inf first).
+    pub fn new(points: &[[f64; 3]]) -> Option<Self> {
+        if points.is_empty() || points.len() > u32::MAX as usize {
+            return None;
+        }
+        let tree = if points.len() > 50_000 {
+            ImmutableKdTree::new_from_slice_parallel(points).ok()?
+        } else {
+            ImmutableKdTree::new_from_slice(points).ok()?
+        };
+        Some(Self {
+            tree,
+            len: points.len(),
+        })
+    }
+
+    /// Number of indexed points.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether the index is empty (never true for a constructed index).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The nearest indexed point to `q`. Cost: O(log n), about 1 µs.
+    pub fn nearest(&self, q: &[f64; 3]) -> Neighbor {
+        let r = self
+            .tree
+            .query(q)
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        Neighbor {
+            index: r.item,
+            distance: r.distance.max(0.0).sqrt(),
+        }
+    }
+
+    /// The `k` nearest points to `q`, sorted by increasing distance (fewer when the index has
+    /// fewer than `k` points). `k == 0` gives an empty list. A point of the index queried at its
+    /// own position finds itself first.
+    pub fn k_nearest(&self, q: &[f64; 3], k: usize) -> Vec<Neighbor> {
+        let Some(k) = NonZeroUsize::new(k.min(self.len)) else {
+            return Vec::new();
+        };
+        self.tree
+            .query(q)
+            .nearest_n::<SquaredEuclidean<f64>>(k)
+            .execute()
+            .into_iter()
+            .map(|r| Neighbor {
+                index: r.item,
+                distance: r.distance.max(0.0).sqrt(),
+            })
+            .collect()
+    }
+
+    /// All points within `radius` (inclusive) of `q`, sorted by increasing distance.
+    /// Cost grows with the number of points found.
+    pub fn within(&self, q: &[f64; 3], radius: f64) -> Vec<Neighbor> {
+        if !(radius >= 0.0) {
+            return Vec::new();
+        }
+        self.tree
+            .query(q)
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .execute()
+            .into_iter()
+            .map(|r| Neighbor {
+                index: r.item,
+                distance: r.distance.max(0.0).sqrt(),
+            })
+            .collect()
+    }
+
+    /// All points within `radius` of `q`, in no particular order (faster than [`Self::within`]).
+    pub fn within_unsorted(&self, q: &[f64; 3], radius: f64) -> Vec<Neighbor> {
+        if !(radius >= 0.0) {
+            return Vec::new();
+        }
+        self.tree
+            .query(q)
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .unsorted()
+            .execute()
+            .into_iter()
+            .map(|r| Neighbor {
+                index: r.item,
+                distance: r.distance.max(0.0).sqrt(),
+            })
+            .collect()
+    }
+
+    /// [`Self::nearest`] for every query, in parallel (rayon). Output `#Q` entries, in order.
+    pub fn nearest_batch(&self, queries: &[[f64; 3]]) -> Vec<Neighbor> {
+        queries.par_iter().map(|q| self.nearest(q)).collect()
+    }
+
+    /// [`Self::k_nearest`] for every query, in parallel (rayon). Output `#Q` lists, in order.
+    pub fn k_nearest_batch(&self, queries: &[[f64; 3]], k: usize) -> Vec<Vec<Neighbor>> {
+        queries.par_iter().map(|q| self.k_nearest(q, k)).collect()
+    }
+
+    /// [`Self::within`] for every query, in parallel (rayon). Output `#Q` lists, in order.
+    pub fn within_batch(&self, queries: &[[f64; 3]], radius: f64) -> Vec<Vec<Neighbor>> {
+        queries.par_iter().map(|q| self.within(q, radius)).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_grid_queries() {
+        let mut pts = Vec::new();
+        for i in 0..5 {
+            for j in 0..5 {
+                pts.push([i as f64, j as f64, 0.0]);
+            }
+        }
+        let idx = PointIndex::new(&pts).unwrap();
+        let n = idx.nearest(&[1.1, 2.2, 0.3]);
+        assert_eq!(pts[n.index as usize], [1.0, 2.0, 0.0]);
+        assert!((n.distance - (0.01f64 + 0.04 + 0.09).sqrt()).abs() < 1e-12);
+        let k = idx.k_nearest(&[0.0, 0.0, 0.0], 3);
+        assert_eq!(k.len(), 3);
+        assert_eq!(k[0].index, 0);
+        assert!((k[1].distance - 1.0).abs() < 1e-12);
+        let w = idx.within(&[2.0, 2.0, 0.0], 1.0);
+        assert_eq!(w.len(), 5);
+        assert_eq!(idx.k_nearest(&[0.0; 3], 100).len(), 25);
+        let b = idx.k_nearest_batch(&pts, 4);
+        assert!(b.iter().zip(0..).all(|(l, i)| l[0].index == i));
+    }
+}

@@ -1,0 +1,158 @@
+//! Options, statistics and progress reporting of target construction.
+
+use std::time::Duration;
+
+pub use crate::estimate::Neighborhood;
+
+/// Where the target's normals come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NormalSource {
+    /// Input normals when given (zero-length ones estimated and oriented from their
+    /// neighbours), else area-weighted face normals for meshes, else estimated from the points
+    /// (PCA + quadric, oriented by MST propagation).
+    #[default]
+    Auto,
+    /// Always estimate from the points (input normals and faces are ignored for normals).
+    Estimate,
+}
+
+/// Options of [`crate::Target`] construction. All lengths are in normalized units (the target
+/// scaled into the unit cube).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetOptions {
+    /// Neighbourhood for normals and curvature. Default `Knn(24)`; `Knn(k)` needs `k ≥ 10`,
+    /// `Radius(r)` needs a finite `r > 0` (at least the 10 nearest are always used).
+    pub neighborhood: Neighborhood,
+    /// Normal source. Default [`NormalSource::Auto`].
+    pub normals: NormalSource,
+    /// Neighbours per point in the orientation graph. Default 10, valid `1..=neighbourhood`.
+    pub orientation_k: usize,
+    /// Extra cost `τ` on orientation-graph edges leaving the tangent plane (see
+    /// [`crate::orient`]); 0 is Hoppe's plain `1 − |n_i·n_j|`. Default 1.0, valid `≥ 0`.
+    pub orientation_tangent_penalty: f64,
+    /// A point's normal is counted ambiguous when the smallest two covariance eigenvalues of its
+    /// neighbourhood satisfy `λ0 ≥ ratio · λ1`. Default 0.5, valid `(0, 1]`.
+    pub ambiguity_ratio: f64,
+    /// Support radius `h` of the IMLS kernel (normalized units). Default `None`: twice the median
+    /// neighbourhood radius. Valid: finite, `> 0`.
+    pub imls_radius: Option<f64>,
+    /// Build the triangle BVH for exact closest points when the input has faces. Default true.
+    pub mesh_closest_point: bool,
+}
+
+impl Default for TargetOptions {
+    fn default() -> Self {
+        Self {
+            neighborhood: Neighborhood::default(),
+            normals: NormalSource::Auto,
+            orientation_k: 10,
+            orientation_tangent_penalty: 1.0,
+            ambiguity_ratio: 0.5,
+            imls_radius: None,
+            mesh_closest_point: true,
+        }
+    }
+}
+
+/// Where the final normals came from (reported in [`TargetStats`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NormalOrigin {
+    /// All from input normals.
+    Input,
+    /// All from area-weighted face normals.
+    Faces,
+    /// All estimated (PCA + quadric) and MST-oriented.
+    #[default]
+    Estimated,
+    /// Input or face normals, with some zero-length ones estimated.
+    Mixed,
+}
+
+/// Phases of construction, as reported to the progress callback and timed in [`TargetStats`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Phase {
+    /// Finite-ness, counts, indices.
+    Validate,
+    /// Scaling into the unit cube.
+    Normalize,
+    /// Merging exact duplicates.
+    Merge,
+    /// kd-tree construction.
+    Index,
+    /// Per-point PCA frame and quadric fit (normals, curvatures).
+    Estimate,
+    /// Normal orientation.
+    Orient,
+    /// Triangle BVH for mesh targets.
+    MeshIndex,
+}
+
+/// A progress report: `done` of `total` units of `phase` (units are points, or 1 for phases
+/// without a natural count). Sent at the start (`done = 0`) and end (`done = total`) of every
+/// phase, and in between for [`Phase::Estimate`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// The current phase.
+    pub phase: Phase,
+    /// Units done.
+    pub done: usize,
+    /// Units in the phase.
+    pub total: usize,
+}
+
+/// Progress callback: called from the constructing thread, never concurrently.
+pub type ProgressFn<'a> = &'a (dyn Fn(Progress) + Sync);
+
+/// Wall-clock duration of each construction phase.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TargetTimings {
+    /// [`Phase::Validate`].
+    pub validate: Duration,
+    /// [`Phase::Normalize`].
+    pub normalize: Duration,
+    /// [`Phase::Merge`].
+    pub merge: Duration,
+    /// [`Phase::Index`].
+    pub index: Duration,
+    /// [`Phase::Estimate`].
+    pub estimate: Duration,
+    /// [`Phase::Orient`].
+    pub orient: Duration,
+    /// [`Phase::MeshIndex`].
+    pub mesh_index: Duration,
+    /// Whole construction.
+    pub total: Duration,
+}
+
+/// Counts and timings of one target construction (for `subfit analyze`, reports and benches).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TargetStats {
+    /// Points in the input.
+    pub input_points: usize,
+    /// Distinct points kept.
+    pub points: usize,
+    /// Input points merged into an identical earlier point.
+    pub merged_duplicates: usize,
+    /// Triangles in the mesh BVH (0 for point clouds).
+    pub triangles: usize,
+    /// Where the normals came from.
+    pub normal_origin: NormalOrigin,
+    /// Estimated normals negated by orientation (relative to the arbitrary PCA sign, or to agree
+    /// with neighbouring input/face normals).
+    pub flipped_normals: usize,
+    /// Points whose smallest two covariance eigenvalues are nearly equal (see
+    /// [`TargetOptions::ambiguity_ratio`]): normal direction unreliable.
+    pub ambiguous_normals: usize,
+    /// Points whose quadric fit was damped or reduced to a plane (degenerate neighbourhood).
+    pub degenerate_fits: usize,
+    /// Connected components of the orientation graph (0 when no orientation was needed).
+    pub orientation_components: usize,
+    /// Smallest, mean and largest neighbourhood size (points, the point itself included).
+    pub neighborhood_size: (usize, f64, usize),
+    /// Smallest, median and largest neighbourhood radius (normalized units).
+    pub neighborhood_radius: (f64, f64, f64),
+    /// IMLS kernel support radius `h` in use (normalized units).
+    pub imls_radius: f64,
+    /// Phase durations.
+    pub timings: TargetTimings,
+}

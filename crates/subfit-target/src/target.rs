@@ -1,0 +1,571 @@
+//! The [`Target`]: a scan normalized into the unit cube, indexed, with per-point normals and
+//! local quadrics (Cheng 2004 §3 steps 1–2 and §4.1; Cheng 2007 §II-C), ready for foot-point
+//! queries ([`crate::project`]) and the IMLS distance ([`crate::imls`]).
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use subfit_mesh::PolyMesh;
+
+use crate::closest::TriangleBvh;
+use crate::error::TargetError;
+use crate::estimate::{estimate_all, Neighborhood, PointEstimate};
+use crate::neighbors::PointIndex;
+use crate::normalize::Normalization;
+use crate::options::{
+    NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
+};
+use crate::orient::orient_normals;
+use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
+use crate::vec3::{add, cross, dot, normalize, scale, sub};
+
+/// Fewest (distinct) points a target may have.
+pub const MIN_POINTS: usize = 10;
+
+/// The shape being fitted, in normalized coordinates (unit cube, longest side 1, minimum corner
+/// at the origin).
+///
+/// Holds `#P` distinct points (exact duplicates of the input merged), a unit normal and a local
+/// quadric per point, a kd-tree, and for mesh inputs a triangle BVH. Immutable once built;
+/// queries take `&self` and are safe to run from many threads.
+#[derive(Debug)]
+pub struct Target {
+    normalization: Normalization,
+    points: Vec<[f64; 3]>,
+    normals: Vec<[f64; 3]>,
+    quadrics: Vec<LocalQuadric>,
+    index: PointIndex,
+    bvh: Option<TriangleBvh>,
+    input_to_point: Vec<u32>,
+    imls_radius: f64,
+    stats: TargetStats,
+}
+
+/// Per-point outputs for writers (e.g. the `subfit analyze` PLY): all arrays have `#P` rows, in
+/// the target's point order, normalized units (curvatures in 1/normalized units: divide by
+/// [`Normalization::scale`] for 1/original units).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointAttributes {
+    /// Points, `#P by 3`, normalized.
+    pub points: Vec<[f64; 3]>,
+    /// Unit normals, `#P by 3`.
+    pub normals: Vec<[f64; 3]>,
+    /// Signed principal curvature of smaller magnitude, `#P` (Cheng 2007 §II-D3 sign).
+    pub k1: Vec<f64>,
+    /// Signed principal curvature of larger magnitude, `#P`.
+    pub k2: Vec<f64>,
+    /// Unit principal direction of `k1`, `#P by 3`, ⟂ normal.
+    pub t1: Vec<[f64; 3]>,
+    /// Unit principal direction of `k2`, `#P by 3`, ⟂ normal and `t1`.
+    pub t2: Vec<[f64; 3]>,
+}
+
+impl Target {
+    /// Builds a target from a point cloud, with optional per-point normals (`#P by 3`, any
+    /// length; zero-length rows are estimated). See [`Target::build`].
+    pub fn from_points(
+        points: &[[f64; 3]],
+        normals: Option<&[[f64; 3]]>,
+        options: &TargetOptions,
+    ) -> Result<Self, TargetError> {
+        let mesh = PolyMesh::point_cloud(points.to_vec(), normals.map(<[_]>::to_vec));
+        Self::build(&mesh, options, None)
+    }
+
+    /// Builds a target from a mesh or point cloud (a `PolyMesh` without faces). See
+    /// [`Target::build`].
+    pub fn from_mesh(mesh: &PolyMesh, options: &TargetOptions) -> Result<Self, TargetError> {
+        Self::build(mesh, options, None)
+    }
+
+    /// Builds a target: validate, normalize into the unit cube, merge exact duplicates, build the
+    /// kd-tree, fit a PCA frame and a quadric per point, orient normals, and for meshes build
+    /// the triangle BVH. Faces (any polygon size, fan-triangulated) are used for area-weighted
+    /// normals and exact closest points; colours are ignored.
+    ///
+    /// Errors: NaN/Inf coordinates or normals (with the input index), fewer than
+    /// [`MIN_POINTS`] points or distinct points (this covers duplicate-only input), all points on
+    /// one line, face indices out of range, invalid options. A planar point set is valid: its
+    /// normals are the plane's (oriented `+z`, or `+x`/`+y` for a vertical plane) and its
+    /// curvatures 0.
+    ///
+    /// Cost: O(P log P) plus O(P·k) for the fits, parallel; the orientation is serial
+    /// O(P·k_o log P). Progress goes to `progress`, never to stdout/stderr.
+    pub fn build(
+        mesh: &PolyMesh,
+        options: &TargetOptions,
+        progress: Option<ProgressFn<'_>>,
+    ) -> Result<Self, TargetError> {
+        let t_all = Instant::now();
+        let report = |phase: Phase, done: usize, total: usize| {
+            if let Some(p) = progress {
+                p(Progress { phase, done, total });
+            }
+        };
+        let mut stats = TargetStats::default();
+        let n_in = mesh.positions.len();
+
+        // Validate.
+        let t = Instant::now();
+        report(Phase::Validate, 0, n_in);
+        validate_options(options)?;
+        validate_input(mesh)?;
+        stats.input_points = n_in;
+        stats.timings.validate = t.elapsed();
+        report(Phase::Validate, n_in, n_in);
+
+        // Normalize.
+        let t = Instant::now();
+        report(Phase::Normalize, 0, n_in);
+        let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
+        let Some(normalization) = Normalization::from_bounds(lo, hi) else {
+            return Err(TargetError::TooFewDistinctPoints {
+                distinct: 1,
+                input: n_in,
+                merged: n_in - 1,
+                required: MIN_POINTS,
+            });
+        };
+        let normalized: Vec<[f64; 3]> = mesh
+            .positions
+            .par_iter()
+            .map(|&p| normalization.to_normalized(p))
+            .collect();
+        stats.timings.normalize = t.elapsed();
+        report(Phase::Normalize, n_in, n_in);
+
+        // Merge exact duplicates.
+        let t = Instant::now();
+        report(Phase::Merge, 0, n_in);
+        let (points, input_to_point) = merge_duplicates(&normalized);
+        stats.points = points.len();
+        stats.merged_duplicates = n_in - points.len();
+        if points.len() < MIN_POINTS {
+            return Err(TargetError::TooFewDistinctPoints {
+                distinct: points.len(),
+                input: n_in,
+                merged: stats.merged_duplicates,
+                required: MIN_POINTS,
+            });
+        }
+        check_not_collinear(&points)?;
+        stats.timings.merge = t.elapsed();
+        report(Phase::Merge, n_in, n_in);
+
+        // kd-tree.
+        let t = Instant::now();
+        report(Phase::Index, 0, points.len());
+        let index = PointIndex::new(&points).ok_or(TargetError::TooFewPoints {
+            found: points.len(),
+            required: MIN_POINTS,
+        })?;
+        stats.timings.index = t.elapsed();
+        report(Phase::Index, points.len(), points.len());
+
+        // Prescribed normals (input or faces), per distinct point.
+        let (prescribed, origin) = prescribed_normals(mesh, options, &points, &input_to_point);
+
+        // Per-point estimation.
+        let t = Instant::now();
+        let np = points.len();
+        report(Phase::Estimate, 0, np);
+        let tick = |done: usize| report(Phase::Estimate, done, np);
+        let estimates = estimate_all(
+            &points,
+            &index,
+            options.neighborhood,
+            &prescribed,
+            options.ambiguity_ratio,
+            options.orientation_k,
+            &tick,
+        );
+        stats.timings.estimate = t.elapsed();
+        summarize_estimates(&estimates, &mut stats);
+
+        // Orientation.
+        let t = Instant::now();
+        report(Phase::Orient, 0, np);
+        let mut quadrics: Vec<LocalQuadric> = estimates.iter().map(|e| e.quadric).collect();
+        let mut normals: Vec<[f64; 3]> = quadrics
+            .par_iter()
+            .zip(&prescribed)
+            .map(|(q, p)| p.unwrap_or_else(|| q.frame_at(0.0, 0.0).normal))
+            .collect();
+        let fixed: Vec<bool> = prescribed.iter().map(Option::is_some).collect();
+        let n_fixed = fixed.iter().filter(|&&f| f).count();
+        stats.normal_origin = match (origin, n_fixed) {
+            (_, 0) => NormalOrigin::Estimated,
+            (o, f) if f == np => o,
+            _ => NormalOrigin::Mixed,
+        };
+        if n_fixed < np {
+            let graph: Vec<Vec<u32>> = estimates.into_iter().map(|e| e.graph).collect();
+            let o = orient_normals(
+                &points,
+                &mut normals,
+                &graph,
+                &fixed,
+                options.orientation_tangent_penalty,
+            );
+            for (q, &f) in quadrics.iter_mut().zip(&o.flipped) {
+                if f {
+                    *q = q.flipped();
+                }
+            }
+            stats.flipped_normals = o.flipped.iter().filter(|&&f| f).count();
+            stats.orientation_components = o.components;
+        }
+        stats.timings.orient = t.elapsed();
+        report(Phase::Orient, np, np);
+
+        // Mesh BVH.
+        let t = Instant::now();
+        let bvh = if options.mesh_closest_point && !mesh.faces.is_empty() {
+            report(Phase::MeshIndex, 0, 1);
+            let tris: Vec<[u32; 3]> = mesh
+                .faces
+                .triangulate_fan()
+                .into_iter()
+                .map(|t| t.map(|v| input_to_point[v as usize]))
+                .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+                .collect();
+            stats.triangles = tris.len();
+            report(Phase::MeshIndex, 1, 1);
+            Some(TriangleBvh::new(points.clone(), tris))
+        } else {
+            None
+        };
+        stats.timings.mesh_index = t.elapsed();
+
+        let imls_radius = options
+            .imls_radius
+            .unwrap_or(2.0 * stats.neighborhood_radius.1)
+            .max(f64::MIN_POSITIVE);
+        stats.imls_radius = imls_radius;
+        stats.timings.total = t_all.elapsed();
+        Ok(Self {
+            normalization,
+            points,
+            normals,
+            quadrics,
+            index,
+            bvh,
+            input_to_point,
+            imls_radius,
+            stats,
+        })
+    }
+
+    /// The map between original and normalized coordinates.
+    pub fn normalization(&self) -> &Normalization {
+        &self.normalization
+    }
+
+    /// Original → normalized point (shorthand for `normalization().to_normalized`).
+    pub fn to_normalized(&self, p: [f64; 3]) -> [f64; 3] {
+        self.normalization.to_normalized(p)
+    }
+
+    /// Normalized → original point.
+    pub fn to_original(&self, p: [f64; 3]) -> [f64; 3] {
+        self.normalization.to_original(p)
+    }
+
+    /// Number of distinct points `#P`.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Always false for a built target (at least [`MIN_POINTS`] points).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Distinct points, `#P by 3`, normalized.
+    pub fn points(&self) -> &[[f64; 3]] {
+        &self.points
+    }
+
+    /// Unit normals, `#P by 3`, consistently oriented (outward for closed shapes when estimated).
+    pub fn normals(&self) -> &[[f64; 3]] {
+        &self.normals
+    }
+
+    /// The local quadric of each point, `#P`, oriented like [`Self::normals`].
+    pub fn quadrics(&self) -> &[LocalQuadric] {
+        &self.quadrics
+    }
+
+    /// For each input point, the index of its distinct point (`#input` entries).
+    pub fn input_to_point(&self) -> &[u32] {
+        &self.input_to_point
+    }
+
+    /// The kd-tree over [`Self::points`].
+    pub fn index(&self) -> &PointIndex {
+        &self.index
+    }
+
+    /// The triangle BVH (normalized coordinates, distinct-point indices) for mesh targets.
+    pub fn mesh(&self) -> Option<&TriangleBvh> {
+        self.bvh.as_ref()
+    }
+
+    /// Construction statistics and timings.
+    pub fn stats(&self) -> &TargetStats {
+        &self.stats
+    }
+
+    /// IMLS kernel support radius `h` (normalized units).
+    pub fn imls_radius(&self) -> f64 {
+        self.imls_radius
+    }
+
+    /// Sets the IMLS kernel support radius `h` (normalized units); ignored unless finite and > 0.
+    pub fn set_imls_radius(&mut self, h: f64) {
+        if h.is_finite() && h > 0.0 {
+            self.imls_radius = h;
+            self.stats.imls_radius = h;
+        }
+    }
+
+    /// Per-point normals, principal curvatures and directions (evaluated on each point's
+    /// quadric at the point), for writers. Parallel, O(P).
+    pub fn point_attributes(&self) -> PointAttributes {
+        let frames: Vec<_> = self
+            .quadrics
+            .par_iter()
+            .zip(&self.normals)
+            .map(|(q, &n)| {
+                let f = q.frame_at(0.0, 0.0);
+                // Input normals may differ slightly from the quadric's: keep t ⟂ n.
+                let t1 = normalize(sub(f.t1, scale(n, dot(f.t1, n)))).unwrap_or(f.t1);
+                (f.k1, f.k2, t1, cross(n, t1))
+            })
+            .collect();
+        PointAttributes {
+            points: self.points.clone(),
+            normals: self.normals.clone(),
+            k1: frames.iter().map(|f| f.0).collect(),
+            k2: frames.iter().map(|f| f.1).collect(),
+            t1: frames.iter().map(|f| f.2).collect(),
+            t2: frames.iter().map(|f| f.3).collect(),
+        }
+    }
+}
+
+fn validate_options(o: &TargetOptions) -> Result<(), TargetError> {
+    let bad = |name, reason: &str| {
+        Err(TargetError::InvalidOption {
+            name,
+            reason: reason.to_string(),
+        })
+    };
+    match o.neighborhood {
+        Neighborhood::Knn(k) if k < crate::estimate::MIN_NEIGHBORS => {
+            return bad("neighborhood", "Knn(k) needs k >= 10")
+        }
+        Neighborhood::Radius(r) if !(r.is_finite() && r > 0.0) => {
+            return bad("neighborhood", "Radius(r) needs a finite r > 0")
+        }
+        _ => {}
+    }
+    if o.orientation_k == 0 {
+        return bad("orientation_k", "must be at least 1");
+    }
+    if !(o.orientation_tangent_penalty.is_finite() && o.orientation_tangent_penalty >= 0.0) {
+        return bad("orientation_tangent_penalty", "must be finite and >= 0");
+    }
+    if !(o.ambiguity_ratio > 0.0 && o.ambiguity_ratio <= 1.0) {
+        return bad("ambiguity_ratio", "must be in (0, 1]");
+    }
+    if let Some(h) = o.imls_radius {
+        if !(h.is_finite() && h > 0.0) {
+            return bad("imls_radius", "must be finite and > 0");
+        }
+    }
+    Ok(())
+}
+
+fn validate_input(mesh: &PolyMesh) -> Result<(), TargetError> {
+    let n = mesh.positions.len();
+    if n < MIN_POINTS {
+        return Err(TargetError::TooFewPoints {
+            found: n,
+            required: MIN_POINTS,
+        });
+    }
+    if let Some(i) = mesh
+        .positions
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(TargetError::NonFinitePoint {
+            index: i,
+            coordinates: mesh.positions[i],
+        });
+    }
+    if let Some(normals) = &mesh.normals {
+        if normals.len() != n {
+            return Err(TargetError::NormalCountMismatch {
+                points: n,
+                normals: normals.len(),
+            });
+        }
+        if let Some(i) = normals
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(TargetError::NonFiniteNormal {
+                index: i,
+                components: normals[i],
+            });
+        }
+    }
+    for (f, face) in mesh.faces.iter().enumerate() {
+        if let Some(&v) = face.iter().find(|&&v| v as usize >= n) {
+            return Err(TargetError::FaceIndexOutOfRange {
+                face: f,
+                vertex: v,
+                vertices: n,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Merges bitwise-identical points. Returns the distinct points (in order of first occurrence)
+/// and the map input index → distinct index. O(n log n).
+fn merge_duplicates(points: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let n = points.len();
+    let key = |p: &[f64; 3]| p.map(|c| (c + 0.0).to_bits()); // +0.0 folds -0.0 into 0.0
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
+    let mut rep = vec![0u32; n];
+    let mut g = 0;
+    while g < n {
+        let first = order[g];
+        let k = key(&points[first as usize]);
+        let mut e = g;
+        while e < n && key(&points[order[e] as usize]) == k {
+            rep[order[e] as usize] = first; // sorted by index within the group: first is min
+            e += 1;
+        }
+        g = e;
+    }
+    let mut map = vec![0u32; n];
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        if rep[i] as usize == i {
+            map[i] = out.len() as u32;
+            out.push(points[i]);
+        } else {
+            map[i] = map[rep[i] as usize];
+        }
+    }
+    (out, map)
+}
+
+fn check_not_collinear(points: &[[f64; 3]]) -> Result<(), TargetError> {
+    let inv = 1.0 / points.len() as f64;
+    let mut c = [0.0; 3];
+    for p in points {
+        c = add(c, scale(*p, inv));
+    }
+    let mut cv = [[0.0; 3]; 3];
+    for p in points {
+        let d = sub(*p, c);
+        for a in 0..3 {
+            for b in 0..3 {
+                cv[a][b] += d[a] * d[b] * inv;
+            }
+        }
+    }
+    let (lam, _) = sym3_eigen(cv);
+    let spread = (lam[1].max(0.0) / lam[2].max(f64::MIN_POSITIVE)).sqrt();
+    if !(spread > 1e-8) {
+        return Err(TargetError::Collinear {
+            points: points.len(),
+            spread,
+        });
+    }
+    Ok(())
+}
+
+/// Unit normals prescribed by the input (per distinct point), and where they came from.
+fn prescribed_normals(
+    mesh: &PolyMesh,
+    options: &TargetOptions,
+    points: &[[f64; 3]],
+    input_to_point: &[u32],
+) -> (Vec<Option<[f64; 3]>>, NormalOrigin) {
+    let np = points.len();
+    if options.normals == NormalSource::Estimate {
+        return (vec![None; np], NormalOrigin::Estimated);
+    }
+    let mut acc = vec![[0.0; 3]; np];
+    let origin = if let Some(normals) = &mesh.normals {
+        for (i, n) in normals.iter().enumerate() {
+            let j = input_to_point[i] as usize;
+            // Duplicates: sum of unit normals.
+            if let Some(u) = normalize(*n) {
+                acc[j] = add(acc[j], u);
+            }
+        }
+        NormalOrigin::Input
+    } else if !mesh.faces.is_empty() {
+        for t in mesh.faces.triangulate_fan() {
+            let [a, b, c] = t.map(|v| input_to_point[v as usize] as usize);
+            // Twice the area times the unit normal: area weighting.
+            let w = cross(sub(points[b], points[a]), sub(points[c], points[a]));
+            for v in [a, b, c] {
+                acc[v] = add(acc[v], w);
+            }
+        }
+        NormalOrigin::Faces
+    } else {
+        return (vec![None; np], NormalOrigin::Estimated);
+    };
+    (acc.into_iter().map(normalize).collect(), origin)
+}
+
+fn summarize_estimates(est: &[PointEstimate], stats: &mut TargetStats) {
+    let n = est.len();
+    stats.ambiguous_normals = est.iter().filter(|e| e.ambiguous).count();
+    stats.degenerate_fits = est.iter().filter(|e| e.quality != FitQuality::Full).count();
+    let (mut lo, mut hi, mut sum) = (usize::MAX, 0usize, 0usize);
+    for e in est {
+        lo = lo.min(e.size as usize);
+        hi = hi.max(e.size as usize);
+        sum += e.size as usize;
+    }
+    stats.neighborhood_size = (lo, sum as f64 / n.max(1) as f64, hi);
+    let mut r: Vec<f64> = est.iter().map(|e| e.radius).collect();
+    let mid = n / 2;
+    if n > 0 {
+        let (_, m, _) = r.select_nth_unstable_by(mid, f64::total_cmp);
+        let m = *m;
+        let lo = r.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = r.iter().copied().fold(0.0, f64::max);
+        stats.neighborhood_radius = (lo, m, hi);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merge_keeps_first_occurrence_order() {
+        let p = vec![
+            [1.0, 0.0, 0.0],
+            [0.0; 3],
+            [1.0, 0.0, 0.0],
+            [-0.0, 0.0, 0.0],
+            [2.0; 3],
+        ];
+        let (q, map) = merge_duplicates(&p);
+        assert_eq!(q, vec![[1.0, 0.0, 0.0], [0.0; 3], [2.0; 3]]);
+        assert_eq!(map, vec![0, 1, 0, 1, 2]);
+    }
+}
