@@ -1,0 +1,121 @@
+//! Command-line syntax (clap derive). Values are checked here or in each command's `validate`
+//! step before any work starts.
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+/// Fit compact subdivision surfaces to dense 3D scans.
+#[derive(Parser, Debug)]
+#[command(name = "subfit", version, about, long_about = None, propagate_version = true)]
+pub struct Args {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Describe a mesh or point-cloud file: counts, bounding box, topology, defects.
+    Info(InfoArgs),
+    /// Convert between PLY, OBJ, OFF, STL and XYZ.
+    Convert(ConvertArgs),
+    /// Generate the built-in shapes (ellipsoid 0.25/0.5/1, torus, genus-2) as point clouds.
+    Demo(DemoArgs),
+}
+
+/// `subfit info`.
+#[derive(clap::Args, Debug)]
+pub struct InfoArgs {
+    /// The file to describe (.ply, .obj, .off, .stl, .xyz/.pts/.txt).
+    pub file: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Read the file as this format, whatever its extension.
+    #[arg(long, value_enum)]
+    pub format: Option<FormatArg>,
+}
+
+/// `subfit convert`.
+#[derive(clap::Args, Debug)]
+pub struct ConvertArgs {
+    /// Input file.
+    pub input: PathBuf,
+    /// Output file; its extension picks the format unless `--to` is given.
+    pub output: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum)]
+    pub to: Option<FormatArg>,
+    /// Input format, whatever the input's extension.
+    #[arg(long, value_enum)]
+    pub from: Option<FormatArg>,
+    /// Output encoding (PLY: all; STL: ascii or binary; others: ascii).
+    #[arg(long, value_enum, default_value_t = EncodingArg::Auto)]
+    pub encoding: EncodingArg,
+    /// Store single-precision floats in binary PLY (default: double, lossless).
+    #[arg(long)]
+    pub single: bool,
+    /// Do not merge identical STL corners into shared vertices.
+    #[arg(long)]
+    pub no_weld: bool,
+}
+
+/// `subfit demo`.
+#[derive(clap::Args, Debug)]
+pub struct DemoArgs {
+    /// Output directory.
+    #[arg(short, long, default_value = "subfit-demo")]
+    pub output: PathBuf,
+    /// Points per shape.
+    #[arg(long, default_value_t = 50_000, value_parser = clap::value_parser!(u32).range(10..=50_000_000))]
+    pub points: u32,
+    /// Gaussian noise, as a fraction of the bounding-box diagonal (0.002 = 0.2%).
+    #[arg(long, default_value_t = 0.0)]
+    pub noise: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+/// A file format named on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum FormatArg {
+    /// Stanford PLY.
+    Ply,
+    /// Wavefront OBJ.
+    Obj,
+    /// Object File Format.
+    Off,
+    /// Stereolithography.
+    Stl,
+    /// Point list (x y z [nx ny nz]).
+    Xyz,
+}
+
+impl From<FormatArg> for subfit::io::Format {
+    fn from(f: FormatArg) -> Self {
+        use subfit::io::Format;
+        match f {
+            FormatArg::Ply => Format::Ply,
+            FormatArg::Obj => Format::Obj,
+            FormatArg::Off => Format::Off,
+            FormatArg::Stl => Format::Stl,
+            FormatArg::Xyz => Format::Xyz,
+        }
+    }
+}
+
+/// An output encoding named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EncodingArg {
+    /// Binary little-endian for PLY and STL, text for the others.
+    Auto,
+    /// Text.
+    Ascii,
+    /// Binary little-endian.
+    Binary,
+    /// Binary big-endian (PLY only).
+    BinaryBe,
+}

@@ -1,0 +1,18 @@
+//! One module per subcommand; `run` dispatches.
+
+mod convert;
+mod demo;
+mod info;
+
+use std::process::ExitCode;
+
+use crate::cli::{Args, Command};
+
+/// Runs a parsed command. `Err` means bad input or usage (exit code 2).
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    match args.command {
+        Command::Info(a) => info::run(a),
+        Command::Convert(a) => convert::run(a),
+        Command::Demo(a) => demo::run(a),
+    }
+}

@@ -1,0 +1,74 @@
+//! Progress bars on stderr (hidden automatically when stderr is not a terminal) and file
+//! reading with progress.
+
+use std::io::Read;
+use std::path::Path;
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+/// Files smaller than this are read without a bar.
+const BAR_THRESHOLD: u64 = 8 << 20;
+
+/// A spinner with a message, on stderr.
+pub fn spinner(msg: &str) -> ProgressBar {
+    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    pb.set_style(
+        ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("valid template"),
+    );
+    pb.set_message(msg.to_string());
+    pb.enable_steady_tick(Duration::from_millis(120));
+    pb
+}
+
+/// A bar counting `len` items, on stderr.
+pub fn bar(len: u64, msg: &str) -> ProgressBar {
+    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    pb.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} [{elapsed}<{eta}]")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    pb.set_message(msg.to_string());
+    pb
+}
+
+/// Reads a whole file, with a byte progress bar for large files.
+pub fn read_with_progress(path: &Path) -> Result<Vec<u8>, subfit::io::Error> {
+    use subfit::io::{Error, ErrorKind};
+    if path.is_dir() {
+        return Err(Error::file(path, ErrorKind::IsDirectory));
+    }
+    let io = |e| Error::file(path, ErrorKind::Io(e));
+    let file = std::fs::File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
+    if len < BAR_THRESHOLD {
+        return subfit::io::read_all(path);
+    }
+    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    pb.set_style(
+        ProgressStyle::with_template(
+            "reading {msg} [{bar:40}] {bytes}/{total_bytes} ({bytes_per_sec})",
+        )
+        .expect("valid template")
+        .progress_chars("=> "),
+    );
+    pb.set_message(path.display().to_string());
+    let mut buf = Vec::with_capacity(len as usize);
+    pb.wrap_read(file).read_to_end(&mut buf).map_err(io)?;
+    pb.finish_and_clear();
+    Ok(buf)
+}
+
+/// Reads and parses a mesh or point-cloud file, with progress for large files.
+pub fn load(
+    path: &Path,
+) -> Result<(subfit::mesh::PolyMesh, subfit::io::FileInfo), subfit::io::Error> {
+    let bytes = read_with_progress(path)?;
+    let sp = (bytes.len() as u64 >= BAR_THRESHOLD).then(|| spinner("parsing"));
+    let out = subfit::io::read_bytes(&bytes, path, &subfit::io::ReadOptions::default());
+    if let Some(sp) = sp {
+        sp.finish_and_clear();
+    }
+    out
+}

@@ -1,0 +1,220 @@
+//! The command line, end to end: exit codes, one-line errors naming file/line/element, atomic
+//! outputs, and conversions.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn subfit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subfit"))
+        .args(args)
+        .output()
+        .expect("run subfit")
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+/// Runs `subfit info FILE` and checks exit code 2 with one stderr line containing every
+/// fragment.
+#[track_caller]
+fn expect_bad(path: &Path, fragments: &[&str]) {
+    let out = subfit(&["info", path.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one line expected: {err}"
+    );
+    let name = path.file_name().unwrap().to_str().unwrap();
+    assert!(err.contains(name), "no file name in: {err}");
+    for f in fragments {
+        assert!(err.contains(f), "missing `{f}` in: {err}");
+    }
+    assert!(out.stdout.is_empty());
+}
+
+const CUBE_OBJ: &str = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+#[test]
+fn malformed_files_give_exit_code_2_and_a_located_message() {
+    let d = tempfile::tempdir().unwrap();
+    let d = d.path();
+
+    // Truncated binary PLY: header promises 3 vertices, data holds 2.5.
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n".to_vec();
+    ply.extend(std::iter::repeat_n(0u8, 12 * 2 + 6));
+    expect_bad(&write(d, "truncated.ply", &ply), &["vertex 2"]);
+
+    // Wrong counts: OFF announces 10 vertices, holds 3.
+    expect_bad(
+        &write(
+            d,
+            "counts.off",
+            b"OFF\n10 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+        ),
+        &[],
+    );
+
+    // Index out of range in OBJ, at line 4.
+    expect_bad(
+        &write(d, "range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"),
+        &["line 4", "99", "out of range"],
+    );
+
+    // NaN coordinate in an XYZ file at line 2.
+    expect_bad(
+        &write(d, "nan.xyz", b"0 0 0\n1 nan 0\n0 1 0\n"),
+        &["line 2", "non-finite"],
+    );
+    // Inf in ascii PLY.
+    expect_bad(
+        &write(
+            d,
+            "inf.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\nend_header\n0 0 0\n1 inf 0\n",
+        ),
+        &["non-finite"],
+    );
+
+    // Empty (whitespace only) and 0-byte files.
+    expect_bad(&write(d, "blank.obj", b"  \n\n"), &["empty"]);
+    expect_bad(&write(d, "zero.ply", b""), &["empty"]);
+    expect_bad(&write(d, "zero.stl", b""), &["empty"]);
+
+    // Binary garbage with a PLY extension.
+    let garbage: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8)
+        .collect();
+    expect_bad(&write(d, "garbage.ply", &garbage), &[]);
+
+    // A directory.
+    let sub = d.join("adir.ply");
+    std::fs::create_dir(&sub).unwrap();
+    expect_bad(&sub, &["directory"]);
+
+    // A missing file and an unknown format.
+    expect_bad(&d.join("missing.obj"), &[]);
+    expect_bad(&write(d, "mesh.foo", b"hello\n"), &["unknown file format"]);
+}
+
+#[test]
+fn usage_errors_exit_with_2() {
+    assert_eq!(subfit(&[]).status.code(), Some(2));
+    assert_eq!(subfit(&["info"]).status.code(), Some(2));
+    assert_eq!(subfit(&["frobnicate"]).status.code(), Some(2));
+    assert_eq!(subfit(&["demo", "--points", "3"]).status.code(), Some(2));
+    assert_eq!(subfit(&["--help"]).status.code(), Some(0));
+}
+
+#[test]
+fn info_reports_counts_and_topology_as_text_and_json() {
+    let d = tempfile::tempdir().unwrap();
+    let p = write(d.path(), "cube.obj", CUBE_OBJ.as_bytes());
+    let out = subfit(&["info", p.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("obj"), "{text}");
+    assert!(text.contains("genus"), "{text}");
+
+    let out = subfit(&["info", "--json", p.to_str().unwrap()]);
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["format"], "obj");
+    assert_eq!(v["vertices"], 8);
+    assert_eq!(v["faces"], 6);
+    assert_eq!(v["faces_by_size"]["4"], 6);
+    assert_eq!(v["bbox"]["diagonal"].as_f64().unwrap(), 3f64.sqrt());
+    assert_eq!(v["topology"]["genus"], 0);
+    assert_eq!(v["topology"]["boundary_loops"], 0);
+    assert_eq!(v["topology"]["components"], 1);
+    assert_eq!(v["topology"]["euler_characteristic"], 2);
+}
+
+#[test]
+fn convert_round_trips_through_every_format_and_never_leaves_partial_files() {
+    let d = tempfile::tempdir().unwrap();
+    let d = d.path();
+    let src = write(d, "cube.obj", CUBE_OBJ.as_bytes());
+    for (name, extra) in [
+        ("a.ply", &[][..]),
+        ("b.ply", &["--encoding", "ascii"][..]),
+        ("c.ply", &["--encoding", "binary-be"][..]),
+        ("d.off", &[][..]),
+        ("e.obj", &[][..]),
+    ] {
+        let out_path = d.join(name);
+        let mut args = vec!["convert", src.to_str().unwrap(), out_path.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let out = subfit(&args);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let info = subfit(&["info", "--json", out_path.to_str().unwrap()]);
+        let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+        assert_eq!(v["vertices"], 8, "{name}");
+        assert_eq!(v["faces_by_size"]["4"], 6, "{name}");
+    }
+    // STL triangulates and welds: 8 vertices, 12 triangles.
+    let stl = d.join("f.stl");
+    assert!(
+        subfit(&["convert", src.to_str().unwrap(), stl.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", stl.to_str().unwrap()]).stdout).unwrap();
+    assert_eq!(v["vertices"], 8);
+    assert_eq!(v["faces_by_size"]["3"], 12);
+
+    // A failing conversion leaves nothing behind.
+    let bad = write(d, "bad.obj", b"v 0 0 0\nf 1 2 3\n");
+    let target = d.join("never.ply");
+    let out = subfit(&["convert", bad.to_str().unwrap(), target.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!target.exists());
+    let leftovers: Vec<_> = std::fs::read_dir(d)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty());
+    // Unknown output extension is a usage error before any work.
+    let out = subfit(&[
+        "convert",
+        src.to_str().unwrap(),
+        d.join("x.abc").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn demo_writes_the_builtin_shapes() {
+    let d = tempfile::tempdir().unwrap();
+    let out_dir = d.path().join("demo");
+    let out = subfit(&["demo", "-o", out_dir.to_str().unwrap(), "--points", "500"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in ["ellipsoid", "torus", "genus2"] {
+        let p = out_dir.join(format!("{name}.ply"));
+        let info = subfit(&["info", "--json", p.to_str().unwrap()]);
+        let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+        assert_eq!(v["normals"], true, "{name}");
+        assert_eq!(v["faces"], 0, "{name}");
+        let n = v["vertices"].as_u64().unwrap();
+        assert!((475..=500).contains(&n), "{name}: {n}");
+    }
+}
