@@ -68,7 +68,8 @@ pub(crate) fn group_edges(
         let (a, b) = (idx[h], idx[next[h] as usize]);
         (a.min(b), a.max(b))
     };
-    // Counting sort by the smaller endpoint.
+    // Counting sort by the smaller endpoint; entries are `(larger endpoint << 32) | half-edge`
+    // so each bucket sorts as plain integers.
     let mut count = vec![0u32; num_vertices + 1];
     for (f, w) in offs.windows(2).enumerate() {
         if include(f) {
@@ -81,34 +82,37 @@ pub(crate) fn group_edges(
         count[i + 1] += count[i];
     }
     let total = count[num_vertices] as usize;
-    let mut order = vec![0u32; total];
+    let mut packed = vec![0u64; total];
     let mut fill = count.clone();
     for (f, w) in offs.windows(2).enumerate() {
         if include(f) {
             for h in w[0] as usize..w[1] as usize {
-                let slot = &mut fill[key(h).0 as usize];
-                order[*slot as usize] = h as u32;
+                let (lo, hi) = key(h);
+                let slot = &mut fill[lo as usize];
+                packed[*slot as usize] = (u64::from(hi) << 32) | h as u64;
                 *slot += 1;
             }
         }
     }
-    // Sort each bucket by the larger endpoint, then split into runs.
+    drop(fill);
+    // Sort each bucket, then split into runs of equal larger endpoint.
     let mut starts = Vec::with_capacity(total / 2 + 2);
     for v in 0..num_vertices {
-        let bucket = &mut order[count[v] as usize..count[v + 1] as usize];
+        let (a, b) = (count[v] as usize, count[v + 1] as usize);
+        let bucket = &mut packed[a..b];
         if bucket.len() > 1 {
-            bucket.sort_unstable_by_key(|&h| (key(h as usize).1, h));
+            bucket.sort_unstable();
         }
-        let mut prev = u32::MAX;
-        for (i, &h) in bucket.iter().enumerate() {
-            let hi = key(h as usize).1;
-            if hi != prev {
-                starts.push(count[v] + i as u32);
-                prev = hi;
+        let mut prev = u64::MAX;
+        for (i, &x) in bucket.iter().enumerate() {
+            if x >> 32 != prev {
+                starts.push((a + i) as u32);
+                prev = x >> 32;
             }
         }
     }
     starts.push(total as u32);
+    let order = packed.into_iter().map(|x| x as u32).collect();
     EdgeGroups { order, starts }
 }
 

@@ -305,3 +305,19 @@ fn empty_and_components() {
     assert_eq!(m.component_genera(), vec![1, 0]);
     assert_eq!(face_components(&p, nv + ns).face_counts(), vec![12, 6]);
 }
+
+#[test]
+fn report_serializes_to_json() {
+    let (p, nv) = grid(3, 3, false, false, false);
+    let r = diagnose(&p, nv + 2, None);
+    let v = serde_json::to_value(&r).unwrap();
+    assert_eq!(v["genus"], 0);
+    assert_eq!(v["boundary_loops"], 1);
+    assert_eq!(v["unreferenced_vertices"], 2);
+    assert_eq!(v["face_sizes"][0], serde_json::json!([4, 9]));
+    assert_eq!(v["components"][0]["genus"], 0);
+    assert!(v["examples"]["non_manifold_edges"]
+        .as_array()
+        .unwrap()
+        .is_empty());
+}
