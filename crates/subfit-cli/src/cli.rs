@@ -23,6 +23,51 @@ pub enum Command {
     Convert(ConvertArgs),
     /// Generate the built-in shapes (ellipsoid 0.25/0.5/1, torus, genus-2) as point clouds.
     Demo(DemoArgs),
+    /// Refine a control mesh uniformly (Loop or Catmull-Clark), or push it to the limit surface.
+    Subdivide(SubdivideArgs),
+}
+
+/// `subfit subdivide`.
+#[derive(clap::Args, Debug)]
+pub struct SubdivideArgs {
+    /// The control mesh (any mesh format).
+    pub control: PathBuf,
+    /// Subdivision scheme; `auto` picks Loop for all-triangle meshes, Catmull-Clark otherwise.
+    #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
+    pub scheme: SchemeArg,
+    /// Number of uniform refinement levels.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(0..=8))]
+    pub levels: u32,
+    /// Write limit positions and limit normals of the refined vertices instead of the refined
+    /// control points.
+    #[arg(long)]
+    pub limit: bool,
+    /// Boundary interpolation rule (OpenSubdiv's VTX_BOUNDARY_EDGE_ONLY / EDGE_AND_CORNER).
+    #[arg(long, value_enum, default_value_t = BoundaryArg::EdgeOnly)]
+    pub boundary: BoundaryArg,
+    /// Output file (format from the extension: .ply, .obj, .off, .stl, .xyz).
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// A subdivision scheme named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SchemeArg {
+    /// Loop for triangle meshes, Catmull-Clark otherwise.
+    Auto,
+    /// Loop (triangles only).
+    Loop,
+    /// Catmull-Clark (any polygons).
+    CatmullClark,
+}
+
+/// A boundary rule named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BoundaryArg {
+    /// Boundary edges are creases; the boundary limit is the cubic B-spline of the boundary.
+    EdgeOnly,
+    /// As edge-only, and boundary vertices on a single face are corners.
+    EdgeAndCorner,
 }
 
 /// `subfit info`.

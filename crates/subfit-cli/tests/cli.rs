@@ -218,3 +218,67 @@ fn demo_writes_the_builtin_shapes() {
         assert!((475..=500).contains(&n), "{name}: {n}");
     }
 }
+
+#[test]
+fn subdivide_refines_and_evaluates_the_limit() {
+    let d = tempfile::tempdir().unwrap();
+    let d = d.path();
+    let cube = write(d, "cube.obj", CUBE_OBJ.as_bytes());
+    let out = d.join("cube2.ply");
+    let r = subfit(&[
+        "subdivide",
+        cube.to_str().unwrap(),
+        "--levels",
+        "2",
+        "--limit",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let v: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", out.to_str().unwrap()]).stdout).unwrap();
+    // Catmull-Clark: V + E + F per level: 8 → 26 → 98 vertices, 6 → 24 → 96 quads.
+    assert_eq!(v["vertices"], 98);
+    assert_eq!(v["faces_by_size"]["4"], 96);
+    assert_eq!(v["normals"], true);
+    assert_eq!(v["topology"]["genus"], 0);
+    // The limit of the unit cube lies strictly inside it.
+    for k in 0..3 {
+        assert!(v["bbox"]["min"][k].as_f64().unwrap() > 0.0);
+        assert!(v["bbox"]["max"][k].as_f64().unwrap() < 1.0);
+    }
+
+    // Loop on quads is refused with exit code 2, and nothing is written.
+    let bad_out = d.join("never.obj");
+    let r = subfit(&[
+        "subdivide",
+        cube.to_str().unwrap(),
+        "--scheme",
+        "loop",
+        "-o",
+        bad_out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(!bad_out.exists());
+
+    // Loop on an octahedron: 6 + 12 vertices and 32 triangles after one level.
+    let octa = write(
+        d,
+        "octa.obj",
+        b"v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
+    );
+    let out = d.join("octa1.off");
+    assert!(subfit(&[
+        "subdivide",
+        octa.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let v: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", out.to_str().unwrap()]).stdout).unwrap();
+    assert_eq!(v["vertices"], 18);
+    assert_eq!(v["faces_by_size"]["3"], 32);
+}

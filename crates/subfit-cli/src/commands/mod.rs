@@ -3,6 +3,7 @@
 mod convert;
 mod demo;
 mod info;
+mod subdivide;
 
 use std::process::ExitCode;
 
@@ -14,5 +15,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Info(a) => info::run(a),
         Command::Convert(a) => convert::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Subdivide(a) => subdivide::run(a),
     }
 }

@@ -1,0 +1,93 @@
+//! `subfit subdivide CONTROL --levels k [--limit] -o OUT`: uniform refinement or limit
+//! positions and normals of a control mesh.
+
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use subfit::io::{Encoding, Format, WriteOptions};
+use subfit::mesh::{PolyMesh, Tags};
+use subfit::subdiv::{refine, sampling_operator, BoundaryRule, Options, Scheme};
+
+use crate::cli::{BoundaryArg, SchemeArg, SubdivideArgs};
+
+pub fn run(a: SubdivideArgs) -> anyhow::Result<ExitCode> {
+    let Some(out_format) = Format::from_path(&a.output) else {
+        bail!(
+            "{}: cannot tell the output format from the extension",
+            a.output.display()
+        );
+    };
+    let (control, _) = crate::progress::load(&a.control)?;
+    if control.faces.is_empty() {
+        bail!(
+            "{}: has no faces; a control mesh is needed",
+            a.control.display()
+        );
+    }
+    let scheme = match a.scheme {
+        SchemeArg::Loop => Scheme::Loop,
+        SchemeArg::CatmullClark => Scheme::CatmullClark,
+        SchemeArg::Auto if control.faces.is_triangles() => Scheme::Loop,
+        SchemeArg::Auto => Scheme::CatmullClark,
+    };
+    let boundary = match a.boundary {
+        BoundaryArg::EdgeOnly => BoundaryRule::EdgeOnly,
+        BoundaryArg::EdgeAndCorner => BoundaryRule::EdgeAndCorner,
+    };
+    let options = Options::new(scheme).with_boundary(boundary);
+    let tags = Tags::new();
+    let ctx = || format!("{}: cannot subdivide", a.control.display());
+
+    let sp = crate::progress::spinner("subdividing");
+    let result = if a.limit {
+        let op = sampling_operator(
+            &control.faces,
+            control.num_vertices(),
+            &tags,
+            &options,
+            a.levels as usize,
+        )
+        .with_context(ctx)?;
+        let samples = op.evaluate(&control.positions);
+        PolyMesh {
+            positions: samples.positions,
+            normals: Some(samples.normals),
+            colors: None,
+            faces: op.faces,
+        }
+    } else {
+        let mut faces = control.faces.clone();
+        let mut positions = control.positions.clone();
+        let mut level_tags = tags;
+        for _ in 0..a.levels {
+            let r = refine(&faces, positions.len(), &level_tags, &options).with_context(ctx)?;
+            positions = r.matrix.apply(&positions);
+            faces = r.faces;
+            level_tags = r.tags;
+        }
+        PolyMesh::new(positions, faces)
+    };
+    sp.finish_and_clear();
+
+    let encoding = match out_format {
+        Format::Ply | Format::Stl => Encoding::BinaryLittleEndian,
+        _ => Encoding::Ascii,
+    };
+    let opts = WriteOptions {
+        format: Some(out_format),
+        encoding,
+        single_precision: false,
+    };
+    subfit::io::write_file(&a.output, &result, &opts)?;
+    eprintln!(
+        "{} ({:?}, {} level(s){}) -> {}: {} vertices, {} faces",
+        a.control.display(),
+        scheme,
+        a.levels,
+        if a.limit { ", limit" } else { "" },
+        a.output.display(),
+        result.num_vertices(),
+        result.num_faces()
+    );
+    Ok(ExitCode::SUCCESS)
+}
