@@ -593,6 +593,10 @@ impl Sink {
                 self.check_index(i)?;
             }
         }
+        if self.faces.is_empty() {
+            // At most one triangle per index; `list` is bounded by the data already read.
+            self.faces = Polygons::with_capacity(list.len(), list.len().saturating_mul(3));
+        }
         for strip in list.split(|&i| i == -1) {
             for j in 2..strip.len() {
                 // Checked above: every entry is in 0..vertex_count <= u32::MAX.
