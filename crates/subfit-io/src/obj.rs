@@ -31,7 +31,7 @@ use subfit_mesh::{PolyMesh, Polygons};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{
-    check_utf8, finite_f64, parse_i64, push_f64_exact, push_u64, strip_hash_comment, syntax,
+    check_utf8, finite_f64, parse_int, push_f64_exact, push_u64, strip_hash_comment, syntax,
     tokens, unit_to_u8, NumberedLines,
 };
 
@@ -362,7 +362,7 @@ impl<'p> Parser<'p> {
     /// current count are allowed here (forward references) and checked in [`Parser::finish`].
     fn resolve(&mut self, no: u64, tok: &[u8], target: Target) -> Result<u32> {
         let what = target.name();
-        let Some(i) = parse_i64(tok) else {
+        let Some(i) = parse_int(tok) else {
             return Err(syntax(self.path, no, &format!("bad {what} index"), tok));
         };
         let count = match target {

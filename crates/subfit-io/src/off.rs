@@ -28,8 +28,8 @@ use subfit_mesh::{PolyMesh, Polygons};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{
-    check_utf8, finite_f64, parse_f64, parse_i64, push_f64_exact, push_u64, strip_hash_comment,
-    syntax, tokens, unit_to_u8, NumberedLines,
+    check_utf8, finite_f64, parse_f64, parse_i64, parse_int, push_f64_exact, push_u64,
+    strip_hash_comment, syntax, tokens, unit_to_u8, NumberedLines,
 };
 
 /// What the header keyword announces per vertex.
@@ -195,7 +195,7 @@ fn counts(line: &[u8], path: &Path, no: u64) -> Result<(u64, u64)> {
         if n == 3 {
             return Err(syntax(path, no, "extra value after the counts `V F E`", t));
         }
-        let Some(v) = parse_i64(t) else {
+        let Some(v) = parse_int(t) else {
             return Err(syntax(path, no, "expected the counts `V F E`", t));
         };
         if !(0..=u32::MAX as i64).contains(&v) {
@@ -316,7 +316,7 @@ fn face_line(line: &[u8], no: u64, path: &Path, nv: u64, face: &mut Vec<u32>) ->
     face.clear();
     let mut toks = tokens(line);
     let first = toks.next().unwrap_or_default();
-    let n = match parse_i64(first) {
+    let n = match parse_int(first) {
         Some(n) if n >= 3 => n as u64,
         Some(n) => {
             return Err(Error::at_line(
@@ -335,7 +335,7 @@ fn face_line(line: &[u8], no: u64, path: &Path, nv: u64, face: &mut Vec<u32>) ->
                 ErrorKind::Syntax(format!("face announces {n} vertices but lists {k}")),
             ));
         };
-        let Some(i) = parse_i64(t) else {
+        let Some(i) = parse_int(t) else {
             return Err(syntax(path, no, "bad vertex index", t));
         };
         if i < 0 || i as u64 >= nv {

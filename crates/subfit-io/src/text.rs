@@ -184,6 +184,27 @@ pub(crate) fn push_f64_exact(out: &mut Vec<u8>, v: f64) {
     }
 }
 
+/// Parses a signed integer token like [`parse_i64`] (same accepted syntax and results), with a
+/// fast path for the short decimal tokens that face indices are.
+pub(crate) fn parse_int(tok: &[u8]) -> Option<i64> {
+    let (neg, digits) = match tok.first() {
+        Some(b'-') => (true, &tok[1..]),
+        Some(b'+') => (false, &tok[1..]),
+        _ => (false, tok),
+    };
+    if digits.is_empty() || digits.len() > 18 {
+        return parse_i64(tok);
+    }
+    let mut v: i64 = 0;
+    for &c in digits {
+        if !c.is_ascii_digit() {
+            return None;
+        }
+        v = v * 10 + (c - b'0') as i64;
+    }
+    Some(if neg { -v } else { v })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,6 +222,30 @@ mod tests {
                 (5, &b"d"[..])
             ]
         );
+    }
+
+    #[test]
+    fn fast_integers_agree_with_std() {
+        for t in [
+            "0",
+            "-0",
+            "+7",
+            "-",
+            "+",
+            "",
+            "12a",
+            "999999999999999999",
+            "-999999999999999999",
+            "9223372036854775807",
+            "-9223372036854775808",
+            "9223372036854775808",
+            " 1",
+            "1.0",
+            "+-1",
+            "--1",
+        ] {
+            assert_eq!(parse_int(t.as_bytes()), parse_i64(t.as_bytes()), "{t:?}");
+        }
     }
 
     #[test]
