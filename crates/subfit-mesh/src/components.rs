@@ -4,7 +4,7 @@
 //! genus `g`, the Euler characteristic is `χ = V − E + F = 2C − 2g − b` (the Euler–Poincaré
 //! formula; see e.g. Botsch et al., *Polygon Mesh Processing*, 2010, §1.3.1), so
 //! `g = (2C − χ − b) / 2`. The formula only holds for manifold, orientable surfaces: callers
-//! check that first (see [`crate::diagnose`]).
+//! check that first (see [`crate::diagnose()`]).
 
 use crate::edges::UnionFind;
 use crate::polygons::Polygons;

@@ -3,7 +3,7 @@
 //! Topology is flat `u32` arrays behind typed ids ([`VertexId`], [`FaceId`], …); positions live
 //! beside it. [`Polygons`] is the compressed-row face list passed between crates and [`PolyMesh`]
 //! bundles it with positions and optional attributes. [`HalfEdgeMesh`] is a derived view for
-//! navigating manifold meshes; [`diagnose`] reports on any polygon soup (boundary loops,
+//! navigating manifold meshes; [`diagnose()`] reports on any polygon soup (boundary loops,
 //! manifoldness, orientation, components, Euler characteristic, genus).
 
 pub mod components;
