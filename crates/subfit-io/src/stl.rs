@@ -40,7 +40,7 @@ use crate::Encoding;
 /// Cost: O(file size) time, and memory proportional to the facets present (the stored facet
 /// count is only trusted once the file size confirms it).
 pub fn read(bytes: &[u8], path: &Path, weld: bool) -> Result<(PolyMesh, Encoding)> {
-    if bytes.is_empty() {
+    if bytes.iter().all(|c| c.is_ascii_whitespace()) {
         return Err(Error::file(path, ErrorKind::Empty));
     }
     if !is_binary_stl(bytes) && looks_ascii(bytes) {

@@ -652,8 +652,10 @@ fn stl_errors() {
     // Too short for a header.
     let e = err(Format::Stl, b"\x00\x01abc");
     assert!(matches!(e.kind, ErrorKind::Truncated(_)), "{e}");
-    let e = err(Format::Stl, b"");
-    assert!(matches!(e.kind, ErrorKind::Empty), "{e}");
+    for empty in [&b""[..], b" \n\t\r\n"] {
+        let e = err(Format::Stl, empty);
+        assert!(matches!(e.kind, ErrorKind::Empty), "{e}");
+    }
 
     let head = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n";
     let cases: Vec<Case<String>> = vec![
