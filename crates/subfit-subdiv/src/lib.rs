@@ -33,4 +33,10 @@ pub use scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, 
 pub use stencil::StencilMatrix;
 pub use topology::Topology;
 
+pub mod eval;
+mod local;
 pub mod patch;
+
+pub use eval::{
+    random_samples, EvalError, EvalKind, EvalWeights, Evaluator, SurfaceParam, SurfacePoint,
+};

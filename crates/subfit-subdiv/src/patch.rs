@@ -214,7 +214,10 @@ fn cubic_bspline(t: f64) -> [[f64; 4]; 3] {
 /// Control point order: [`BSPLINE_PATCH_GRID`]. At a corner the weights are the regular limit
 /// mask (4/9 at the corner, 1/9 at its edge neighbours, 1/36 at its diagonal neighbours).
 /// Cost: about 150 flops.
-#[allow(clippy::needless_range_loop, reason = "tensor indices i, j read clearer")]
+#[allow(
+    clippy::needless_range_loop,
+    reason = "tensor indices i, j read clearer"
+)]
 pub fn bicubic_bspline(u: f64, v: f64) -> PatchBasis<BSPLINE_PATCH_POINTS> {
     let bu = cubic_bspline(u);
     let bv = cubic_bspline(v);
