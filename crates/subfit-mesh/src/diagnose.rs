@@ -176,10 +176,8 @@ pub fn diagnose(
     let idx = faces.indices();
     let corner_face = corner_faces(faces);
 
-    // Edges: classify, fans (corner union-find), orientation parity, boundary degree.
-    let mut fans = UnionFind::new(idx.len());
-    let mut parity = ParityUnionFind::new(faces.len());
-    let mut non_orientable_faces = Vec::new();
+    // Edges: classify; `mate` pairs the two half-edges of each two-sided edge.
+    let mut mate = vec![u32::MAX; idx.len()];
     let mut boundary_degree = vec![0u32; num_vertices];
     let mut bad_edge = vec![false; groups.len()];
     r.num_edges = groups.len();
@@ -196,14 +194,11 @@ pub fn diagnose(
             }
             2 => {
                 let h1 = g[1] as usize;
-                let same = idx[h1] == a;
-                if same {
+                mate[h0] = h1 as u32;
+                mate[h1] = h0 as u32;
+                if idx[h1] == a {
                     r.inconsistent_edges += 1;
                     push_example(&mut r.examples.inconsistent_edges, key);
-                }
-                let (f0, f1) = (corner_face[h0], corner_face[h1]);
-                if !parity.relate(f0, f1, u8::from(same)) {
-                    non_orientable_faces.push(f0);
                 }
             }
             _ => {
@@ -212,35 +207,21 @@ pub fn diagnose(
                 push_example(&mut r.examples.non_manifold_edges, key);
             }
         }
-        // Corner at the origin of h is h; at its destination, next[h].
-        let (mut at_a, mut at_b) = (u32::MAX, u32::MAX);
-        for &h in g {
-            let (ca, cb) = if idx[h as usize] == a {
-                (h, next[h as usize])
-            } else {
-                (next[h as usize], h)
-            };
-            for (c, first) in [(ca, &mut at_a), (cb, &mut at_b)] {
-                if *first == u32::MAX {
-                    *first = c;
-                } else {
-                    fans.union(*first, c);
-                }
-            }
-        }
     }
+    // Orientability: only in doubt when some edge is inconsistently oriented (otherwise the
+    // given orientation is a consistent one).
+    let non_orientable_faces = if r.inconsistent_edges > 0 {
+        non_orientable_faces(&groups, idx, &corner_face, faces.len())
+    } else {
+        Vec::new()
+    };
 
-    // Non-manifold vertices: more than one fan root among a vertex's corners.
-    let mut fan_count = vec![0u32; num_vertices];
-    for (f, w) in faces.offsets().windows(2).enumerate() {
-        if analysed[f] {
-            for c in w[0]..w[1] {
-                if fans.find(c) == c {
-                    fan_count[idx[c as usize] as usize] += 1;
-                }
-            }
-        }
-    }
+    // Non-manifold vertices: more than one fan of corners.
+    let fan_count = if r.non_manifold_edges == 0 {
+        fans_by_walking(faces, &analysed, &next, &mate, num_vertices)
+    } else {
+        fans_by_union_find(faces, &analysed, &groups, &next, num_vertices)
+    };
     let mut vertex_bad = vec![false; num_vertices];
     for (v, &n) in fan_count.iter().enumerate() {
         if n > 1 {
@@ -274,6 +255,132 @@ pub fn diagnose(
     }
     count_duplicates(faces, &analysed, &mut r);
     r
+}
+
+/// Faces where the parity union-find over two-sided edges finds an odd cycle (one face per
+/// contradiction). Cost `O(#E · α)`.
+fn non_orientable_faces(
+    groups: &crate::edges::EdgeGroups,
+    idx: &[u32],
+    corner_face: &[u32],
+    nf: usize,
+) -> Vec<u32> {
+    let mut parity = ParityUnionFind::new(nf);
+    let mut out = Vec::new();
+    for e in 0..groups.len() {
+        if let &[h0, h1] = groups.group(e) {
+            let same = idx[h0 as usize] == idx[h1 as usize];
+            let (f0, f1) = (corner_face[h0 as usize], corner_face[h1 as usize]);
+            if !parity.relate(f0, f1, u8::from(same)) {
+                out.push(f0);
+            }
+        }
+    }
+    out
+}
+
+/// Number of fans at each vertex (`#V` entries) when no edge has more than two sides: the
+/// corners at a vertex and the two-sided edges between them form paths and cycles, walked
+/// once each (orientation-agnostic). Cost `O(#H)`.
+fn fans_by_walking(
+    faces: &Polygons,
+    analysed: &[bool],
+    next: &[u32],
+    mate: &[u32],
+    num_vertices: usize,
+) -> Vec<u32> {
+    let idx = faces.indices();
+    let mut prev = vec![0u32; idx.len()];
+    for (h, &n) in next.iter().enumerate() {
+        prev[n as usize] = h as u32;
+    }
+    let mut visited = vec![false; idx.len()];
+    let mut fan_count = vec![0u32; num_vertices];
+    // From the corner at `v` reached through half-edge `m`, the corner and its other edge.
+    let step = |m: u32, v: u32| {
+        if idx[m as usize] == v {
+            (m, prev[m as usize])
+        } else {
+            (next[m as usize], next[m as usize])
+        }
+    };
+    for (f, w) in faces.offsets().windows(2).enumerate() {
+        if !analysed[f] {
+            continue;
+        }
+        for c in w[0]..w[1] {
+            if visited[c as usize] {
+                continue;
+            }
+            visited[c as usize] = true;
+            let v = idx[c as usize];
+            fan_count[v as usize] += 1;
+            // Leave through the outgoing side, then (if the fan is open) the incoming side.
+            'sides: for mut exit in [c, prev[c as usize]] {
+                loop {
+                    let m = mate[exit as usize];
+                    if m == u32::MAX {
+                        break;
+                    }
+                    let (corner, other) = step(m, v);
+                    if corner == c {
+                        break 'sides;
+                    }
+                    if visited[corner as usize] {
+                        break;
+                    }
+                    visited[corner as usize] = true;
+                    exit = other;
+                }
+            }
+        }
+    }
+    fan_count
+}
+
+/// Number of fans at each vertex (`#V` entries) for any soup: a union-find over corners, two
+/// corners at a vertex joined when their faces share an edge at it (through any number of
+/// sides). Cost `O(#H · α)`.
+fn fans_by_union_find(
+    faces: &Polygons,
+    analysed: &[bool],
+    groups: &crate::edges::EdgeGroups,
+    next: &[u32],
+    num_vertices: usize,
+) -> Vec<u32> {
+    let idx = faces.indices();
+    let mut fans = UnionFind::new(idx.len());
+    for e in 0..groups.len() {
+        let g = groups.group(e);
+        let a = idx[g[0] as usize];
+        // Corner at the origin of h is h; at its destination, next[h].
+        let (mut at_a, mut at_b) = (u32::MAX, u32::MAX);
+        for &h in g {
+            let (ca, cb) = if idx[h as usize] == a {
+                (h, next[h as usize])
+            } else {
+                (next[h as usize], h)
+            };
+            for (c, first) in [(ca, &mut at_a), (cb, &mut at_b)] {
+                if *first == u32::MAX {
+                    *first = c;
+                } else {
+                    fans.union(*first, c);
+                }
+            }
+        }
+    }
+    let mut fan_count = vec![0u32; num_vertices];
+    for (f, w) in faces.offsets().windows(2).enumerate() {
+        if analysed[f] {
+            for c in w[0]..w[1] {
+                if fans.find(c) == c {
+                    fan_count[idx[c as usize] as usize] += 1;
+                }
+            }
+        }
+    }
+    fan_count
 }
 
 /// Per face whether it is analysed; fills the face-level counts.
@@ -499,4 +606,54 @@ fn count_duplicates(faces: &Polygons, analysed: &[bool], r: &mut MeshReport) {
     dups.sort_unstable();
     r.duplicate_faces = dups.len();
     r.examples.duplicate_faces = dups.into_iter().take(MAX_EXAMPLES).collect();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edges::{corner_next, group_edges};
+
+    /// The fan walk and the corner union-find agree on soups without non-manifold edges.
+    #[test]
+    fn fan_walk_matches_union_find() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n) as u32
+        };
+        let mut compared = 0;
+        for _ in 0..3000 {
+            let nv = 3 + rnd(6) as usize;
+            let mut p = Polygons::new();
+            for _ in 0..1 + rnd(8) {
+                let k = 3 + rnd(2);
+                let f: Vec<u32> = (0..k).map(|_| rnd(nv as u64)).collect();
+                p.push(&f);
+            }
+            let mut scratch = Vec::new();
+            let analysed: Vec<bool> = p
+                .iter()
+                .map(|f| repeated_vertex(f, &mut scratch).is_none())
+                .collect();
+            let next = corner_next(&p);
+            let groups = group_edges(&p, &next, nv, |f| analysed[f]);
+            if (0..groups.len()).any(|e| groups.group(e).len() > 2) {
+                continue;
+            }
+            let mut mate = vec![u32::MAX; p.indices().len()];
+            for e in 0..groups.len() {
+                if let &[a, b] = groups.group(e) {
+                    mate[a as usize] = b;
+                    mate[b as usize] = a;
+                }
+            }
+            let walk = fans_by_walking(&p, &analysed, &next, &mate, nv);
+            let uf = fans_by_union_find(&p, &analysed, &groups, &next, nv);
+            assert_eq!(walk, uf, "{p:?}");
+            compared += 1;
+        }
+        assert!(compared > 500);
+    }
 }
