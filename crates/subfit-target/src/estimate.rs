@@ -38,6 +38,15 @@ pub(crate) struct PointEstimate {
     pub graph: Vec<u32>,
 }
 
+/// Per-point estimation settings (from [`crate::TargetOptions`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EstimateParams {
+    pub hood: Neighborhood,
+    pub ambiguity_ratio: f64,
+    pub graph_k: usize,
+    pub degree: u8,
+}
+
 /// Minimum number of neighbours used in any fit.
 pub(crate) const MIN_NEIGHBORS: usize = 10;
 
@@ -50,11 +59,15 @@ pub(crate) fn estimate_point(
     points: &[[f64; 3]],
     index: &PointIndex,
     i: usize,
-    hood: Neighborhood,
     prescribed: Option<[f64; 3]>,
-    ambiguity_ratio: f64,
-    graph_k: usize,
+    params: &EstimateParams,
 ) -> PointEstimate {
+    let EstimateParams {
+        hood,
+        ambiguity_ratio,
+        graph_k,
+        degree,
+    } = *params;
     let p = points[i];
     let nb: Vec<Neighbor> = match hood {
         Neighborhood::Knn(k) => index.k_nearest(&p, k.max(MIN_NEIGHBORS)),
@@ -104,7 +117,7 @@ pub(crate) fn estimate_point(
         .iter()
         .map(|n| (-(n.distance / h).powi(2)).exp())
         .collect();
-    let (quadric, quality) = LocalQuadric::fit(n, e1, &rel, &w, h);
+    let (quadric, quality) = LocalQuadric::fit(n, e1, &rel, &w, h, degree);
     let graph = nb
         .iter()
         .filter(|n| n.index as usize != i)
@@ -125,10 +138,8 @@ pub(crate) fn estimate_point(
 pub(crate) fn estimate_all(
     points: &[[f64; 3]],
     index: &PointIndex,
-    hood: Neighborhood,
     prescribed: &[Option<[f64; 3]>],
-    ambiguity_ratio: f64,
-    graph_k: usize,
+    params: &EstimateParams,
     tick: &(dyn Fn(usize) + Sync),
 ) -> Vec<PointEstimate> {
     const CHUNK: usize = 1 << 15;
@@ -143,10 +154,8 @@ pub(crate) fn estimate_all(
                     points,
                     index,
                     i,
-                    hood,
                     prescribed.get(i).copied().flatten(),
-                    ambiguity_ratio,
-                    graph_k,
+                    params,
                 )
             })
             .collect();

@@ -99,10 +99,28 @@ impl Target {
     /// The foot point of `x` (normalized coordinates). Cost: one nearest-neighbour query (≈1 µs)
     /// plus a few Newton steps. Accurate where the nearest data point's quadric represents the
     /// surface (dense sampling, `|d|` well below the local radii of curvature); not checked.
+    ///
+    /// When the data point nearest to the first foot point differs from the one nearest to `x`
+    /// (queries far from the surface or near strong curvature), the projection is redone once on
+    /// that point's quadric, which represents the surface better there.
     pub fn foot_point(&self, x: [f64; 3]) -> FootPoint {
-        let nb = self.index().nearest(&x);
-        let i = nb.index as usize;
-        foot_point_on(&self.quadrics()[i], self.points()[i], x, nb.index)
+        let i = self.index().nearest(&x).index;
+        let f = foot_point_on(
+            &self.quadrics()[i as usize],
+            self.points()[i as usize],
+            x,
+            i,
+        );
+        let j = self.index().nearest(&f.point).index;
+        if j == i {
+            return f;
+        }
+        foot_point_on(
+            &self.quadrics()[j as usize],
+            self.points()[j as usize],
+            x,
+            j,
+        )
     }
 
     /// [`Self::foot_point`] for many points, in parallel (rayon); `#Q` results in order.

@@ -9,7 +9,7 @@ use subfit_mesh::PolyMesh;
 
 use crate::closest::TriangleBvh;
 use crate::error::TargetError;
-use crate::estimate::{estimate_all, Neighborhood, PointEstimate};
+use crate::estimate::{estimate_all, EstimateParams, Neighborhood, PointEstimate};
 use crate::neighbors::PointIndex;
 use crate::normalize::Normalization;
 use crate::options::{
@@ -170,15 +170,13 @@ impl Target {
         let np = points.len();
         report(Phase::Estimate, 0, np);
         let tick = |done: usize| report(Phase::Estimate, done, np);
-        let estimates = estimate_all(
-            &points,
-            &index,
-            options.neighborhood,
-            &prescribed,
-            options.ambiguity_ratio,
-            options.orientation_k,
-            &tick,
-        );
+        let params = EstimateParams {
+            hood: options.neighborhood,
+            ambiguity_ratio: options.ambiguity_ratio,
+            graph_k: options.orientation_k,
+            degree: options.jet_degree,
+        };
+        let estimates = estimate_all(&points, &index, &prescribed, &params, &tick);
         stats.timings.estimate = t.elapsed();
         summarize_estimates(&estimates, &mut stats);
 
@@ -369,6 +367,9 @@ fn validate_options(o: &TargetOptions) -> Result<(), TargetError> {
             return bad("neighborhood", "Radius(r) needs a finite r > 0")
         }
         _ => {}
+    }
+    if !(2..=3).contains(&o.jet_degree) {
+        return bad("jet_degree", "must be 2 or 3");
     }
     if o.orientation_k == 0 {
         return bad("orientation_k", "must be at least 1");
