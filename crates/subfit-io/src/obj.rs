@@ -30,51 +30,48 @@ use std::path::Path;
 use subfit_mesh::{PolyMesh, Polygons};
 
 use crate::error::{Error, ErrorKind, Result};
-use crate::text::{
-    check_utf8, finite_f64, parse_int, push_f64_exact, push_u64, strip_hash_comment, syntax,
-    tokens, unit_to_u8, NumberedLines,
-};
+use crate::text::{parse_int, push_f64_exact, push_u64, syntax, unit_to_u8, NumberedLines};
 
 /// Marks a corner without a normal, or a vertex without one.
 const NONE: u32 = u32::MAX;
 
 /// Statements that are read and ignored.
-const IGNORED: &[&[u8]] = &[
-    b"l",
-    b"p",
-    b"o",
-    b"g",
-    b"s",
-    b"usemtl",
-    b"mtllib",
-    b"vp",
-    b"cstype",
-    b"deg",
-    b"bmat",
-    b"step",
-    b"curv",
-    b"curv2",
-    b"surf",
-    b"parm",
-    b"trim",
-    b"hole",
-    b"scrv",
-    b"sp",
-    b"end",
-    b"con",
-    b"mg",
-    b"lod",
-    b"usemap",
-    b"maplib",
-    b"shadow_obj",
-    b"trace_obj",
-    b"ctech",
-    b"stech",
-    b"bevel",
-    b"c_interp",
-    b"d_interp",
-    b"call",
-    b"csh",
+const IGNORED: &[&str] = &[
+    "l",
+    "p",
+    "o",
+    "g",
+    "s",
+    "usemtl",
+    "mtllib",
+    "vp",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "mg",
+    "lod",
+    "usemap",
+    "maplib",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
+    "stech",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "call",
+    "csh",
 ];
 
 /// Parses a whole OBJ file.
@@ -83,27 +80,26 @@ const IGNORED: &[&[u8]] = &[
 /// Errors: non-UTF-8 text, syntax errors (quoting the token), NaN/infinite values, zero or
 /// out-of-range indices (with their line), faces with fewer than three corners, no vertices.
 pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
-    check_utf8(bytes, path)?;
     let mut p = Parser::new(path, bytes.len());
-    let mut lines = NumberedLines::new(bytes);
-    let mut joined = Vec::new();
-    while let Some((no, raw)) = lines.next() {
-        let line = strip_hash_comment(raw);
+    let mut lines = NumberedLines::new(bytes).map(|(no, raw)| (no, utf8_line(raw, no, path)));
+    let mut joined = String::new();
+    while let Some((no, text)) = lines.next() {
+        let line = strip_comment(text?);
         match continued(line) {
             None => p.statement(no, line)?,
             Some(head) => {
                 joined.clear();
-                joined.extend_from_slice(head);
-                joined.push(b' ');
+                joined.push_str(head);
+                joined.push(' ');
                 for (_, next) in lines.by_ref() {
-                    let next = strip_hash_comment(next);
+                    let next = strip_comment(next?);
                     match continued(next) {
                         Some(h) => {
-                            joined.extend_from_slice(h);
-                            joined.push(b' ');
+                            joined.push_str(h);
+                            joined.push(' ');
                         }
                         None => {
-                            joined.extend_from_slice(next);
+                            joined.push_str(next);
                             break;
                         }
                     }
@@ -115,16 +111,49 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
     p.finish()
 }
 
+/// A line as text: validated once here, so that number tokens need no further check.
+fn utf8_line<'a>(raw: &'a [u8], no: u64, path: &Path) -> Result<&'a str> {
+    std::str::from_utf8(raw).map_err(|e| {
+        let at = e.valid_up_to();
+        let bad = &raw[at..raw.len().min(at + 4)];
+        Error::at_line(
+            path,
+            no,
+            ErrorKind::Syntax(format!(
+                "not UTF-8 text (column {}: {bad:02x?}); is this a binary file?",
+                at + 1
+            )),
+        )
+    })
+}
+
+/// Cuts a line at `#`.
+fn strip_comment(line: &str) -> &str {
+    line.split('#').next().unwrap_or_default()
+}
+
 /// If `line` ends with a continuation backslash (before trailing blanks), the part before it.
-fn continued(line: &[u8]) -> Option<&[u8]> {
-    let end = line.len()
-        - line
-            .iter()
-            .rev()
-            .take_while(|c| c.is_ascii_whitespace())
-            .count();
-    let t = &line[..end];
-    t.strip_suffix(b"\\")
+fn continued(line: &str) -> Option<&str> {
+    line.trim_end_matches(|c: char| c.is_ascii_whitespace())
+        .strip_suffix('\\')
+}
+
+/// Parses a number token that must be finite (errors as [`crate::text`]'s `finite_f64`).
+fn float(tok: &str, path: &Path, no: u64, what: &str) -> Result<f64> {
+    match tok.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(Error::at_line(
+            path,
+            no,
+            ErrorKind::NonFinite(format!("{what} `{tok}`")),
+        )),
+        Err(_) => Err(syntax(
+            path,
+            no,
+            &format!("expected a number ({what})"),
+            tok.as_bytes(),
+        )),
+    }
 }
 
 /// Reading state: everything seen so far.
@@ -183,29 +212,34 @@ impl<'p> Parser<'p> {
         }
     }
 
-    fn statement(&mut self, no: u64, line: &[u8]) -> Result<()> {
-        let mut toks = tokens(line);
+    fn statement(&mut self, no: u64, line: &str) -> Result<()> {
+        let mut toks = line.split_ascii_whitespace();
         let Some(kw) = toks.next() else {
             return Ok(());
         };
         match kw {
-            b"v" => self.vertex(no, toks),
-            b"vn" => {
+            "v" => self.vertex(no, toks),
+            "vn" => {
                 let n = self.triple(no, &mut toks, "normal component")?;
                 self.no_more(no, toks, "`vn` takes 3 numbers")?;
                 self.normals.push(n);
                 Ok(())
             }
-            b"vt" => self.texcoord(no, toks),
-            b"f" | b"fo" => self.face(no, toks),
+            "vt" => self.texcoord(no, toks),
+            "f" | "fo" => self.face(no, toks),
             _ if IGNORED.contains(&kw) => Ok(()),
-            _ => Err(syntax(self.path, no, "unknown OBJ statement", kw)),
+            _ => Err(syntax(
+                self.path,
+                no,
+                "unknown OBJ statement",
+                kw.as_bytes(),
+            )),
         }
     }
 
-    fn number(&self, no: u64, tok: Option<&[u8]>, what: &str) -> Result<f64> {
+    fn number(&self, no: u64, tok: Option<&str>, what: &str) -> Result<f64> {
         match tok {
-            Some(t) => finite_f64(t, self.path, no, what),
+            Some(t) => float(t, self.path, no, what),
             None => Err(Error::at_line(
                 self.path,
                 no,
@@ -217,7 +251,7 @@ impl<'p> Parser<'p> {
     fn triple<'a>(
         &self,
         no: u64,
-        toks: &mut impl Iterator<Item = &'a [u8]>,
+        toks: &mut impl Iterator<Item = &'a str>,
         what: &str,
     ) -> Result<[f64; 3]> {
         Ok([
@@ -230,16 +264,21 @@ impl<'p> Parser<'p> {
     fn no_more<'a>(
         &self,
         no: u64,
-        mut toks: impl Iterator<Item = &'a [u8]>,
+        mut toks: impl Iterator<Item = &'a str>,
         what: &str,
     ) -> Result<()> {
         match toks.next() {
-            Some(t) => Err(syntax(self.path, no, &format!("extra value ({what})"), t)),
+            Some(t) => Err(syntax(
+                self.path,
+                no,
+                &format!("extra value ({what})"),
+                t.as_bytes(),
+            )),
             None => Ok(()),
         }
     }
 
-    fn vertex<'a>(&mut self, no: u64, mut toks: impl Iterator<Item = &'a [u8]>) -> Result<()> {
+    fn vertex<'a>(&mut self, no: u64, mut toks: impl Iterator<Item = &'a str>) -> Result<()> {
         if self.positions.len() >= NONE as usize {
             return Err(Error::at_line(
                 self.path,
@@ -256,10 +295,10 @@ impl<'p> Parser<'p> {
                     self.path,
                     no,
                     "extra value (`v` takes x y z, x y z w or x y z r g b)",
-                    t,
+                    t.as_bytes(),
                 ));
             }
-            extra[n] = finite_f64(t, self.path, no, "vertex weight or colour")?;
+            extra[n] = float(t, self.path, no, "vertex weight or colour")?;
             n += 1;
         }
         let color = match n {
@@ -283,7 +322,7 @@ impl<'p> Parser<'p> {
         Ok(())
     }
 
-    fn texcoord<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a [u8]>) -> Result<()> {
+    fn texcoord<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a str>) -> Result<()> {
         let mut n = 0;
         for t in toks {
             if n == 3 {
@@ -291,10 +330,10 @@ impl<'p> Parser<'p> {
                     self.path,
                     no,
                     "extra value (`vt` takes 1 to 3 numbers)",
-                    t,
+                    t.as_bytes(),
                 ));
             }
-            finite_f64(t, self.path, no, "texture coordinate")?;
+            float(t, self.path, no, "texture coordinate")?;
             n += 1;
         }
         if n == 0 {
@@ -308,20 +347,20 @@ impl<'p> Parser<'p> {
         Ok(())
     }
 
-    fn face<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a [u8]>) -> Result<()> {
+    fn face<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a str>) -> Result<()> {
         self.face_buf.clear();
         self.normal_buf.clear();
         for corner in toks {
-            let mut parts = corner.split(|&c| c == b'/');
+            let mut parts = corner.split('/');
             let v = parts.next().unwrap_or_default();
             let vt = parts.next().unwrap_or_default();
             let vn = parts.next().unwrap_or_default();
-            if parts.next().is_some() || v.is_empty() || (vt.is_empty() && corner.ends_with(b"/")) {
+            if parts.next().is_some() || v.is_empty() || (vt.is_empty() && corner.ends_with('/')) {
                 return Err(syntax(
                     self.path,
                     no,
                     "bad face corner (expected v, v/vt, v//vn or v/vt/vn)",
-                    corner,
+                    corner.as_bytes(),
                 ));
             }
             let vi = self.resolve(no, v, Target::Vertex)?;
@@ -360,10 +399,15 @@ impl<'p> Parser<'p> {
 
     /// Turns a 1-based or negative index token into a 0-based index. Positive indices past the
     /// current count are allowed here (forward references) and checked in [`Parser::finish`].
-    fn resolve(&mut self, no: u64, tok: &[u8], target: Target) -> Result<u32> {
+    fn resolve(&mut self, no: u64, tok: &str, target: Target) -> Result<u32> {
         let what = target.name();
-        let Some(i) = parse_int(tok) else {
-            return Err(syntax(self.path, no, &format!("bad {what} index"), tok));
+        let Some(i) = parse_int(tok.as_bytes()) else {
+            return Err(syntax(
+                self.path,
+                no,
+                &format!("bad {what} index"),
+                tok.as_bytes(),
+            ));
         };
         let count = match target {
             Target::Vertex => self.positions.len() as u64,
@@ -389,7 +433,7 @@ impl<'p> Parser<'p> {
                 self.path,
                 no,
                 &format!("{what} index 0 (OBJ indices start at 1; negative ones count back)"),
-                tok,
+                tok.as_bytes(),
             ));
         }
         if i < 0 {
