@@ -107,6 +107,9 @@ pub enum TopologyError {
 /// `#V` vertices (including unreferenced ones, which have no outgoing half-edge), `#F` faces.
 /// Memory is `24·#H + 4·#E + 4·#V + 4·#F` bytes (plus about 16 bytes per half-edge of scratch
 /// during construction).
+///
+/// Accessors taking an id index these arrays directly and panic on an out-of-range id (a caller
+/// bug, as with slice indexing); they never panic on ids obtained from the same mesh.
 #[derive(Clone, Debug)]
 pub struct HalfEdgeMesh {
     /// `#F + 1` offsets: face `f` owns half-edges `offsets[f]..offsets[f+1]`.
