@@ -40,3 +40,6 @@ pub mod patch;
 pub use eval::{
     random_samples, EvalError, EvalKind, EvalWeights, Evaluator, SurfaceParam, SurfacePoint,
 };
+pub mod bvh;
+pub mod closest;
+pub use closest::{ClosestOptions, ClosestPoint, ClosestPointFinder};

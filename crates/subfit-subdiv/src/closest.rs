@@ -1,0 +1,574 @@
+//! Closest point on the limit surface from any query point.
+//!
+//! 1. Start: a BVH ([`crate::bvh`]) over a tessellation of the limit surface (each patch's
+//!    domain cut into an `r × r` grid, corners evaluated exactly and remembered as
+//!    `(face, sub, u, v)`) gives the nearest tessellation triangle; its barycentric point is
+//!    mapped to parameters.
+//! 2. Refine: Newton's method on `F(u, v) = ½ |S(u, v) − q|²` with the exact first and second
+//!    derivatives of [`crate::eval`] (Hessian `JᵀJ + Σ r·S_ij`), Levenberg-Marquardt damping when
+//!    the Hessian is not positive definite or a step does not decrease `F`. Steps that leave the
+//!    patch stop at its edge and continue in the adjacent patch with the parameters mapped across
+//!    the shared edge (control-mesh edges, and the inner edges of Catmull-Clark `n`-gons'
+//!    sub-quads).
+//!
+//! Convergence: the residual is `|r − (r·n) n| / |r|` with `r = S − q` — the sine of the angle
+//! between `r` and the normal, i.e. the gradient of the squared distance projected on the tangent
+//! plane, relative to the distance — and the search stops below `tolerance` (default 1e-10), or
+//! when `|r|` is below 1e-14 of the mesh size (the query is on the surface). At a mesh boundary
+//! the closest point may be on the boundary curve, where this residual need not vanish: the search
+//! then stops when no step along the boundary decreases `F` and reports `converged = false`.
+
+use crate::bvh::TriangleBvh;
+use crate::eval::{EvalError, EvalKind, Evaluator, SurfaceParam, SurfacePoint};
+use crate::scheme::Scheme;
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Options of the closest-point search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosestOptions {
+    /// Tessellation resolution per patch edge for the starting guess. Default 4 (16 quads or
+    /// 16 triangles per patch).
+    pub resolution: u32,
+    /// Iteration limit of the Newton search. Default 50.
+    pub max_iterations: u32,
+    /// Residual tolerance (dimensionless sine, see the module docs). Default 1e-10.
+    pub tolerance: f64,
+}
+
+impl Default for ClosestOptions {
+    fn default() -> Self {
+        Self {
+            resolution: 4,
+            max_iterations: 50,
+            tolerance: 1e-10,
+        }
+    }
+}
+
+/// The closest point found for one query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosestPoint {
+    /// Parameters of the closest point.
+    pub param: SurfaceParam,
+    /// The closest point on the limit surface.
+    pub position: [f64; 3],
+    /// Unit normal there (front side by face winding).
+    pub normal: [f64; 3],
+    /// `|q − S|`.
+    pub distance: f64,
+    /// `(q − S) · n`: positive on the side the normal points to.
+    pub signed_distance: f64,
+    /// Final residual (see the module docs).
+    pub residual: f64,
+    /// Newton iterations used.
+    pub iterations: u32,
+    /// Whether the residual reached the tolerance.
+    pub converged: bool,
+}
+
+/// Where a patch edge lies: a control-mesh edge `(a, b)` with `a < b` (parameter 0 at `a`), or
+/// the inner spoke `m` of a Catmull-Clark `n`-gon (parameter 0 at the edge point of edge
+/// `m − 1 → m`, 1 at the face point).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum EdgeKey {
+    Mesh(u32, u32),
+    Spoke(u32, u32),
+}
+
+#[derive(Clone, Copy, Debug)]
+struct EdgeSpan {
+    patch: u32,
+    edge: u8,
+    t0: f64,
+    t1: f64,
+}
+
+/// A reusable closest-point searcher for one control mesh and one set of control points.
+///
+/// Construction evaluates the tessellation (`#patches · (r+1)²` exact evaluations, parallel) and
+/// builds the BVH; a query costs one BVH descent plus a few exact evaluations per Newton step.
+pub struct ClosestPointFinder<'a> {
+    ev: &'a Evaluator,
+    positions: Vec<[f64; 3]>,
+    opts: ClosestOptions,
+    bvh: TriangleBvh,
+    tri_params: Vec<[SurfaceParam; 3]>,
+    edges: HashMap<EdgeKey, Vec<EdgeSpan>>,
+    patch_edges: Vec<[(EdgeKey, f64, f64); 4]>,
+    scale: f64,
+}
+
+impl<'a> ClosestPointFinder<'a> {
+    /// Builds a finder for `evaluator` with control points `positions` (`#V by 3`).
+    ///
+    /// Errors: wrong number of positions, or an evaluation failure.
+    pub fn new(
+        evaluator: &'a Evaluator,
+        positions: &[[f64; 3]],
+        opts: ClosestOptions,
+    ) -> Result<Self, EvalError> {
+        if positions.len() != evaluator.num_vertices() {
+            return Err(EvalError::PositionCount {
+                expected: evaluator.num_vertices(),
+                got: positions.len(),
+            });
+        }
+        let r = opts.resolution.max(1);
+        let tri = evaluator.triangular();
+        let per_patch: Vec<Vec<TessTriangle>> = (0..evaluator.num_patches())
+            .into_par_iter()
+            .map(|pi| {
+                let (face, sub) = evaluator.patch(pi);
+                let prm = |i: u32, j: u32| SurfaceParam {
+                    face,
+                    sub,
+                    u: i as f64 / r as f64,
+                    v: j as f64 / r as f64,
+                };
+                let mut cache: HashMap<(u32, u32), [f64; 3]> = HashMap::new();
+                let mut pos = |i: u32, j: u32| -> Result<[f64; 3], EvalError> {
+                    if let Some(p) = cache.get(&(i, j)) {
+                        return Ok(*p);
+                    }
+                    let p = evaluator.evaluate(positions, prm(i, j))?.position;
+                    cache.insert((i, j), p);
+                    Ok(p)
+                };
+                let mut out = Vec::new();
+                let mut push =
+                    |a: (u32, u32), b: (u32, u32), c: (u32, u32)| -> Result<(), EvalError> {
+                        let t = [pos(a.0, a.1)?, pos(b.0, b.1)?, pos(c.0, c.1)?];
+                        out.push((t, [prm(a.0, a.1), prm(b.0, b.1), prm(c.0, c.1)]));
+                        Ok(())
+                    };
+                for j in 0..r {
+                    for i in 0..r {
+                        if tri {
+                            if i + j < r {
+                                push((i, j), (i + 1, j), (i, j + 1))?;
+                            }
+                            if i + j + 1 < r {
+                                push((i + 1, j), (i + 1, j + 1), (i, j + 1))?;
+                            }
+                        } else {
+                            push((i, j), (i + 1, j), (i + 1, j + 1))?;
+                            push((i, j), (i + 1, j + 1), (i, j + 1))?;
+                        }
+                    }
+                }
+                Ok(out)
+            })
+            .collect::<Result<_, EvalError>>()?;
+        let mut tris = Vec::new();
+        let mut tri_params = Vec::new();
+        for (t, p) in per_patch.into_iter().flatten() {
+            tris.push(t);
+            tri_params.push(p);
+        }
+        let scale = subfit_mesh::bounding_box(positions)
+            .map(|(lo, hi)| {
+                ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+            })
+            .unwrap_or(1.0)
+            .max(f64::MIN_POSITIVE);
+        let (edges, patch_edges) = edge_spans(evaluator);
+        Ok(Self {
+            ev: evaluator,
+            positions: positions.to_vec(),
+            opts,
+            bvh: TriangleBvh::new(tris),
+            tri_params,
+            edges,
+            patch_edges,
+            scale,
+        })
+    }
+
+    /// The starting guess for `q`: parameters of the nearest tessellation point.
+    fn start(&self, q: [f64; 3]) -> Option<SurfaceParam> {
+        let n = self.bvh.nearest(q)?;
+        let ps = &self.tri_params[n.triangle as usize];
+        let (mut u, mut v) = (0.0, 0.0);
+        for (p, w) in ps.iter().zip(n.bary) {
+            u += w * p.u;
+            v += w * p.v;
+        }
+        // Start off the patch corners, where the parametrisation may be singular.
+        let (cu, cv) = if self.ev.triangular() {
+            (1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            (0.5, 0.5)
+        };
+        let e = 1e-3;
+        Some(SurfaceParam {
+            u: u + e * (cu - u),
+            v: v + e * (cv - v),
+            ..ps[0]
+        })
+    }
+
+    fn eval(&self, p: SurfaceParam) -> Result<SurfacePoint, EvalError> {
+        let r = self.ev.evaluate(&self.positions, p)?;
+        if r.kind == EvalKind::Patch {
+            return Ok(r);
+        }
+        // Exactly at an irregular vertex there are no parametric derivatives: nudge inside.
+        let (cu, cv) = if self.ev.triangular() {
+            (1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            (0.5, 0.5)
+        };
+        let e = 1e-9;
+        self.ev.evaluate(
+            &self.positions,
+            SurfaceParam {
+                u: p.u + e * (cu - p.u),
+                v: p.v + e * (cv - p.v),
+                ..p
+            },
+        )
+    }
+
+    /// The closest point on the limit surface to `q`.
+    ///
+    /// Errors: evaluation failures (none are expected for a valid mesh); an empty mesh gives
+    /// [`EvalError::FaceOutOfRange`].
+    pub fn closest(&self, q: [f64; 3]) -> Result<ClosestPoint, EvalError> {
+        let mut p = self.start(q).ok_or(EvalError::FaceOutOfRange {
+            face: 0,
+            num_faces: 0,
+        })?;
+        let mut s = self.eval(p)?;
+        let mut f = half_norm2(sub(s.position, q));
+        let mut mu = 0.0f64;
+        let mut iterations = 0;
+        let mut came_from: Option<u32> = None;
+        let mut f_at_cross = f64::INFINITY;
+        let mut residual = self.residual(&s, q);
+        while iterations < self.opts.max_iterations {
+            if residual <= self.opts.tolerance {
+                break;
+            }
+            iterations += 1;
+            // Next to a patch corner the parametrisation may be singular (an extraordinary
+            // vertex): try the corner itself, where the limit masks give the exact normal.
+            if let Some((c, cs)) = self.corner_candidate(p)? {
+                let cf = half_norm2(sub(cs.position, q));
+                let cres = self.residual(&cs, q);
+                if cf <= f * (1.0 + 1e-13) && cres <= self.opts.tolerance {
+                    p = c;
+                    s = cs;
+                    residual = cres;
+                    break;
+                }
+            }
+            let r = sub(s.position, q);
+            let (su, sv) = (s.du, s.dv);
+            let g = [dot(su, r), dot(sv, r)];
+            let mut h = [[dot(su, su), dot(su, sv)], [dot(su, sv), dot(sv, sv)]];
+            let jtj = [h[0][0], h[1][1]];
+            if let Some([suu, suv, svv]) = s.second {
+                h[0][0] += dot(suu, r);
+                h[0][1] += dot(suv, r);
+                h[1][0] += dot(suv, r);
+                h[1][1] += dot(svv, r);
+            }
+            let mut accepted = false;
+            for _ in 0..30 {
+                let a = [
+                    [h[0][0] + mu * jtj[0], h[0][1]],
+                    [h[1][0], h[1][1] + mu * jtj[1]],
+                ];
+                let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+                if !(a[0][0] > 0.0 && det > 0.0) {
+                    mu = (mu * 10.0).max(1e-3);
+                    continue;
+                }
+                let d = [
+                    -(a[1][1] * g[0] - a[0][1] * g[1]) / det,
+                    -(-a[1][0] * g[0] + a[0][0] * g[1]) / det,
+                ];
+                let (mut cand, mut exit) = self.clip(p, d);
+                if let Some(e) = exit {
+                    // On the edge and pointing back into the patch just left: the minimum is on
+                    // the shared edge, so move along it only.
+                    let back = self
+                        .cross(p, e)
+                        .map(|(np, _)| self.ev.patch_index(np.face, np.sub) as u32);
+                    if cand == p && back.is_some() && back == came_from && f >= f_at_cross {
+                        (cand, exit) = self.clip(p, along_edge(self.ev.triangular(), e, d));
+                    }
+                }
+                let cs = self.eval(cand)?;
+                let cf = half_norm2(sub(cs.position, q));
+                // Near convergence F changes below its rounding: then accept a step that lowers
+                // the residual without raising F beyond rounding.
+                let flat = cf <= f * (1.0 + 1e-13) && self.residual(&cs, q) < residual;
+                if cf < f || flat || (cf <= f && exit.is_some()) {
+                    let progressed = cf < f || flat;
+                    p = cand;
+                    s = cs;
+                    f = cf;
+                    mu *= 0.1;
+                    if mu < 1e-12 {
+                        mu = 0.0;
+                    }
+                    accepted = progressed;
+                    if let Some(edge) = exit {
+                        if let Some((np, left)) = self.cross(p, edge) {
+                            let target = self.ev.patch_index(np.face, np.sub) as u32;
+                            if progressed || came_from != Some(target) || f < f_at_cross {
+                                came_from = Some(left);
+                                f_at_cross = f;
+                                p = np;
+                                s = self.eval(p)?;
+                                accepted = true;
+                            }
+                        }
+                    }
+                    break;
+                }
+                mu = (mu * 10.0).max(1e-3);
+            }
+            residual = self.residual(&s, q);
+            if !accepted {
+                break;
+            }
+        }
+        let rr = sub(q, s.position);
+        let distance = dot(rr, rr).sqrt();
+        Ok(ClosestPoint {
+            param: p,
+            position: s.position,
+            normal: s.normal,
+            distance,
+            signed_distance: dot(rr, s.normal),
+            residual,
+            iterations,
+            converged: residual <= self.opts.tolerance,
+        })
+    }
+
+    /// [`Self::closest`] for many queries in parallel (rayon), in input order.
+    pub fn closest_batch(&self, queries: &[[f64; 3]]) -> Result<Vec<ClosestPoint>, EvalError> {
+        queries.par_iter().map(|&q| self.closest(q)).collect()
+    }
+
+    /// The nearest patch corner and the surface there, when `p` is within 1e-3 of it.
+    fn corner_candidate(
+        &self,
+        p: SurfaceParam,
+    ) -> Result<Option<(SurfaceParam, SurfacePoint)>, EvalError> {
+        let corners: &[(f64, f64)] = if self.ev.triangular() {
+            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+        } else {
+            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        };
+        for &(u, v) in corners {
+            let d = (p.u - u).abs().max((p.v - v).abs());
+            if d > 0.0 && d < 1e-3 {
+                let c = SurfaceParam { u, v, ..p };
+                return Ok(Some((c, self.ev.evaluate(&self.positions, c)?)));
+            }
+        }
+        Ok(None)
+    }
+
+    fn residual(&self, s: &SurfacePoint, q: [f64; 3]) -> f64 {
+        let r = sub(s.position, q);
+        let len = dot(r, r).sqrt();
+        if len <= 1e-14 * self.scale {
+            return 0.0;
+        }
+        let rn = dot(r, s.normal);
+        let t = [
+            r[0] - rn * s.normal[0],
+            r[1] - rn * s.normal[1],
+            r[2] - rn * s.normal[2],
+        ];
+        dot(t, t).sqrt() / len
+    }
+
+    /// The point `p + d` clipped to the patch domain, and the patch edge where it was clipped.
+    fn clip(&self, p: SurfaceParam, d: [f64; 2]) -> (SurfaceParam, Option<u8>) {
+        let (u, v) = (p.u, p.v);
+        // Each constraint: (value now, rate of change, edge id); value must stay ≥ 0.
+        let cons: Vec<(f64, f64, u8)> = if self.ev.triangular() {
+            vec![(v, d[1], 0), (1.0 - u - v, -d[0] - d[1], 1), (u, d[0], 2)]
+        } else {
+            vec![
+                (v, d[1], 0),
+                (1.0 - u, -d[0], 1),
+                (1.0 - v, -d[1], 2),
+                (u, d[0], 3),
+            ]
+        };
+        let mut alpha = 1.0;
+        let mut edge = None;
+        for (val, rate, e) in cons {
+            if rate < 0.0 && val + rate < 0.0 {
+                let a = (val / -rate).max(0.0);
+                if a < alpha {
+                    alpha = a;
+                    edge = Some(e);
+                }
+            }
+        }
+        let mut c = SurfaceParam {
+            u: u + alpha * d[0],
+            v: v + alpha * d[1],
+            ..p
+        };
+        // Land exactly on the edge.
+        match (self.ev.triangular(), edge) {
+            (true, Some(0)) | (false, Some(0)) => c.v = 0.0,
+            (true, Some(2)) | (false, Some(3)) => c.u = 0.0,
+            (true, Some(1)) => {
+                let s = c.u + c.v;
+                if s > 0.0 {
+                    c.u /= s;
+                    c.v /= s;
+                }
+            }
+            (false, Some(1)) => c.u = 1.0,
+            (false, Some(2)) => c.v = 1.0,
+            _ => {}
+        }
+        c.u = c.u.clamp(0.0, 1.0);
+        c.v = c.v.clamp(0.0, 1.0);
+        if self.ev.triangular() && c.u + c.v > 1.0 {
+            let s = c.u + c.v;
+            c.u /= s;
+            c.v /= s;
+        }
+        (c, edge)
+    }
+
+    /// The same surface point seen from the patch across `edge`, and the patch index left.
+    fn cross(&self, p: SurfaceParam, edge: u8) -> Option<(SurfaceParam, u32)> {
+        let tri = self.ev.triangular();
+        let s = edge_param(tri, edge, p.u, p.v);
+        let pi = self.ev.patch_index(p.face, p.sub) as u32;
+        let (key, t0, t1) = self.patch_edges[pi as usize][edge as usize];
+        let t = t0 + s * (t1 - t0);
+        let other = self.edges.get(&key)?.iter().find(|e| {
+            e.patch != pi && t >= e.t0.min(e.t1) - 1e-15 && t <= e.t0.max(e.t1) + 1e-15
+        })?;
+        let s2 = ((t - other.t0) / (other.t1 - other.t0)).clamp(0.0, 1.0);
+        let (u, v) = edge_point(tri, other.edge, s2);
+        let (face, sub) = self.ev.patch(other.patch as usize);
+        Some((SurfaceParam { face, sub, u, v }, pi))
+    }
+}
+
+/// The component of step `d` along patch edge `e`.
+fn along_edge(tri: bool, e: u8, d: [f64; 2]) -> [f64; 2] {
+    match (tri, e) {
+        (true, 1) => {
+            let t = 0.5 * (d[1] - d[0]);
+            [-t, t]
+        }
+        (true, 0) | (false, 0) | (false, 2) => [d[0], 0.0],
+        _ => [0.0, d[1]],
+    }
+}
+
+/// Parameter along patch edge `e` (from corner `e` to corner `e + 1`) of the point `(u, v)`.
+fn edge_param(tri: bool, e: u8, u: f64, v: f64) -> f64 {
+    match (tri, e) {
+        (true, 0) => u,
+        (true, 1) => v / (u + v).max(f64::MIN_POSITIVE),
+        (true, _) => 1.0 - v,
+        (false, 0) => u,
+        (false, 1) => v,
+        (false, 2) => 1.0 - u,
+        (false, _) => 1.0 - v,
+    }
+}
+
+/// The point at parameter `s` along patch edge `e`.
+fn edge_point(tri: bool, e: u8, s: f64) -> (f64, f64) {
+    match (tri, e) {
+        (true, 0) => (s, 0.0),
+        (true, 1) => (1.0 - s, s),
+        (true, _) => (0.0, 1.0 - s),
+        (false, 0) => (s, 0.0),
+        (false, 1) => (1.0, s),
+        (false, 2) => (1.0 - s, 1.0),
+        (false, _) => (0.0, 1.0 - s),
+    }
+}
+
+/// A tessellation triangle: corner positions and corner parameters.
+type TessTriangle = ([[f64; 3]; 3], [SurfaceParam; 3]);
+
+type EdgeMaps = (
+    HashMap<EdgeKey, Vec<EdgeSpan>>,
+    Vec<[(EdgeKey, f64, f64); 4]>,
+);
+
+/// Where every patch edge lies on the control mesh (see [`EdgeKey`]).
+fn edge_spans(ev: &Evaluator) -> EdgeMaps {
+    let mesh_edge = |a: u32, b: u32, ta: f64, tb: f64| {
+        // Parameter ta at a, tb at b, along the edge a→b measured from min(a, b).
+        if a < b {
+            (EdgeKey::Mesh(a, b), ta, tb)
+        } else {
+            (EdgeKey::Mesh(b, a), 1.0 - ta, 1.0 - tb)
+        }
+    };
+    let mut per_patch = Vec::with_capacity(ev.num_patches());
+    for (fi, face) in ev.faces().iter().enumerate() {
+        let n = face.len();
+        let nsub = ev.num_subpatches(fi as u32);
+        if nsub == 1 {
+            let mut e = [(EdgeKey::Mesh(0, 0), 0.0, 0.0); 4];
+            for (j, ej) in e.iter_mut().enumerate().take(n) {
+                *ej = mesh_edge(face[j], face[(j + 1) % n], 0.0, 1.0);
+            }
+            per_patch.push(e);
+        } else {
+            debug_assert_eq!(ev.options().scheme, Scheme::CatmullClark);
+            let f = fi as u32;
+            for k in 0..n {
+                let (vk, vn, vp) = (face[k], face[(k + 1) % n], face[(k + n - 1) % n]);
+                per_patch.push([
+                    // v_k → e_{k,k+1}: first half of edge (v_k, v_{k+1}).
+                    mesh_edge(vk, vn, 0.0, 0.5),
+                    // e_{k,k+1} → F: spoke k+1.
+                    (EdgeKey::Spoke(f, ((k + 1) % n) as u32), 0.0, 1.0),
+                    // F → e_{k−1,k}: spoke k, reversed.
+                    (EdgeKey::Spoke(f, k as u32), 1.0, 0.0),
+                    // e_{k−1,k} → v_k: second half of edge (v_{k−1}, v_k).
+                    mesh_edge(vp, vk, 0.5, 1.0),
+                ]);
+            }
+        }
+    }
+    let mut map: HashMap<EdgeKey, Vec<EdgeSpan>> = HashMap::new();
+    let nedges = if ev.triangular() { 3 } else { 4 };
+    for (pi, es) in per_patch.iter().enumerate() {
+        for (j, &(key, t0, t1)) in es.iter().enumerate().take(nedges) {
+            map.entry(key).or_default().push(EdgeSpan {
+                patch: pi as u32,
+                edge: j as u8,
+                t0,
+                t1,
+            });
+        }
+    }
+    (map, per_patch)
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn half_norm2(a: [f64; 3]) -> f64 {
+    0.5 * dot(a, a)
+}

@@ -1,0 +1,138 @@
+//! Closest point on the limit surface: agreement with brute-force dense sampling and convergence
+//! of the residual to 1e-10, on Catmull-Clark and Loop tori and on meshes with extraordinary
+//! vertices and `n`-gons.
+#![allow(
+    clippy::print_stdout,
+    reason = "the tests report the errors they measured"
+)]
+
+use subfit_mesh::shapes::torus_mesh;
+use subfit_mesh::{Polygons, Tags};
+use subfit_subdiv::{ClosestOptions, ClosestPointFinder, Evaluator, Options, Scheme, SurfaceParam};
+
+struct Rng(u64);
+impl Rng {
+    fn f(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn dense_samples(ev: &Evaluator, p: &[[f64; 3]], m: u32) -> Vec<[f64; 3]> {
+    let mut params = Vec::new();
+    for pi in 0..ev.num_patches() {
+        let (face, sub) = ev.patch(pi);
+        for j in 0..=m {
+            for i in 0..=m {
+                if ev.triangular() && i + j > m {
+                    continue;
+                }
+                params.push(SurfaceParam {
+                    face,
+                    sub,
+                    u: i as f64 / m as f64,
+                    v: j as f64 / m as f64,
+                });
+            }
+        }
+    }
+    ev.evaluate_batch(p, &params)
+        .unwrap()
+        .into_iter()
+        .map(|s| s.position)
+        .collect()
+}
+
+fn check(name: &str, scheme: Scheme, p: &[[f64; 3]], f: &Polygons, nq: usize) {
+    let ev = Evaluator::new(f, p.len(), &Tags::new(), &Options::new(scheme)).unwrap();
+    let finder = ClosestPointFinder::new(&ev, p, ClosestOptions::default()).unwrap();
+    let m = 24;
+    let dense = dense_samples(&ev, p, m);
+    let (lo, hi) = subfit_mesh::bounding_box(p).unwrap();
+    let diag = ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt();
+    let mut rng = Rng(42);
+    let mut max_res = 0.0f64;
+    let mut max_gap = 0.0f64;
+    let mut max_it = 0;
+    for _ in 0..nq {
+        let q = [
+            lo[0] + (hi[0] - lo[0]) * (1.4 * rng.f() - 0.2),
+            lo[1] + (hi[1] - lo[1]) * (1.4 * rng.f() - 0.2),
+            lo[2] + (hi[2] - lo[2]) * (1.4 * rng.f() - 0.2),
+        ];
+        let c = finder.closest(q).unwrap();
+        let bf = dense
+            .iter()
+            .map(|x| ((x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2) + (x[2] - q[2]).powi(2)).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        // The exact closest point is never farther than the best sample, and the best sample is
+        // within the sampling error of it.
+        assert!(
+            c.distance <= bf + 1e-12 * diag,
+            "{name}: {} > {bf}",
+            c.distance
+        );
+        max_gap = max_gap.max((bf - c.distance) / diag);
+        assert!(
+            c.converged,
+            "{name}: residual {} after {} iterations",
+            c.residual, c.iterations
+        );
+        max_res = max_res.max(c.residual);
+        max_it = max_it.max(c.iterations);
+        // The reported point is on the surface at the reported parameters.
+        let s = ev.evaluate(p, c.param).unwrap();
+        for k in 0..3 {
+            assert!((s.position[k] - c.position[k]).abs() < 1e-14 * diag);
+        }
+        assert!((c.signed_distance.abs() - c.distance).abs() < 1e-9 * diag);
+    }
+    println!(
+        "{name}: {nq} queries, max residual {max_res:.1e}, max (sampled − exact) distance {max_gap:.1e} of diag, max iterations {max_it}"
+    );
+    assert!(max_gap < 1e-2, "{name}: sampling gap {max_gap}");
+}
+
+#[test]
+fn catmull_clark_torus_matches_dense_sampling() {
+    let t = torus_mesh(1.0, 0.4, 8, 6, false);
+    check(
+        "cc torus",
+        Scheme::CatmullClark,
+        &t.positions,
+        &t.faces,
+        150,
+    );
+}
+
+#[test]
+fn loop_torus_matches_dense_sampling() {
+    let t = torus_mesh(1.0, 0.4, 8, 6, true);
+    check("loop torus", Scheme::Loop, &t.positions, &t.faces, 150);
+}
+
+#[test]
+fn extraordinary_vertices_and_ngons() {
+    // A pentagonal prism (n-gon caps, valence-3 corners) and an octahedron (Loop valence 4).
+    let n = 5u32;
+    let mut p = Vec::new();
+    for z in [0.0, 1.0] {
+        for i in 0..n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            p.push([a.cos(), a.sin(), z]);
+        }
+    }
+    let mut f = Polygons::new();
+    f.push(&(0..n).rev().collect::<Vec<_>>());
+    f.push(&(n..2 * n).collect::<Vec<_>>());
+    for i in 0..n {
+        let j = (i + 1) % n;
+        f.push(&[i, j, n + j, n + i]);
+    }
+    check("cc pentagonal prism", Scheme::CatmullClark, &p, &f, 300);
+    let o = subfit_mesh::shapes::octahedron_mesh(1.0, 0.7, 1.3);
+    check("loop octahedron", Scheme::Loop, &o.positions, &o.faces, 300);
+}
