@@ -9,6 +9,7 @@
 //!   last element defined so far; positive ones may refer forward (they are checked once the
 //!   whole file is read). Faces need at least three corners; polygons of any size are kept.
 //! - Comments from `#` to the end of the line, and line continuation with a trailing `\`.
+//!   Every line, comments included, must be UTF-8 (an error names the line and column).
 //! - `l`, `p`, `o`, `g`, `s`, `usemtl`, `mtllib` and the free-form geometry statements
 //!   (`vp`, `curv`, `surf`, `cstype`…) are ignored. Any other statement is a syntax error.
 //!
