@@ -21,8 +21,9 @@
 use crate::error::SubdivError;
 use crate::mask::Mask;
 use crate::refine::{neighborhoods, refine_topology, sharp_edges, topology_for};
+use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
-use crate::stencil::StencilMatrix;
+use crate::stencil::{compose_rows, MultiRows, StencilMatrix};
 use crate::topology::Topology;
 use subfit_mesh::{Polygons, Tags};
 
@@ -54,51 +55,133 @@ pub fn limit_stencils(
 
 /// Limit stencils on an already built adjacency.
 pub(crate) fn limit_topology(topo: &Topology, tags: &Tags, options: &Options) -> LimitStencils {
-    let all_quads = (0..topo.num_faces()).all(|f| topo.face(f).len() == 4);
-    if options.scheme == Scheme::CatmullClark && !all_quads {
-        let nv = topo.num_vertices();
-        let r = refine_topology(topo, tags, options);
-        let child = Topology::new(&r.faces, r.num_vertices)
-            .expect("the refinement of a valid mesh is valid");
-        let mut l = limit_topology(&child, &r.tags, options);
-        for m in [&mut l.position, &mut l.tangent1, &mut l.tangent2] {
-            m.truncate_rows(nv);
-            *m = m.compose(&r.matrix);
-        }
-        l.tangent1.scale(2.0);
-        l.tangent2.scale(2.0);
-        return l;
-    }
-    let sharp = sharp_edges(topo, tags);
-    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
-    let nv = topo.num_vertices();
-    let mut out = [
-        StencilMatrix::new(nv),
-        StencilMatrix::new(nv),
-        StencilMatrix::new(nv),
-    ];
-    let mut masks = [Mask::default(), Mask::default(), Mask::default()];
-    let mut row: Vec<(u32, f64)> = Vec::with_capacity(64);
-    for v in 0..nv as u32 {
-        let [p, a, b] = &mut masks;
-        options.scheme.limit_masks(&hoods[v as usize], p, a, b);
-        for (m, mask) in out.iter_mut().zip(&masks) {
-            row.clear();
-            row.push((v, mask.vertex));
-            for (&u, &w) in topo.vertex_ring(v).iter().zip(&mask.edges) {
-                row.push((u, w));
-            }
-            for (&c, &w) in topo.vertex_corners(v).iter().zip(&mask.faces) {
-                // The vertex two corners away (the quad's diagonal).
-                row.push((topo.corner_vertex(topo.corner_next(topo.corner_next(c))), w));
-            }
-            m.push_row(&mut row);
-        }
-    }
-    let [position, tangent1, tangent2] = out;
+    let [position, tangent1, tangent2] = limit_rows(topo, tags, options).split();
     LimitStencils {
         position,
         tangent1,
         tangent2,
     }
+}
+
+/// Appends the limit row of vertex `v` (position and two tangent weights per entry; repeated
+/// columns possible) to `row`.
+fn push_limit_row(
+    topo: &Topology,
+    scheme: Scheme,
+    hood: &Neighborhood,
+    masks: &mut [Mask; 3],
+    v: u32,
+    row: &mut Vec<(u32, [f64; 3])>,
+) {
+    let [p, a, b] = masks;
+    scheme.limit_masks(hood, p, a, b);
+    row.push((v, [p.vertex, a.vertex, b.vertex]));
+    for (i, &u) in topo.vertex_ring(v).iter().enumerate() {
+        row.push((u, [p.edges[i], a.edges[i], b.edges[i]]));
+    }
+    let nf = p.faces.len().max(a.faces.len()).max(b.faces.len());
+    let get = |m: &Mask, i: usize| m.faces.get(i).copied().unwrap_or(0.0);
+    for (i, &c) in topo.vertex_corners(v).iter().enumerate().take(nf) {
+        // The vertex two corners away (the quad's diagonal).
+        let d = topo.corner_vertex(topo.corner_next(topo.corner_next(c)));
+        row.push((d, [get(p, i), get(a, i), get(b, i)]));
+    }
+}
+
+fn needs_refinement(topo: &Topology, options: &Options) -> bool {
+    options.scheme == Scheme::CatmullClark && (0..topo.num_faces()).any(|f| topo.face(f).len() != 4)
+}
+
+/// Limit position and tangent weights sharing one support per vertex (`#V` rows over the same
+/// `#V` vertices).
+pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> MultiRows<3> {
+    if needs_refinement(topo, options) {
+        return limit_rows_via_refinement(topo, tags, options);
+    }
+    let sharp = sharp_edges(topo, tags);
+    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
+    let nv = topo.num_vertices();
+    let mut rows = MultiRows {
+        ncols: nv,
+        offsets: Vec::with_capacity(nv + 1),
+        cols: Vec::new(),
+        weights: Vec::new(),
+    };
+    rows.offsets.push(0);
+    let mut masks: [Mask; 3] = Default::default();
+    let mut row = Vec::new();
+    for (v, hood) in hoods.iter().enumerate() {
+        row.clear();
+        push_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
+        for &(c, w) in &row {
+            rows.cols.push(c);
+            rows.weights.push(w);
+        }
+        rows.offsets.push(rows.cols.len());
+    }
+    rows
+}
+
+/// The three products `L · rhs` (limit position, tangent 1, tangent 2 of every vertex of
+/// `topo`, times `rhs` with `#V` rows), generating the limit rows on the fly (never stored).
+pub(crate) fn limit_compose(
+    topo: &Topology,
+    tags: &Tags,
+    options: &Options,
+    rhs: &StencilMatrix,
+) -> [StencilMatrix; 3] {
+    if needs_refinement(topo, options) {
+        return limit_rows(topo, tags, options).compose(rhs);
+    }
+    let sharp = sharp_edges(topo, tags);
+    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
+    compose_rows(
+        topo.num_vertices(),
+        rhs,
+        <[Mask; 3]>::default,
+        |masks, v, row| push_limit_row(topo, options.scheme, &hoods[v], masks, v as u32, row),
+    )
+}
+
+/// Catmull-Clark with non-quads: limit rows of the vertex points after one refinement, composed
+/// with the refinement matrix; tangents scaled by 2.
+fn limit_rows_via_refinement(topo: &Topology, tags: &Tags, options: &Options) -> MultiRows<3> {
+    let nv = topo.num_vertices();
+    let r = refine_topology(topo, tags, options);
+    let child =
+        Topology::new(&r.faces, r.num_vertices).expect("the refinement of a valid mesh is valid");
+    let mut fine = limit_rows(&child, &r.tags, options);
+    fine.offsets.truncate(nv + 1);
+    let nnz = fine.offsets[nv];
+    fine.cols.truncate(nnz);
+    fine.weights.truncate(nnz);
+    for w in &mut fine.weights {
+        w[1] *= 2.0;
+        w[2] *= 2.0;
+    }
+    let [p, a, b] = fine.compose(&r.matrix);
+    let mut rows = MultiRows {
+        ncols: nv,
+        offsets: vec![0],
+        cols: Vec::new(),
+        weights: Vec::new(),
+    };
+    for i in 0..nv {
+        let mut entries: Vec<(u32, [f64; 3])> = Vec::new();
+        for (k, m) in [&p, &a, &b].into_iter().enumerate() {
+            let (c, w) = m.row(i);
+            for (&c, &w) in c.iter().zip(w) {
+                let mut x = [0.0; 3];
+                x[k] = w;
+                entries.push((c, x));
+            }
+        }
+        entries.sort_by_key(|e| e.0);
+        for (c, w) in entries {
+            rows.cols.push(c);
+            rows.weights.push(w);
+        }
+        rows.offsets.push(rows.cols.len());
+    }
+    rows
 }

@@ -7,7 +7,7 @@
 //! points and stays short (its support is the control-mesh neighbourhood of the vertex).
 
 use crate::error::SubdivError;
-use crate::limit::limit_topology;
+use crate::limit::{limit_compose, limit_rows};
 use crate::refine::{refine_topology, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
@@ -76,16 +76,9 @@ pub fn sampling_operator(
         level_faces = r.faces;
         level_tags = r.tags;
     }
-    let l = limit_topology(&topo, &level_tags, options);
-    let (position, tangent1, tangent2) = match &product {
-        None => (l.position, l.tangent1, l.tangent2),
-        Some(p) => {
-            let (pos, (t1, t2)) = rayon::join(
-                || l.position.compose(p),
-                || rayon::join(|| l.tangent1.compose(p), || l.tangent2.compose(p)),
-            );
-            (pos, t1, t2)
-        }
+    let [position, tangent1, tangent2] = match &product {
+        None => limit_rows(&topo, &level_tags, options).split(),
+        Some(p) => limit_compose(&topo, &level_tags, options, p),
     };
     Ok(SamplingOperator {
         level,

@@ -217,71 +217,152 @@ impl StencilMatrix {
     #[track_caller]
     pub fn compose(&self, rhs: &StencilMatrix) -> StencilMatrix {
         assert_eq!(self.ncols, rhs.nrows(), "inner dimensions differ");
-        const BLOCK: usize = 2048;
-        let nrows = self.nrows();
-        let nblocks = nrows.div_ceil(BLOCK);
-        let blocks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..nblocks)
-            .into_par_iter()
-            .map_init(
-                || (vec![0.0f64; rhs.ncols], vec![false; rhs.ncols], Vec::new()),
-                |(acc, mark, touched), b| {
-                    let rows = b * BLOCK..((b + 1) * BLOCK).min(nrows);
-                    let mut lens = Vec::with_capacity(rows.len());
-                    let mut idx = Vec::new();
-                    let mut wts = Vec::new();
-                    for i in rows {
-                        let (cols, ws) = self.row(i);
-                        for (&j, &w) in cols.iter().zip(ws) {
-                            let (c2, w2) = rhs.row(j as usize);
-                            for (&c, &u) in c2.iter().zip(w2) {
-                                let c = c as usize;
-                                if !mark[c] {
-                                    mark[c] = true;
-                                    touched.push(c as u32);
-                                }
-                                acc[c] += w * u;
-                            }
-                        }
-                        touched.sort_unstable();
-                        let big = touched
-                            .iter()
-                            .fold(0.0f64, |m, &c| m.max(acc[c as usize].abs()));
-                        let before = idx.len();
-                        for &c in touched.iter() {
-                            let w = acc[c as usize];
-                            if w.abs() > DROP_TOLERANCE * big {
-                                idx.push(c);
-                                wts.push(w);
-                            }
-                            acc[c as usize] = 0.0;
-                            mark[c as usize] = false;
-                        }
-                        touched.clear();
-                        lens.push(idx.len() - before);
-                    }
-                    (lens, idx, wts)
-                },
-            )
-            .collect();
-        let nnz = blocks.iter().map(|b| b.1.len()).sum();
-        let mut out = StencilMatrix {
-            ncols: rhs.ncols,
-            offsets: Vec::with_capacity(nrows + 1),
-            indices: Vec::with_capacity(nnz),
-            weights: Vec::with_capacity(nnz),
-        };
-        out.offsets.push(0);
-        let mut end = 0;
-        for (lens, idx, wts) in blocks {
-            for l in lens {
-                end += l;
-                out.offsets.push(end);
+        let [out] = compose_rows(
+            self.nrows(),
+            rhs,
+            || (),
+            |_, i, row| {
+                let (c, w) = self.row(i);
+                row.extend(c.iter().zip(w).map(|(&c, &w)| (c, [w])));
+            },
+        );
+        out
+    }
+}
+
+/// Rows whose entries carry `K` weights each (e.g. a limit position and two tangents sharing
+/// one support), over `ncols` columns. Columns may repeat within a row (they are summed).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct MultiRows<const K: usize> {
+    pub(crate) ncols: usize,
+    pub(crate) offsets: Vec<usize>,
+    pub(crate) cols: Vec<u32>,
+    pub(crate) weights: Vec<[f64; K]>,
+}
+
+impl<const K: usize> MultiRows<K> {
+    pub(crate) fn nrows(&self) -> usize {
+        self.offsets.len() - 1
+    }
+
+    /// Splits into `K` matrices (repeated columns summed, exact zeros dropped).
+    pub(crate) fn split(&self) -> [StencilMatrix; K] {
+        let mut out: [StencilMatrix; K] = std::array::from_fn(|_| StencilMatrix::new(self.ncols));
+        let mut row = Vec::new();
+        for i in 0..self.nrows() {
+            let (a, b) = (self.offsets[i], self.offsets[i + 1]);
+            for (k, m) in out.iter_mut().enumerate() {
+                row.clear();
+                row.extend((a..b).map(|e| (self.cols[e], self.weights[e][k])));
+                m.push_row(&mut row);
             }
-            out.indices.extend_from_slice(&idx);
-            out.weights.extend_from_slice(&wts);
         }
         out
     }
+
+    /// The `K` products `W_k · rhs` in one pass over `rhs` (each row of `rhs` is read once per
+    /// use for all `K` weights). Same pruning and determinism as [`StencilMatrix::compose`].
+    pub(crate) fn compose(&self, rhs: &StencilMatrix) -> [StencilMatrix; K] {
+        assert_eq!(self.ncols, rhs.nrows(), "inner dimensions differ");
+        compose_rows(
+            self.nrows(),
+            rhs,
+            || (),
+            |_, i, row| {
+                let (a, b) = (self.offsets[i], self.offsets[i + 1]);
+                row.extend((a..b).map(|e| (self.cols[e], self.weights[e])));
+            },
+        )
+    }
+}
+
+/// `K` products `L_k · rhs` where the rows of the `L_k` (sharing one support, `K` weights per
+/// entry, columns < `rhs.nrows()`, repeats allowed) are generated on the fly by
+/// `lhs_row(state, i, row)`, so the left factors are never stored. Parallel over blocks of rows,
+/// with one `init()` state per worker. Entries below [`DROP_TOLERANCE`] relative to their row's
+/// largest are dropped; columns are sorted within each row.
+pub(crate) fn compose_rows<const K: usize, S>(
+    nrows: usize,
+    rhs: &StencilMatrix,
+    init: impl Fn() -> S + Sync + Send,
+    lhs_row: impl Fn(&mut S, usize, &mut Vec<(u32, [f64; K])>) + Sync + Send,
+) -> [StencilMatrix; K] {
+    const BLOCK: usize = 2048;
+    let nblocks = nrows.div_ceil(BLOCK);
+    type Block = (Vec<usize>, Vec<u32>, Vec<f64>);
+    let blocks: Vec<[Block; K]> = (0..nblocks)
+        .into_par_iter()
+        .map_init(
+            || {
+                let scratch = (vec![[0.0f64; K]; rhs.ncols], vec![false; rhs.ncols]);
+                (scratch, Vec::<u32>::new(), Vec::new(), init())
+            },
+            |((acc, mark), touched, lrow, state), blk| {
+                let rows = blk * BLOCK..((blk + 1) * BLOCK).min(nrows);
+                let mut out: [Block; K] = std::array::from_fn(|_| Default::default());
+                for i in rows {
+                    lrow.clear();
+                    lhs_row(state, i, lrow);
+                    for &(j, w) in lrow.iter() {
+                        let (c2, w2) = rhs.row(j as usize);
+                        for (&c, &u) in c2.iter().zip(w2) {
+                            let c = c as usize;
+                            if !mark[c] {
+                                mark[c] = true;
+                                touched.push(c as u32);
+                            }
+                            let a = &mut acc[c];
+                            for k in 0..K {
+                                a[k] += w[k] * u;
+                            }
+                        }
+                    }
+                    touched.sort_unstable();
+                    let mut big = [0.0f64; K];
+                    for &c in touched.iter() {
+                        for k in 0..K {
+                            big[k] = big[k].max(acc[c as usize][k].abs());
+                        }
+                    }
+                    for (k, (lens, idx, wts)) in out.iter_mut().enumerate() {
+                        let before = idx.len();
+                        for &c in touched.iter() {
+                            let w = acc[c as usize][k];
+                            if w.abs() > DROP_TOLERANCE * big[k] {
+                                idx.push(c);
+                                wts.push(w);
+                            }
+                        }
+                        lens.push(idx.len() - before);
+                    }
+                    for &c in touched.iter() {
+                        acc[c as usize] = [0.0; K];
+                        mark[c as usize] = false;
+                    }
+                    touched.clear();
+                }
+                out
+            },
+        )
+        .collect();
+    let mut out: [StencilMatrix; K] = std::array::from_fn(|_| StencilMatrix::new(rhs.ncols));
+    for (k, m) in out.iter_mut().enumerate() {
+        let nnz = blocks.iter().map(|b| b[k].1.len()).sum();
+        m.indices.reserve_exact(nnz);
+        m.weights.reserve_exact(nnz);
+        m.offsets.reserve_exact(nrows);
+        let mut end = 0;
+        for b in &blocks {
+            let (lens, idx, wts) = &b[k];
+            for &l in lens {
+                end += l;
+                m.offsets.push(end);
+            }
+            m.indices.extend_from_slice(idx);
+            m.weights.extend_from_slice(wts);
+        }
+    }
+    out
 }
 
 #[cfg(test)]

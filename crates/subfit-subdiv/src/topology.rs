@@ -23,6 +23,7 @@ pub struct Topology {
     offsets: Vec<u32>,
     indices: Vec<u32>,
     corner_face: Vec<u32>,
+    next_vertex: Vec<u32>,
     corner_edge: Vec<u32>,
     edge_verts: Vec<[u32; 2]>,
     edge_corners: Vec<[u32; 2]>,
@@ -78,6 +79,7 @@ impl Topology {
             offsets,
             indices,
             corner_face,
+            next_vertex: Vec::new(),
             corner_edge: vec![NONE; nc],
             edge_verts: Vec::new(),
             edge_corners: Vec::new(),
@@ -87,6 +89,9 @@ impl Topology {
             face_ring_offsets: Vec::new(),
             ring_corners: Vec::new(),
         };
+        t.next_vertex = (0..nc as u32)
+            .map(|c| t.indices[t.corner_next(c) as usize])
+            .collect();
         // Outgoing corners per vertex (CSR by counting sort), ascending corner order.
         let mut out_off = vec![0u32; num_vertices + 1];
         for &v in &t.indices {
@@ -262,7 +267,7 @@ impl Topology {
     /// The vertex after corner `c`'s vertex in its face.
     #[inline]
     pub fn corner_next_vertex(&self, c: u32) -> u32 {
-        self.indices[self.corner_next(c) as usize]
+        self.next_vertex[c as usize]
     }
 
     /// End vertices of edge `e`, in the direction of the first face that uses it.
