@@ -212,8 +212,17 @@ fn foot_points_torus() {
     check_foot_points("torus", &sh, &positions(&sh.samples(100_000, 6)), 3000, 60);
 }
 
-/// 0.2 % of the bounding-box diagonal Gaussian noise; a larger neighbourhood (option).
-fn noisy(name: &str, shape: &dyn Shape, n: usize, hood: Neighborhood, seed: u64) -> f64 {
+/// 0.2 % of the bounding-box diagonal Gaussian noise; a larger neighbourhood (option). The
+/// ellipsoid's tips (ρ = 0.031) are smaller than any neighbourhood that averages the noise out:
+/// they are the ≤ 10 % allowed to fail.
+fn noisy(
+    name: &str,
+    shape: &dyn Shape,
+    n: usize,
+    hood: Neighborhood,
+    degree: u8,
+    seed: u64,
+) -> f64 {
     let truth = shape.samples(n, seed);
     let p = positions(&truth);
     let (lo, hi) = subfit_mesh::bounding_box(&p).unwrap();
@@ -221,6 +230,7 @@ fn noisy(name: &str, shape: &dyn Shape, n: usize, hood: Neighborhood, seed: u64)
     let noisy = jitter(&p, 0.002 * diag, seed + 100);
     let opts = TargetOptions {
         neighborhood: hood,
+        jet_degree: degree,
         ..TargetOptions::default()
     };
     check_estimates(name, shape, &noisy, &truth, &opts, 0.2).curv_ok
@@ -234,6 +244,7 @@ fn noisy_sphere_curvature() {
             &sphere(),
             40_000,
             Neighborhood::Radius(0.12),
+            3,
             7
         ) >= 0.9
     );
@@ -247,6 +258,7 @@ fn noisy_torus_curvature() {
             &torus(),
             50_000,
             Neighborhood::Radius(0.06),
+            3,
             8
         ) >= 0.9
     );
@@ -260,6 +272,7 @@ fn noisy_ellipsoid_curvature() {
             &ellipsoid(),
             50_000,
             Neighborhood::Radius(0.06),
+            3,
             9
         ) >= 0.9
     );
