@@ -118,15 +118,11 @@ impl Format {
         let mut lost = Vec::new();
         let has_faces = !mesh.faces.is_empty();
         match self {
-            Format::Ply => {}
+            // PLY and OFF (CNOFF) carry positions, normals, colours and polygons.
+            Format::Ply | Format::Off => {}
             Format::Obj => {
                 if mesh.colors.is_some() {
                     lost.push("vertex colours");
-                }
-            }
-            Format::Off => {
-                if mesh.normals.is_some() && mesh.colors.is_some() {
-                    // CNOFF carries both; nothing lost.
                 }
             }
             Format::Stl => {
@@ -307,12 +303,17 @@ fn check_writable(mesh: &PolyMesh, format: Format, opts: &WriteOptions, path: &P
 ///
 /// The format comes from `opts.format` or the extension of `path`.
 pub fn write_file(path: &Path, mesh: &PolyMesh, opts: &WriteOptions) -> Result<()> {
-    let format = opts.format.or_else(|| Format::from_path(path)).ok_or_else(|| {
-        Error::file(
-            path,
-            ErrorKind::UnknownFormat(" (cannot tell the output format from the extension)".into()),
-        )
-    })?;
+    let format = opts
+        .format
+        .or_else(|| Format::from_path(path))
+        .ok_or_else(|| {
+            Error::file(
+                path,
+                ErrorKind::UnknownFormat(
+                    " (cannot tell the output format from the extension)".into(),
+                ),
+            )
+        })?;
     let bytes = write_bytes(mesh, format, opts).map_err(|mut e| {
         e.path = path.to_path_buf();
         e
