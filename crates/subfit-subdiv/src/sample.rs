@@ -50,10 +50,12 @@ pub struct LimitSamples {
 /// refinement `level`.
 ///
 /// Errors: bad topology, or non-triangles for Loop (see [`SubdivError`]).
-/// Cost: `l` refinements, then three sparse products; memory about `3 · #V_l · s` entries with
-/// `s` ≈ 10–30 control points per row. A 10k-face control mesh at level 3 (≈ 320k Loop /
-/// 640k Catmull-Clark rows) builds in well under a second in release builds (see
-/// `benches/stencils.rs`).
+/// Cost: `l` refinements and adjacency builds, then one fused pass producing the three
+/// products; memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15 (Catmull-Clark)
+/// control points per row. Measured (`benches/stencils.rs`, release, CPU time summed over
+/// threads on a shared 2-core machine): 10k-face control meshes at level 3 take ≈ 0.9 s for Loop
+/// (320k rows, 11M entries) and ≈ 2.9 s for Catmull-Clark (686k rows, 30M entries); 1k-face
+/// meshes ≈ 0.1 s and 0.2 s.
 pub fn sampling_operator(
     faces: &Polygons,
     num_vertices: usize,
