@@ -25,6 +25,34 @@ pub enum Command {
     Demo(DemoArgs),
     /// Refine a control mesh uniformly (Loop or Catmull-Clark), or push it to the limit surface.
     Subdivide(SubdivideArgs),
+    /// Analyse a target: normalize, estimate normals and principal curvatures per point.
+    Analyze(AnalyzeArgs),
+}
+
+/// `subfit analyze`.
+#[derive(clap::Args, Debug)]
+pub struct AnalyzeArgs {
+    /// The target: a point cloud or a mesh (any supported format).
+    pub target: PathBuf,
+    /// Write the normalized points with normals, curvatures and principal directions to this
+    /// binary PLY (f64).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Neighbours per point for normals and curvature (default 24).
+    #[arg(long, conflicts_with = "radius", value_parser = clap::value_parser!(u32).range(10..=1000))]
+    pub neighbors: Option<u32>,
+    /// Neighbourhood radius in normalized (unit-cube) units instead of k nearest.
+    #[arg(long)]
+    pub radius: Option<f64>,
+    /// Estimate normals from the points even when the file has normals or faces.
+    #[arg(long)]
+    pub estimate_normals: bool,
+    /// Degree of the local polynomial fitted per point (2: quadric as in the papers; 3: cubic).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(2..=3))]
+    pub jet_degree: u8,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `subfit subdivide`.

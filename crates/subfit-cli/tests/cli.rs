@@ -282,3 +282,62 @@ f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
     assert_eq!(v["vertices"], 18);
     assert_eq!(v["faces_by_size"]["3"], 32);
 }
+
+#[test]
+fn analyze_writes_normals_curvatures_and_directions() {
+    let d = tempfile::tempdir().unwrap();
+    let demo = d.path().join("demo");
+    assert!(
+        subfit(&["demo", "-o", demo.to_str().unwrap(), "--points", "4000"])
+            .status
+            .success()
+    );
+    let cloud = demo.join("ellipsoid.ply");
+    let out = d.path().join("an.ply");
+    let r = subfit(&[
+        "analyze",
+        cloud.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+        "--estimate-normals",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(s["points"], 4000);
+    assert_eq!(s["normal_origin"], "estimated");
+    // The ellipsoid is convex: with outward normals both curvatures are negative (Cheng 2007
+    // §II-D3: the centre of curvature lies on the side opposite the normal) at almost all points.
+    assert!(s["k1_quantiles"][3].as_f64().unwrap() < 0.0, "{s}");
+    assert!(s["k2_quantiles"][3].as_f64().unwrap() < 0.0, "{s}");
+
+    let bytes = std::fs::read(&out).unwrap();
+    let header = String::from_utf8_lossy(&bytes[..600]);
+    for p in ["nx", "k1", "k2", "t1x", "t1y", "t1z", "t2x", "t2y", "t2z"] {
+        assert!(
+            header.contains(&format!("property double {p}\n")),
+            "{p}: {header}"
+        );
+    }
+    let v: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", out.to_str().unwrap()]).stdout).unwrap();
+    assert_eq!(v["vertices"], 4000);
+    // Normalized into the unit cube, longest side 1.
+    assert_eq!(v["bbox"]["size"][2].as_f64().unwrap(), 1.0);
+
+    // Bad option values are rejected before any work.
+    let r = subfit(&["analyze", cloud.to_str().unwrap(), "--radius", "-1"]);
+    assert_eq!(r.status.code(), Some(2));
+    let r = subfit(&[
+        "analyze",
+        cloud.to_str().unwrap(),
+        "-o",
+        d.path().join("x.obj").to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    // Too few points: a clear error, exit code 2.
+    let few = write(d.path(), "few.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n");
+    let r = subfit(&["analyze", few.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("few.xyz"));
+}

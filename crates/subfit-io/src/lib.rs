@@ -321,6 +321,21 @@ pub fn write_file(path: &Path, mesh: &PolyMesh, opts: &WriteOptions) -> Result<(
     write_atomic(path, &bytes)
 }
 
+/// Writes a mesh as PLY with extra per-vertex scalar properties (see
+/// [`ply::write_with_properties`]), atomically like [`write_file`]. `opts.format` is ignored.
+pub fn write_ply_with_properties(
+    path: &Path,
+    mesh: &PolyMesh,
+    extra: &[ply::VertexProperty<'_>],
+    opts: &WriteOptions,
+) -> Result<()> {
+    check_writable(mesh, Format::Ply, opts, path)?;
+    let mut out = Vec::new();
+    ply::write_with_properties(mesh, extra, opts.encoding, opts.single_precision, &mut out)
+        .map_err(|e| Error::file(path, ErrorKind::CannotWrite(e.to_string())))?;
+    write_atomic(path, &out)
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io_err = |e: std::io::Error| Error::file(path, ErrorKind::Io(e));

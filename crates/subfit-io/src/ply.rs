@@ -1004,14 +1004,49 @@ pub fn write(
     single_precision: bool,
     out: &mut Vec<u8>,
 ) -> std::io::Result<()> {
+    write_with_properties(mesh, &[], encoding, single_precision, out)
+}
+
+/// A named per-vertex scalar property for [`write_with_properties`]: `values` has one entry per
+/// vertex.
+#[derive(Clone, Copy, Debug)]
+pub struct VertexProperty<'a> {
+    /// The property name in the header (e.g. `k1`, `error`); must be a single word.
+    pub name: &'a str,
+    /// One value per vertex.
+    pub values: &'a [f64],
+}
+
+/// Writes a mesh as PLY like [`write`], with extra per-vertex scalar properties after the
+/// standard ones (stored as `double`, or `float` when `single_precision`).
+///
+/// Errors (`InvalidInput`) when an attribute or property length differs from the vertex count
+/// or a property name is empty or contains whitespace.
+pub fn write_with_properties(
+    mesh: &PolyMesh,
+    extra: &[VertexProperty<'_>],
+    encoding: Encoding,
+    single_precision: bool,
+    out: &mut Vec<u8>,
+) -> std::io::Result<()> {
     let n = mesh.positions.len();
+    let invalid = |msg: &str| {
+        Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            msg.to_string(),
+        ))
+    };
     if mesh.normals.as_ref().is_some_and(|v| v.len() != n)
         || mesh.colors.as_ref().is_some_and(|v| v.len() != n)
+        || extra.iter().any(|p| p.values.len() != n)
     {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            "attribute arrays do not match the vertex count",
-        ));
+        return invalid("attribute arrays do not match the vertex count");
+    }
+    if extra
+        .iter()
+        .any(|p| p.name.is_empty() || p.name.chars().any(|c| c.is_whitespace()))
+    {
+        return invalid("a property name is empty or contains whitespace");
     }
     let max_face = mesh.faces.iter().map(|f| f.len()).max().unwrap_or(0);
     let count_ty = if max_face <= u8::MAX as usize {
@@ -1044,6 +1079,9 @@ pub fn write(
     }
     if mesh.colors.is_some() {
         head += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    }
+    for p in extra {
+        head += &format!("property {real} {}\n", p.name);
     }
     if !mesh.faces.is_empty() {
         let name = |s: Scalar| match s {
@@ -1079,6 +1117,9 @@ pub fn write(
             for &c in &cs[i] {
                 w.int(c as u32, Scalar::U8);
             }
+        }
+        for p in extra {
+            w.real(p.values[i]);
         }
         w.end();
     }

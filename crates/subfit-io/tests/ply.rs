@@ -661,3 +661,48 @@ fn tristrips_and_faces_together_keep_both() {
         Polygons::from_triangles(&[[0, 1, 2], [2, 1, 3], [3, 2, 0]])
     );
 }
+
+#[test]
+fn extra_vertex_properties_are_written_and_skipped_by_the_reader() {
+    use subfit_io::ply::{write_with_properties, VertexProperty};
+    let mesh = subfit_mesh::PolyMesh::point_cloud(
+        vec![[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]],
+        Some(vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]),
+    );
+    let k1 = [0.5, -0.25];
+    for enc in [
+        Encoding::Ascii,
+        Encoding::BinaryLittleEndian,
+        Encoding::BinaryBigEndian,
+    ] {
+        let mut out = Vec::new();
+        write_with_properties(
+            &mesh,
+            &[VertexProperty {
+                name: "k1",
+                values: &k1,
+            }],
+            enc,
+            false,
+            &mut out,
+        )
+        .unwrap();
+        let head = String::from_utf8_lossy(&out[..out.len().min(300)]).into_owned();
+        assert!(head.contains("property double k1"), "{head}");
+        let (back, _) = subfit_io::ply::read(&out, std::path::Path::new("x.ply")).unwrap();
+        assert_eq!(back.positions, mesh.positions);
+        assert_eq!(back.normals, mesh.normals);
+    }
+    let mut out = Vec::new();
+    let bad = write_with_properties(
+        &mesh,
+        &[VertexProperty {
+            name: "a b",
+            values: &k1,
+        }],
+        Encoding::Ascii,
+        false,
+        &mut out,
+    );
+    assert!(bad.is_err());
+}

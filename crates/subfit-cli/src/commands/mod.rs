@@ -1,5 +1,6 @@
 //! One module per subcommand; `run` dispatches.
 
+mod analyze;
 mod convert;
 mod demo;
 mod info;
@@ -16,5 +17,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Convert(a) => convert::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Subdivide(a) => subdivide::run(a),
+        Command::Analyze(a) => analyze::run(a),
     }
 }

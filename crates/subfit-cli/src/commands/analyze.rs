@@ -1,0 +1,238 @@
+//! `subfit analyze TARGET [-o OUT.ply]`: build the target (normalization, kd-tree, normals,
+//! principal curvatures and directions), print timings per phase and summary statistics, and
+//! optionally write the per-point results as a binary PLY.
+
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use serde::Serialize;
+use subfit::io::ply::VertexProperty;
+use subfit::io::{Encoding, WriteOptions};
+use subfit::mesh::PolyMesh;
+use subfit::target::{Neighborhood, NormalSource, Phase, Progress, Target, TargetOptions};
+
+use crate::cli::AnalyzeArgs;
+
+#[derive(Serialize)]
+struct Summary {
+    file: String,
+    input_points: usize,
+    points: usize,
+    merged_duplicates: usize,
+    triangles: usize,
+    normal_origin: String,
+    flipped_normals: usize,
+    ambiguous_normals: usize,
+    degenerate_fits: usize,
+    orientation_components: usize,
+    neighborhood_size: [f64; 3],
+    neighborhood_radius: [f64; 3],
+    /// Quantiles (0, 5, 50, 95, 100 %) of the signed principal curvatures, normalized units.
+    k1_quantiles: [f64; 5],
+    k2_quantiles: [f64; 5],
+    /// Normalized units → original units: multiply lengths by this.
+    scale_to_original: f64,
+    /// Seconds per phase.
+    timings: Timings,
+}
+
+#[derive(Serialize)]
+struct Timings {
+    read: f64,
+    validate: f64,
+    normalize: f64,
+    merge: f64,
+    index: f64,
+    estimate: f64,
+    orient: f64,
+    mesh_index: f64,
+    total: f64,
+}
+
+fn quantiles(v: &[f64]) -> [f64; 5] {
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if s.is_empty() {
+        return [f64::NAN; 5];
+    }
+    s.sort_by(f64::total_cmp);
+    let q = |p: f64| s[((s.len() - 1) as f64 * p).round() as usize];
+    [q(0.0), q(0.05), q(0.5), q(0.95), q(1.0)]
+}
+
+fn phase_name(p: Phase) -> &'static str {
+    match p {
+        Phase::Validate => "validating",
+        Phase::Normalize => "normalizing",
+        Phase::Merge => "merging duplicates",
+        Phase::Index => "building kd-tree",
+        Phase::Estimate => "fitting normals and curvatures",
+        Phase::Orient => "orienting normals",
+        Phase::MeshIndex => "building triangle BVH",
+    }
+}
+
+pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
+    let neighborhood = match (a.neighbors, a.radius) {
+        (_, Some(r)) if !(r.is_finite() && r > 0.0 && r < 1.0) => {
+            bail!("--radius must be in (0, 1) (unit-cube units), got {r}")
+        }
+        (_, Some(r)) => Neighborhood::Radius(r),
+        (Some(k), None) => Neighborhood::Knn(k as usize),
+        (None, None) => TargetOptions::default().neighborhood,
+    };
+    if let Some(out) = &a.output {
+        if subfit::io::Format::from_path(out) != Some(subfit::io::Format::Ply) {
+            bail!(
+                "{}: the analysis output is a PLY file (.ply)",
+                out.display()
+            );
+        }
+    }
+    let options = TargetOptions {
+        neighborhood,
+        jet_degree: a.jet_degree,
+        normals: if a.estimate_normals {
+            NormalSource::Estimate
+        } else {
+            NormalSource::Auto
+        },
+        ..TargetOptions::default()
+    };
+
+    let t_read = std::time::Instant::now();
+    let (mesh, _) = crate::progress::load(&a.target)?;
+    let read = t_read.elapsed().as_secs_f64();
+
+    let bar = crate::progress::bar(1, "analysing");
+    let on_progress = |p: Progress| {
+        bar.set_message(phase_name(p.phase));
+        bar.set_length(p.total.max(1) as u64);
+        bar.set_position(p.done as u64);
+    };
+    let target = Target::build(&mesh, &options, Some(&on_progress))
+        .with_context(|| format!("{}: cannot analyse", a.target.display()))?;
+    bar.finish_and_clear();
+
+    let attrs = target.point_attributes();
+    let s = target.stats();
+    let t = &s.timings;
+    let summary = Summary {
+        file: a.target.display().to_string(),
+        input_points: s.input_points,
+        points: s.points,
+        merged_duplicates: s.merged_duplicates,
+        triangles: s.triangles,
+        normal_origin: format!("{:?}", s.normal_origin).to_lowercase(),
+        flipped_normals: s.flipped_normals,
+        ambiguous_normals: s.ambiguous_normals,
+        degenerate_fits: s.degenerate_fits,
+        orientation_components: s.orientation_components,
+        neighborhood_size: [
+            s.neighborhood_size.0 as f64,
+            s.neighborhood_size.1,
+            s.neighborhood_size.2 as f64,
+        ],
+        neighborhood_radius: [
+            s.neighborhood_radius.0,
+            s.neighborhood_radius.1,
+            s.neighborhood_radius.2,
+        ],
+        k1_quantiles: quantiles(&attrs.k1),
+        k2_quantiles: quantiles(&attrs.k2),
+        scale_to_original: target.normalization().length_to_original(1.0),
+        timings: Timings {
+            read,
+            validate: t.validate.as_secs_f64(),
+            normalize: t.normalize.as_secs_f64(),
+            merge: t.merge.as_secs_f64(),
+            index: t.index.as_secs_f64(),
+            estimate: t.estimate.as_secs_f64(),
+            orient: t.orient.as_secs_f64(),
+            mesh_index: t.mesh_index.as_secs_f64(),
+            total: t.total.as_secs_f64(),
+        },
+    };
+
+    if let Some(out) = &a.output {
+        write_points(out, &attrs)?;
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        print_text(&summary, a.output.as_deref());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write_points(out: &std::path::Path, at: &subfit::target::PointAttributes) -> anyhow::Result<()> {
+    let col = |v: &[[f64; 3]], k: usize| v.iter().map(|p| p[k]).collect::<Vec<f64>>();
+    let (t1x, t1y, t1z) = (col(&at.t1, 0), col(&at.t1, 1), col(&at.t1, 2));
+    let (t2x, t2y, t2z) = (col(&at.t2, 0), col(&at.t2, 1), col(&at.t2, 2));
+    let props = [
+        ("k1", &at.k1[..]),
+        ("k2", &at.k2[..]),
+        ("t1x", &t1x[..]),
+        ("t1y", &t1y[..]),
+        ("t1z", &t1z[..]),
+        ("t2x", &t2x[..]),
+        ("t2y", &t2y[..]),
+        ("t2z", &t2z[..]),
+    ]
+    .map(|(name, values)| VertexProperty { name, values });
+    let cloud = PolyMesh::point_cloud(at.points.clone(), Some(at.normals.clone()));
+    let opts = WriteOptions {
+        format: None,
+        encoding: Encoding::BinaryLittleEndian,
+        single_precision: false,
+    };
+    subfit::io::write_ply_with_properties(out, &cloud, &props, &opts)?;
+    Ok(())
+}
+
+fn print_text(s: &Summary, out: Option<&std::path::Path>) {
+    println!("file          {}", s.file);
+    println!(
+        "points        {} ({} in the input, {} exact duplicates merged{})",
+        s.points,
+        s.input_points,
+        s.merged_duplicates,
+        if s.triangles > 0 {
+            format!(", {} triangles", s.triangles)
+        } else {
+            String::new()
+        }
+    );
+    println!(
+        "normals       {}; {} flipped by orientation, {} ambiguous, {} degenerate fits, {} orientation component(s)",
+        s.normal_origin, s.flipped_normals, s.ambiguous_normals, s.degenerate_fits, s.orientation_components
+    );
+    println!(
+        "neighbours    k min/mean/max {:.0}/{:.1}/{:.0}; radius min/median/max {:.5}/{:.5}/{:.5}",
+        s.neighborhood_size[0],
+        s.neighborhood_size[1],
+        s.neighborhood_size[2],
+        s.neighborhood_radius[0],
+        s.neighborhood_radius[1],
+        s.neighborhood_radius[2]
+    );
+    let q = |v: &[f64; 5]| {
+        format!(
+            "min {:.4}  5% {:.4}  median {:.4}  95% {:.4}  max {:.4}",
+            v[0], v[1], v[2], v[3], v[4]
+        )
+    };
+    println!("k1            {}", q(&s.k1_quantiles));
+    println!("k2            {}", q(&s.k2_quantiles));
+    println!(
+        "units         1 normalized unit = {:.6} original units",
+        s.scale_to_original
+    );
+    let t = &s.timings;
+    println!(
+        "time (s)      read {:.3}, validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh index {:.3}; analysis total {:.3}",
+        t.read, t.validate, t.normalize, t.merge, t.index, t.estimate, t.orient, t.mesh_index, t.total
+    );
+    if let Some(o) = out {
+        println!("wrote         {}", o.display());
+    }
+}
