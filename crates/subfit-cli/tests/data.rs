@@ -4,6 +4,8 @@
 //! Needs `SUBFIT_DATA`: without it the test fails under `CI=true` and is skipped with a notice
 //! elsewhere.
 
+#![allow(clippy::print_stderr)]
+
 use std::path::PathBuf;
 use std::process::Command;
 
