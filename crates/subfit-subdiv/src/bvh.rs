@@ -128,6 +128,9 @@ impl TriangleBvh {
     /// The nearest triangle to `p`, or `None` when there are no triangles. Cost O(log #T)
     /// typically.
     pub fn nearest(&self, p: [f64; 3]) -> Option<Nearest> {
+        if self.nodes.is_empty() {
+            return None;
+        }
         let mut best: Option<Nearest> = None;
         let mut stack = vec![0u32];
         while let Some(i) = stack.pop() {
@@ -226,4 +229,43 @@ pub fn closest_on_triangle(p: [f64; 3], t: &[[f64; 3]; 3]) -> ([f64; 3], [f64; 3
     let denom = 1.0 / (va + vb + vc);
     let (v, w) = (vb * denom, vc * denom);
     at([1.0 - v - w, v, w])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nearest_matches_brute_force() {
+        let mut s = 1u64;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let tris: Vec<[[f64; 3]; 3]> = (0..300)
+            .map(|_| {
+                let c = [r(), r(), r()];
+                [0, 1, 2].map(|_| [c[0] + 0.1 * r(), c[1] + 0.1 * r(), c[2] + 0.1 * r()])
+            })
+            .collect();
+        let bvh = TriangleBvh::new(tris.clone());
+        for _ in 0..200 {
+            let q = [1.4 * r() - 0.2, 1.4 * r() - 0.2, 1.4 * r() - 0.2];
+            let n = bvh.nearest(q).unwrap();
+            let bf = tris
+                .iter()
+                .map(|t| dist2(q, closest_on_triangle(q, t).0))
+                .fold(f64::INFINITY, f64::min);
+            assert!((n.dist2 - bf).abs() <= 1e-15);
+            let t = &tris[n.triangle as usize];
+            let b = n.bary;
+            for (k, pk) in n.point.iter().enumerate() {
+                let x = b[0] * t[0][k] + b[1] * t[1][k] + b[2] * t[2][k];
+                assert!((x - pk).abs() < 1e-14);
+            }
+        }
+        assert!(TriangleBvh::new(Vec::new()).nearest([0.0; 3]).is_none());
+    }
 }

@@ -17,9 +17,12 @@
 //! * Catmull-Clark quad `(c0, c1, c2, c3)`: `(u, v) ∈ [0,1]²`, `c0` at `(0,0)`, `c1` at `(1,0)`,
 //!   `c2` at `(1,1)`, `c3` at `(0,1)`.
 //! * Catmull-Clark `n`-gon (`n ≠ 4`): sub-patch `k` (`0 ≤ k < n`) is the quad of the first-level
-//!   split at corner `k`, `(v_k, e_{k,k+1}, F, e_{k−1,k})` with `e` the edge midpoints' edge points
-//!   and `F` the face point (the order of [`crate::refine`]); `(u, v) ∈ [0,1]²` on it with the
-//!   quad convention above (`v_k` at `(0,0)`, `e_{k,k+1}` at `(1,0)`, `F` at `(1,1)`).
+//!   split at corner `k`, `(v_k, e_{k,k+1}, F, e_{k−1,k})` with `e_{i,j}` the edge point of edge
+//!   `v_i v_j` and `F` the face point (the order of [`crate::refine`]); `(u, v) ∈ [0,1]²` on it
+//!   with the quad convention above (`v_k` at `(0,0)`, `e_{k,k+1}` at `(1,0)`, `F` at `(1,1)`,
+//!   `e_{k−1,k}` at `(0,1)`). Each sub-patch covers a quarter-like sector of the `n`-gon.
+//!
+//! Closest points on the surface: [`crate::closest`].
 //!
 //! A [`SurfaceParam`] is `(face, sub, u, v)`; `sub` is 0 except for Catmull-Clark `n`-gons.
 //! Dyadic parameters `(i / 2^l, j / 2^l)` are the level-`l` vertices of uniform refinement
@@ -41,6 +44,7 @@ use crate::patch::{bicubic_bspline, loop_box_spline};
 use crate::scheme::{Options, Scheme};
 use crate::topology::Topology;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 use subfit_mesh::{Polygons, Tags};
 
 /// Refinement depth after which a point that is still not inside a regular patch is taken to be
@@ -349,7 +353,29 @@ pub struct Evaluator {
     corner: Vec<bool>,
     /// First patch of each face (`#F + 1` entries).
     patch_start: Vec<u32>,
-    regular: Vec<Option<PatchCoef>>,
+    /// Memoised local-refinement tree of each patch (built on first use; regular level-0
+    /// patches at construction).
+    roots: Vec<OnceLock<Node>>,
+}
+
+/// Local refinement levels whose results are memoised per patch: evaluations reuse the refined
+/// neighbourhoods and the regular sub-patches of the first `CACHE_DEPTH` levels (memory: up to a
+/// few tens of kB per irregular patch that has been evaluated near its irregular corners).
+const CACHE_DEPTH: u32 = 4;
+
+/// A node of a patch's memoised local-refinement tree.
+#[derive(Clone, Debug)]
+enum Node {
+    /// A regular (sub-)patch.
+    Regular(PatchCoef),
+    /// An irregular (sub-)patch: its refined neighbourhood and, lazily, its four children.
+    Irregular {
+        mesh: LocalMesh,
+        t: usize,
+        kids: Box<[OnceLock<Node>; 4]>,
+    },
+    /// Local refinement failed (a broken invariant, reported as [`EvalError::Incomplete`]).
+    Failed,
 }
 
 impl Evaluator {
@@ -422,7 +448,7 @@ impl Evaluator {
             flags,
             corner,
             patch_start,
-            regular: Vec::new(),
+            roots: Vec::new(),
         };
         let regular: Vec<Option<PatchCoef>> = (0..nf)
             .into_par_iter()
@@ -438,16 +464,20 @@ impl Evaluator {
             })
             .collect();
         // One entry per patch: n-gon sub-patches are never regular at level 0.
-        let mut per_patch = Vec::with_capacity(*ev.patch_start.last().unwrap() as usize);
+        let mut roots = Vec::with_capacity(*ev.patch_start.last().unwrap() as usize);
         for (f, r) in regular.into_iter().enumerate() {
             let n = ev.patch_start[f + 1] - ev.patch_start[f];
             if n == 1 {
-                per_patch.push(r);
+                let cell = OnceLock::new();
+                if let Some(pc) = r {
+                    let _ = cell.set(Node::Regular(pc));
+                }
+                roots.push(cell);
             } else {
-                per_patch.extend((0..n).map(|_| None));
+                roots.extend((0..n).map(|_| OnceLock::new()));
             }
         }
-        ev.regular = per_patch;
+        ev.roots = roots;
         Ok(ev)
     }
 
@@ -499,7 +529,10 @@ impl Evaluator {
     /// Whether the patch of `(face, sub)` is regular at level 0 (evaluated directly, without
     /// local refinement).
     pub fn is_regular(&self, face: u32, sub: u32) -> bool {
-        self.regular[self.patch_index(face, sub)].is_some()
+        matches!(
+            self.roots[self.patch_index(face, sub)].get(),
+            Some(Node::Regular(_))
+        )
     }
 
     /// Whether patches of this evaluator are triangles (Loop) rather than quads.
@@ -608,27 +641,73 @@ impl Evaluator {
     /// (~1 µs); near an irregular vertex one local refinement per halving of the distance to it
     /// (about `log2(1/distance)` levels of a ~50-vertex neighbourhood, ~10–30 µs each).
     pub fn weights(&self, p: SurfaceParam) -> Result<EvalWeights, EvalError> {
-        let (u, v) = self.check(&p)?;
+        let (mut u, mut v) = self.check(&p)?;
         let scheme = self.options.scheme;
-        if let Some(reg) = &self.regular[self.patch_index(p.face, p.sub)] {
-            return Ok(reg.eval(scheme, u, v, [[1.0, 0.0], [0.0, 1.0]], 0));
-        }
-        let (mut mesh, mut t) = self.extract(p.face);
-        let (mut u, mut v) = (u, v);
-        let mut a = [[1.0, 0.0], [0.0, 1.0]];
-        let mut depth = 0;
         let err = |depth| EvalError::Incomplete {
             face: p.face,
             depth,
         };
-        if scheme == Scheme::CatmullClark && mesh.face(t).len() != 4 {
-            let (m, c, _) = self
-                .refine_local(&mesh, t, ChildPick::Index(p.sub as usize))
-                .ok_or(err(0))?;
-            mesh = m;
-            t = c;
-            depth = 1;
+        let root_depth = u32::from(self.num_subpatches(p.face) > 1);
+        let mut node = self.roots[self.patch_index(p.face, p.sub)]
+            .get_or_init(|| self.root_node(p.face, p.sub));
+        let mut a = [[1.0, 0.0], [0.0, 1.0]];
+        let mut depth = root_depth;
+        loop {
+            match node {
+                Node::Failed => return Err(err(depth)),
+                Node::Regular(pc) => return Ok(pc.eval(scheme, u, v, a, depth)),
+                Node::Irregular { mesh, t, kids } => {
+                    if depth >= CACHE_DEPTH || self.at_corner(u, v) {
+                        return self.descend(mesh.clone(), *t, u, v, a, depth, p.face);
+                    }
+                    let ch = children(mesh, scheme, *t);
+                    let which = best_child(&ch, u, v);
+                    let (cu, cv, ca) = child_local(&ch[which].params, u, v);
+                    node = kids[which].get_or_init(|| {
+                        self.refine_local(mesh, *t, ChildPick::Index(which))
+                            .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme))
+                    });
+                    u = cu;
+                    v = cv;
+                    a = mul2(ca, a);
+                    depth += 1;
+                }
+            }
         }
+    }
+
+    /// The root of patch `(face, sub)`'s refinement tree.
+    fn root_node(&self, face: u32, sub: u32) -> Node {
+        let scheme = self.options.scheme;
+        let (mesh, t) = self.extract(face);
+        if scheme == Scheme::CatmullClark && mesh.face(t).len() != 4 {
+            return self
+                .refine_local(&mesh, t, ChildPick::Index(sub as usize))
+                .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme));
+        }
+        make_node(mesh, t, scheme)
+    }
+
+    /// Whether `(u, v)` is exactly a corner of the patch domain.
+    fn at_corner(&self, u: f64, v: f64) -> bool {
+        (u == 0.0 || u == 1.0) && (v == 0.0 || v == 1.0) && !(self.triangular() && u + v > 1.0)
+    }
+
+    /// Evaluation by repeated local refinement from `mesh` (face `t`, parameters `(u, v)`,
+    /// Jacobian `a` to the original parameters, at refinement `depth`), without memoisation.
+    #[allow(clippy::too_many_arguments, reason = "the state of the descent")]
+    fn descend(
+        &self,
+        mut mesh: LocalMesh,
+        mut t: usize,
+        mut u: f64,
+        mut v: f64,
+        mut a: [[f64; 2]; 2],
+        mut depth: u32,
+        face: u32,
+    ) -> Result<EvalWeights, EvalError> {
+        let scheme = self.options.scheme;
+        let err = |depth| EvalError::Incomplete { face, depth };
         let mut mask = Mask::default();
         loop {
             let adj = mesh.adjacency();
@@ -898,6 +977,19 @@ impl Evaluator {
                 SurfaceParam { face, sub, u, v }
             })
             .collect()
+    }
+}
+
+/// A tree node for face `t` of `mesh`: regular patch or irregular (to be refined further).
+fn make_node(mesh: LocalMesh, t: usize, scheme: Scheme) -> Node {
+    let adj = mesh.adjacency();
+    match regular_patch(&mesh, &adj, scheme, t) {
+        Some(c) => Node::Regular(PatchCoef::new(&mesh, &c)),
+        None => Node::Irregular {
+            mesh,
+            t,
+            kids: Box::new(std::array::from_fn(|_| OnceLock::new())),
+        },
     }
 }
 

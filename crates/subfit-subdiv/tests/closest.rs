@@ -5,6 +5,10 @@
     clippy::print_stdout,
     reason = "the tests report the errors they measured"
 )]
+#![allow(
+    clippy::needless_range_loop,
+    reason = "coordinate loops index several arrays"
+)]
 
 use subfit_mesh::shapes::torus_mesh;
 use subfit_mesh::{Polygons, Tags};

@@ -5,6 +5,10 @@
     clippy::print_stdout,
     reason = "the tests report the errors they measured"
 )]
+#![allow(
+    clippy::needless_range_loop,
+    reason = "coordinate loops index several arrays"
+)]
 
 use std::path::PathBuf;
 use subfit_mesh::{Polygons, Tags, SHARPNESS_INFINITE};
@@ -395,4 +399,64 @@ fn bad_parameters_are_typed_errors() {
         .is_err());
     let q = Polygons::from_quads(&[[0, 1, 2, 3]]);
     assert!(Evaluator::new(&q, 4, &Tags::new(), &Options::new(Scheme::Loop)).is_err());
+}
+
+/// The child face of a uniformly refined mesh (children in `refine`'s order) containing `(u, v)`
+/// of face `f`, and the parameters there (all-triangle or all-quad meshes).
+fn to_child(tri: bool, f: u32, u: f64, v: f64) -> (u32, f64, f64) {
+    if tri {
+        let (c, s, t) = if u + v <= 0.5 {
+            (0, 2.0 * u, 2.0 * v)
+        } else if u >= 0.5 {
+            (1, 2.0 * v, 2.0 - 2.0 * u - 2.0 * v)
+        } else if v >= 0.5 {
+            (2, 2.0 - 2.0 * u - 2.0 * v, 2.0 * u)
+        } else {
+            (3, 2.0 * u + 2.0 * v - 1.0, 1.0 - 2.0 * u)
+        };
+        (4 * f + c, s.max(0.0), t.max(0.0))
+    } else {
+        let (c, s, t) = match (u >= 0.5, v >= 0.5) {
+            (false, false) => (0, 2.0 * u, 2.0 * v),
+            (true, false) => (1, 2.0 * v, 2.0 - 2.0 * u),
+            (true, true) => (2, 2.0 - 2.0 * u, 2.0 - 2.0 * v),
+            (false, true) => (3, 2.0 - 2.0 * v, 2.0 * u),
+        };
+        (4 * f + c, s.clamp(0.0, 1.0), t.clamp(0.0, 1.0))
+    }
+}
+
+#[test]
+fn evaluation_commutes_with_global_refinement() {
+    for (name, scheme, p, f, tags) in corpus() {
+        let tri = scheme == Scheme::Loop;
+        if !tri && !f.is_quads() {
+            continue;
+        }
+        let opts = Options::new(scheme);
+        let ev = Evaluator::new(&f, p.len(), &tags, &opts).unwrap();
+        let r1 = refine(&f, p.len(), &tags, &opts).unwrap();
+        let p1 = r1.matrix.apply(&p);
+        let r2 = refine(&r1.faces, p1.len(), &r1.tags, &opts).unwrap();
+        let p2 = r2.matrix.apply(&p1);
+        let ev2 = Evaluator::new(&r2.faces, p2.len(), &r2.tags, &opts).unwrap();
+        let d = diag(&p);
+        let mut params = ev.random_params(100, 5);
+        // Points close to the corners (extraordinary vertices among them).
+        params.extend(ev.random_params(100, 6).into_iter().map(|q| SurfaceParam {
+            u: q.u * 1e-4,
+            v: q.v * 1e-4,
+            ..q
+        }));
+        let mut max_err = 0.0f64;
+        for q in params {
+            let (c1, s1, t1) = to_child(tri, q.face, q.u, q.v);
+            let (c2, s2, t2) = to_child(tri, c1, s1, t1);
+            let a = ev.evaluate(&p, q).unwrap();
+            let b = ev2.evaluate(&p2, SurfaceParam::new(c2, s2, t2)).unwrap();
+            max_err = max_err.max(dist(a.position, b.position) / d);
+        }
+        println!("{name}: eval vs eval on the twice-refined mesh: {max_err:.1e}");
+        assert!(max_err < 1e-13, "{name}: {max_err:e}");
+    }
 }
