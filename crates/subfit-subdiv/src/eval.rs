@@ -709,6 +709,7 @@ impl Evaluator {
         let scheme = self.options.scheme;
         let err = |depth| EvalError::Incomplete { face, depth };
         let mut mask = Mask::default();
+        let mut step: Option<Step> = None;
         loop {
             let adj = mesh.adjacency();
             if let Some(c) = regular_patch(&mesh, &adj, scheme, t) {
@@ -738,9 +739,35 @@ impl Evaluator {
                     .vertex_limit(&mesh, &adj, mesh.face(t)[k], depth, &mut mask)
                     .ok_or(err(depth));
             }
-            let (m, c, which) = self
-                .refine_local(&mesh, t, ChildPick::Param(u, v))
-                .ok_or(err(depth))?;
+            // Near an irregular vertex the neighbourhood becomes self-similar: the same topology
+            // and child at every level, so the step is one fixed local subdivision matrix
+            // (Stam 1998). Refine the topology once with identity rows and reuse the matrix.
+            let which = best_child(&children(&mesh, scheme, t), u, v);
+            let reuse = step
+                .as_ref()
+                .is_some_and(|st: &Step| st.which == which && st.t == t && st.same_topology(&mesh));
+            if !reuse {
+                let mut ident = mesh.clone();
+                let nv = mesh.nv();
+                ident.cols = (0..nv as u32).collect();
+                ident.rows = vec![0.0; nv * nv];
+                for i in 0..nv {
+                    ident.rows[i * nv + i] = 1.0;
+                }
+                let (child, c, _) = self
+                    .refine_local(&ident, t, ChildPick::Index(which))
+                    .ok_or(err(depth))?;
+                step = Some(Step {
+                    which,
+                    t,
+                    parent: mesh.clone(),
+                    child,
+                    c,
+                });
+            }
+            let st = step.as_ref().expect("set above");
+            let m = st.apply(&mesh);
+            let c = st.c;
             let (cu, cv, ca) = self.child_param(&mesh, t, which, u, v);
             mesh = m;
             t = c;
@@ -977,6 +1004,47 @@ impl Evaluator {
                 SurfaceParam { face, sub, u, v }
             })
             .collect()
+    }
+}
+
+/// One local refinement step as a matrix over the parent's local vertices, for a parent
+/// topology (`parent`, rows ignored), face `t` and child `which`.
+struct Step {
+    which: usize,
+    t: usize,
+    parent: LocalMesh,
+    /// The child neighbourhood with rows over the parent's local vertices (`nv_child × nv`).
+    child: LocalMesh,
+    c: usize,
+}
+
+impl Step {
+    fn same_topology(&self, m: &LocalMesh) -> bool {
+        let p = &self.parent;
+        p.fo == m.fo && p.fv == m.fv && p.fe == m.fe && p.nfaces == m.nfaces && p.corner == m.corner
+    }
+
+    /// The child of `m` (same topology as `parent`): rows = matrix · rows of `m`.
+    fn apply(&self, m: &LocalMesh) -> LocalMesh {
+        let (nv, k) = (m.nv(), m.k());
+        let nc = self.child.nv();
+        let mut rows = vec![0.0; nc * k];
+        for i in 0..nc {
+            let w = &self.child.rows[i * nv..(i + 1) * nv];
+            let out = &mut rows[i * k..(i + 1) * k];
+            for (j, &wj) in w.iter().enumerate() {
+                if wj != 0.0 {
+                    for (o, r) in out.iter_mut().zip(m.row(j as u32)) {
+                        *o += wj * r;
+                    }
+                }
+            }
+        }
+        LocalMesh {
+            cols: m.cols.clone(),
+            rows,
+            ..self.child.clone()
+        }
     }
 }
 
