@@ -664,7 +664,7 @@ impl Evaluator {
                     let which = best_child(&ch, u, v);
                     let (cu, cv, ca) = child_local(&ch[which].params, u, v);
                     node = kids[which].get_or_init(|| {
-                        self.refine_local(mesh, *t, ChildPick::Index(which))
+                        self.refine_local(mesh, *t, which)
                             .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme))
                     });
                     u = cu;
@@ -682,7 +682,7 @@ impl Evaluator {
         let (mesh, t) = self.extract(face);
         if scheme == Scheme::CatmullClark && mesh.face(t).len() != 4 {
             return self
-                .refine_local(&mesh, t, ChildPick::Index(sub as usize))
+                .refine_local(&mesh, t, sub as usize)
                 .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme));
         }
         make_node(mesh, t, scheme)
@@ -754,9 +754,7 @@ impl Evaluator {
                 for i in 0..nv {
                     ident.rows[i * nv + i] = 1.0;
                 }
-                let (child, c, _) = self
-                    .refine_local(&ident, t, ChildPick::Index(which))
-                    .ok_or(err(depth))?;
+                let (child, c, _) = self.refine_local(&ident, t, which).ok_or(err(depth))?;
                 step = Some(Step {
                     which,
                     t,
@@ -835,7 +833,7 @@ impl Evaluator {
         &self,
         mesh: &LocalMesh,
         t: usize,
-        pick: ChildPick,
+        which: usize,
     ) -> Option<(LocalMesh, usize, usize)> {
         let scheme = self.options.scheme;
         let adj = mesh.adjacency();
@@ -846,16 +844,8 @@ impl Evaluator {
         let mut target_which = 0;
         for f in 0..mesh.nf() {
             let ch = children(mesh, scheme, f);
-            let which = if f == t {
-                Some(match pick {
-                    ChildPick::Index(i) => i,
-                    ChildPick::Param(u, v) => best_child(&ch, u, v),
-                })
-            } else {
-                None
-            };
             for (i, c) in ch.into_iter().enumerate() {
-                if which == Some(i) {
+                if f == t && i == which {
                     target = cfaces.len();
                     target_which = i;
                 }
@@ -1059,12 +1049,6 @@ fn make_node(mesh: LocalMesh, t: usize, scheme: Scheme) -> Node {
             kids: Box::new(std::array::from_fn(|_| OnceLock::new())),
         },
     }
-}
-
-#[derive(Clone, Copy)]
-enum ChildPick {
-    Index(usize),
-    Param(f64, f64),
 }
 
 fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
