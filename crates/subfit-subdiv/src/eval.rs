@@ -361,7 +361,7 @@ pub struct Evaluator {
 /// Local refinement levels whose results are memoised per patch: evaluations reuse the refined
 /// neighbourhoods and the regular sub-patches of the first `CACHE_DEPTH` levels (memory: up to a
 /// few tens of kB per irregular patch that has been evaluated near its irregular corners).
-const CACHE_DEPTH: u32 = 4;
+pub const CACHE_DEPTH: u32 = 4;
 
 /// A node of a patch's memoised local-refinement tree.
 #[derive(Clone, Debug)]
@@ -638,8 +638,11 @@ impl Evaluator {
     ///
     /// Errors: out-of-range face/sub-patch, parameters outside the domain (by more than 1e-9;
     /// smaller excursions are clamped). Cost: one small dense product for a regular patch
-    /// (~1 µs); near an irregular vertex one local refinement per halving of the distance to it
-    /// (about `log2(1/distance)` levels of a ~50-vertex neighbourhood, ~10–30 µs each).
+    /// (a few µs); in an irregular patch about one local refinement per halving of the distance
+    /// to the irregular vertex (`log2(1/distance)` levels of a ~30–60-vertex neighbourhood). The
+    /// first [`CACHE_DEPTH`] levels are memoised per patch, so only the first evaluation near a
+    /// given corner pays for them; deeper levels reuse one local subdivision matrix once the
+    /// neighbourhood is self-similar. Thread-safe (`&self`; memoisation uses `OnceLock`).
     pub fn weights(&self, p: SurfaceParam) -> Result<EvalWeights, EvalError> {
         let (mut u, mut v) = self.check(&p)?;
         let scheme = self.options.scheme;
