@@ -1,0 +1,370 @@
+//! Assembly of the normal equations of the quadratic model (Cheng et al. 2007, §II-B step 5–6,
+//! §III-B; DESIGN.md §3.3, §6).
+//!
+//! With samples `S_k = Σ_i c_ki P_i` (rows of the sampling operator), frozen foot points `V_k`
+//! and error matrices `Q_k` ([`crate::terms`]), the model of eq. 2 is
+//!
+//! ```text
+//! F_L(P) = 1/m Σ_k (S_k − V_k)ᵀ Q_k (S_k − V_k) + λ/n ‖L P‖²
+//! ```
+//!
+//! whose Hessian is `2H` with `H = 1/m Σ_k (c_k c_kᵀ) ⊗ Q_k + λ/n · LᵀL ⊗ I3` and whose gradient
+//! is `2g` with `g = 1/m Σ_k c_k ⊗ Q_k (S_k − V_k) + λ/n · (LᵀL ⊗ I3) P`. `H` is stored as the
+//! upper triangle of a scalar CSC matrix (`3n × 3n`, or `n × n` for PD where `Q = I` and the
+//! system separates into one scalar system with three right-hand sides).
+//!
+//! The [`Pattern`] (union of the `c_k c_kᵀ` and `LᵀL` patterns) is built once per control-mesh
+//! topology; each iteration [`Pattern::fill`] writes values in place, in parallel over block
+//! columns (each rayon task owns one column's slice of the value array and scatters through a
+//! per-thread index map), so there is no triplet re-assembly and nothing dense of size `n²`.
+
+use rayon::prelude::*;
+use subfit_subdiv::StencilMatrix;
+
+use crate::smooth::Laplacian;
+use crate::terms::{mul, Mat3};
+
+/// Sparsity pattern of the normal matrix `H` (upper triangle, CSC) with the index structures
+/// that let values be filled in place.
+///
+/// Storage: block column `j` lists its block rows `i ≤ j` in increasing order (the diagonal
+/// block last). Scalar column `b·j + c` (`b` = block size, 3 or 1) stores, for each
+/// off-diagonal block row `i`, the `b` rows `b·i .. b·i + b`, then the diagonal rows
+/// `b·j ..= b·j + c`.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    n: usize,
+    block: usize,
+    bcol_ptr: Vec<usize>,
+    brow: Vec<u32>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    diag_slots: Vec<usize>,
+    /// Transposed sampling operator: samples touching control point `j` with weight `c_kj`.
+    samp_ptr: Vec<usize>,
+    samp: Vec<(u32, f64)>,
+    lap: Laplacian,
+    lap_t: Laplacian,
+}
+
+impl Pattern {
+    /// Builds the pattern for the sampling operator `position` (`m × n` limit stencils) and the
+    /// smoothing operator `lap` (`n × n`), with block size `block` (3 for TD/SD, 1 for PD).
+    ///
+    /// Cost: O(Σ_k s_k² + nnz(LᵀL)) with `s_k` the row lengths, parallel over columns; memory
+    /// O(nnz(C) + nnz(H)).
+    ///
+    /// # Panics
+    /// If `block` is not 1 or 3, or the operator and Laplacian sizes differ.
+    #[track_caller]
+    pub fn new(position: &StencilMatrix, lap: &Laplacian, block: usize) -> Self {
+        assert!(block == 1 || block == 3, "block size must be 1 or 3");
+        let n = position.ncols();
+        assert_eq!(
+            lap.len(),
+            n,
+            "Laplacian size differs from the control-point count"
+        );
+        let (samp_ptr, samp) = transpose_operator(position);
+        let lap_t = lap.transpose();
+
+        // Block rows of each block column (i ≤ j), in parallel with a per-thread marker.
+        let cols: Vec<Vec<u32>> = (0..n)
+            .into_par_iter()
+            .map_init(
+                || vec![u32::MAX; n],
+                |mark, j| {
+                    let mut rows = Vec::new();
+                    let mut visit = |i: u32| {
+                        if i as usize <= j && mark[i as usize] != j as u32 {
+                            mark[i as usize] = j as u32;
+                            rows.push(i);
+                        }
+                    };
+                    for &(k, _) in &samp[samp_ptr[j]..samp_ptr[j + 1]] {
+                        position.row(k as usize).0.iter().for_each(|&i| visit(i));
+                    }
+                    let (rs, _) = lap_t.row(j);
+                    for &r in rs {
+                        lap.row(r as usize).0.iter().for_each(|&i| visit(i));
+                    }
+                    visit(j as u32);
+                    rows.sort_unstable();
+                    rows
+                },
+            )
+            .collect();
+
+        let mut bcol_ptr = Vec::with_capacity(n + 1);
+        bcol_ptr.push(0);
+        let mut brow = Vec::new();
+        for c in &cols {
+            brow.extend_from_slice(c);
+            bcol_ptr.push(brow.len());
+        }
+        drop(cols);
+
+        let b = block;
+        let mut col_ptr = Vec::with_capacity(b * n + 1);
+        let mut row_idx = Vec::new();
+        let mut diag_slots = Vec::with_capacity(b * n);
+        col_ptr.push(0);
+        for j in 0..n {
+            let rows = &brow[bcol_ptr[j]..bcol_ptr[j + 1]];
+            let (off, _) = rows.split_at(rows.len() - 1);
+            for c in 0..b {
+                for &i in off {
+                    for a in 0..b {
+                        row_idx.push(b * i as usize + a);
+                    }
+                }
+                for a in 0..=c {
+                    row_idx.push(b * j + a);
+                }
+                diag_slots.push(row_idx.len() - 1);
+                col_ptr.push(row_idx.len());
+            }
+        }
+        Self {
+            n,
+            block,
+            bcol_ptr,
+            brow,
+            col_ptr,
+            row_idx,
+            diag_slots,
+            samp_ptr,
+            samp,
+            lap: lap.clone(),
+            lap_t,
+        }
+    }
+
+    /// Number of control points `n`.
+    pub fn num_points(&self) -> usize {
+        self.n
+    }
+
+    /// Block size (3: coupled coordinates; 1: PD, coordinates separate).
+    pub fn block(&self) -> usize {
+        self.block
+    }
+
+    /// Scalar dimension `b·n` of the system.
+    pub fn dim(&self) -> usize {
+        self.block * self.n
+    }
+
+    /// Number of stored scalar entries (upper triangle).
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// CSC column pointers (`dim + 1`).
+    pub fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+
+    /// CSC row indices (`nnz`), sorted within each column, all `≤` the column.
+    pub fn row_idx(&self) -> &[usize] {
+        &self.row_idx
+    }
+
+    /// The value slot of each scalar diagonal entry (`dim`).
+    pub fn diag_slots(&self) -> &[usize] {
+        &self.diag_slots
+    }
+
+    /// The smoothing operator the pattern was built with.
+    pub fn laplacian(&self) -> &Laplacian {
+        &self.lap
+    }
+
+    /// Writes `H = w_e Σ_k (c_k c_kᵀ) ⊗ Q_k + w_s LᵀL ⊗ I` into `values` (`nnz`), overwriting.
+    /// For block size 1 the `Q_k` are ignored (taken as `I`; PD). Typically `w_e = 1/m`,
+    /// `w_s = λ/n`.
+    ///
+    /// Cost: O(Σ_k s_k² · b²), parallel over block columns; no allocation besides one index map
+    /// of `n` entries per rayon thread.
+    ///
+    /// # Panics
+    /// If `values.len() != nnz`, or (block 3) `q.len()` is not the sample count.
+    #[track_caller]
+    pub fn fill(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        w_e: f64,
+        w_s: f64,
+        values: &mut [f64],
+    ) {
+        assert_eq!(values.len(), self.nnz(), "values length differs from nnz");
+        if self.block == 3 {
+            assert_eq!(q.len(), position.nrows(), "one Q per sample");
+        }
+        let b = self.block;
+        // Split the value array into one slice per block column.
+        let mut chunks: Vec<&mut [f64]> = Vec::with_capacity(self.n);
+        let mut rest = values;
+        for j in 0..self.n {
+            let len = self.col_ptr[b * j + b] - self.col_ptr[b * j];
+            let (head, tail) = rest.split_at_mut(len);
+            chunks.push(head);
+            rest = tail;
+        }
+        chunks.into_par_iter().enumerate().for_each_init(
+            || vec![u32::MAX; self.n],
+            |pos, (j, chunk)| {
+                chunk.fill(0.0);
+                let rows = &self.brow[self.bcol_ptr[j]..self.bcol_ptr[j + 1]];
+                for (p, &i) in rows.iter().enumerate() {
+                    pos[i as usize] = p as u32;
+                }
+                let nb = rows.len();
+                let base = self.col_ptr[b * j];
+                let offs: [usize; 3] = std::array::from_fn(|c| {
+                    if c < b {
+                        self.col_ptr[b * j + c] - base
+                    } else {
+                        0
+                    }
+                });
+                let mut add = |i: usize, w: f64, qm: Option<&Mat3>| {
+                    let p = pos[i] as usize;
+                    if b == 1 {
+                        chunk[offs[0] + p] += w;
+                        return;
+                    }
+                    let qm = qm.expect("Q for block size 3");
+                    if p + 1 < nb {
+                        for c in 0..3 {
+                            let o = offs[c] + 3 * p;
+                            for a in 0..3 {
+                                chunk[o + a] += w * qm[a][c];
+                            }
+                        }
+                    } else {
+                        for c in 0..3 {
+                            let o = offs[c] + 3 * (nb - 1);
+                            for a in 0..=c {
+                                chunk[o + a] += w * qm[a][c];
+                            }
+                        }
+                    }
+                };
+                for &(k, ckj) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+                    let (idx, wts) = position.row(k as usize);
+                    let qk = if b == 3 { Some(&q[k as usize]) } else { None };
+                    for (&i, &cki) in idx.iter().zip(wts) {
+                        if i as usize <= j {
+                            add(i as usize, w_e * cki * ckj, qk);
+                        }
+                    }
+                }
+                if w_s != 0.0 {
+                    const I3: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                    let (rs, lrj) = self.lap_t.row(j);
+                    for (&r, &lrj) in rs.iter().zip(lrj) {
+                        let (idx, wts) = self.lap.row(r as usize);
+                        for (&i, &lri) in idx.iter().zip(wts) {
+                            if i as usize <= j {
+                                add(i as usize, w_s * lri * lrj, Some(&I3));
+                            }
+                        }
+                    }
+                }
+                for &i in rows {
+                    pos[i as usize] = u32::MAX;
+                }
+            },
+        );
+    }
+
+    /// The half-gradient `g = w_e Σ_k c_k ⊗ r_k + w_s (LᵀL ⊗ I) P` (`n by 3`), where
+    /// `r_k = Q_k (S_k − V_k)` are the per-sample weighted residuals (`m by 3`).
+    /// Cost: O(nnz(C) + nnz(L)), parallel over control points.
+    ///
+    /// # Panics
+    /// If the lengths do not match the pattern.
+    #[track_caller]
+    pub fn gradient(&self, r: &[[f64; 3]], p: &[[f64; 3]], w_e: f64, w_s: f64) -> Vec<[f64; 3]> {
+        assert_eq!(p.len(), self.n, "one control point per column");
+        let lp = if w_s != 0.0 {
+            self.lap.apply(p)
+        } else {
+            Vec::new()
+        };
+        (0..self.n)
+            .into_par_iter()
+            .map(|j| {
+                let mut g = [0.0; 3];
+                for &(k, c) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+                    let rk = r[k as usize];
+                    for a in 0..3 {
+                        g[a] += w_e * c * rk[a];
+                    }
+                }
+                if w_s != 0.0 {
+                    let (rs, lrj) = self.lap_t.row(j);
+                    for (&row, &l) in rs.iter().zip(lrj) {
+                        for a in 0..3 {
+                            g[a] += w_s * l * lp[row as usize][a];
+                        }
+                    }
+                }
+                g
+            })
+            .collect()
+    }
+
+    /// The stored entries as `(row, col, value)` with `row ≤ col` (tests, diagnostics).
+    /// Cost: O(nnz).
+    pub fn triplets(&self, values: &[f64]) -> Vec<(usize, usize, f64)> {
+        let mut out = Vec::with_capacity(self.nnz());
+        for c in 0..self.dim() {
+            let r = self.col_ptr[c]..self.col_ptr[c + 1];
+            for (&row, &v) in self.row_idx[r.clone()].iter().zip(&values[r]) {
+                out.push((row, c, v));
+            }
+        }
+        out
+    }
+}
+
+/// Per-sample weighted residuals `r_k = Q_k (S_k − V_k)` (block 3) or `S_k − V_k` (PD).
+pub fn weighted_residuals(s: &[[f64; 3]], v: &[[f64; 3]], q: Option<&[Mat3]>) -> Vec<[f64; 3]> {
+    s.par_iter()
+        .zip(v.par_iter())
+        .enumerate()
+        .map(|(k, (s, v))| {
+            let e = [s[0] - v[0], s[1] - v[1], s[2] - v[2]];
+            match q {
+                Some(q) => mul(&q[k], e),
+                None => e,
+            }
+        })
+        .collect()
+}
+
+/// Columns of a CSR operator: for each column `j`, the `(row, weight)` pairs.
+fn transpose_operator(c: &StencilMatrix) -> (Vec<usize>, Vec<(u32, f64)>) {
+    let n = c.ncols();
+    let mut ptr = vec![0usize; n + 1];
+    for &j in c.indices() {
+        ptr[j as usize + 1] += 1;
+    }
+    for j in 0..n {
+        ptr[j + 1] += ptr[j];
+    }
+    let mut next = ptr.clone();
+    let mut out = vec![(0u32, 0.0); c.nnz()];
+    for k in 0..c.nrows() {
+        let (idx, w) = c.row(k);
+        for (&j, &w) in idx.iter().zip(w) {
+            let s = &mut next[j as usize];
+            out[*s] = (k as u32, w);
+            *s += 1;
+        }
+    }
+    (ptr, out)
+}

@@ -1,0 +1,485 @@
+//! The fitting loop (Cheng et al. 2007, §II-B steps 4–7 and §III-C; DESIGN.md §1, §3.3–3.4):
+//! sample `S = C·P`, project onto the target, assemble the PD/TD/SD model, solve with the
+//! reused sparse Cholesky, then accept the step as it is, by the LM gain ratio, or by Armijo
+//! backtracking — both judged on the true objective with fresh foot points.
+
+use std::time::{Duration, Instant};
+
+use rayon::prelude::*;
+use subfit_mesh::{PolyMesh, Polygons, Tags};
+use subfit_subdiv::{sampling_operator, Options, SamplingOperator};
+use subfit_target::{FootPoint, Target};
+
+use crate::assemble::{weighted_residuals, Pattern};
+use crate::error::{FitError, Phase};
+use crate::options::{FitOptions, Method, StepControl};
+use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
+use crate::smooth::Laplacian;
+use crate::solve::{CholeskySolver, SolveFailure};
+use crate::terms::{error_matrix, Mat3};
+
+/// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
+const MU_MAX: f64 = 1e16;
+
+/// Samples and foot points of one set of control points.
+#[derive(Clone, Debug, Default)]
+struct State {
+    samples: Vec<[f64; 3]>,
+    feet: Vec<FootPoint>,
+    stats: ErrorStats,
+}
+
+/// A reusable fitter for one target and one control-mesh topology. Keeps the sampling operator,
+/// the pattern of the normal matrix, the symbolic Cholesky factorization and all buffers
+/// between iterations and between calls to [`Fitter::run`] (STYLE.md rule 3).
+pub struct Fitter<'t> {
+    target: &'t Target,
+    options: FitOptions,
+    op: SamplingOperator,
+    pattern: Pattern,
+    solver: CholeskySolver,
+    values: Vec<f64>,
+    hdiag: Vec<f64>,
+    q: Vec<Mat3>,
+    bbox_diagonal: f64,
+    setup: Duration,
+}
+
+impl<'t> Fitter<'t> {
+    /// Prepares fitting `faces` (over `num_vertices` control points, with crease/corner `tags`)
+    /// to `target`. Builds the sampling operator at `options.sample_level`, the umbrella
+    /// Laplacian and the pattern of `H`. The control points themselves are given to
+    /// [`Self::run`], in the target's normalized coordinates.
+    ///
+    /// Errors: invalid options, invalid control topology (see [`subfit_subdiv::SubdivError`]).
+    /// Cost: dominated by the sampling operator and the pattern, O(m·s²) with `m` samples and
+    /// `s` ≈ 12–15 control points per sample.
+    pub fn new(
+        target: &'t Target,
+        faces: &Polygons,
+        num_vertices: usize,
+        tags: &Tags,
+        options: &FitOptions,
+    ) -> Result<Self, FitError> {
+        let t0 = Instant::now();
+        options
+            .validate()
+            .map_err(|(name, value)| FitError::BadOption { name, value })?;
+        if num_vertices == 0 || faces.is_empty() {
+            return Err(FitError::BadInput("no control points or no faces".into()));
+        }
+        let op = sampling_operator(
+            faces,
+            num_vertices,
+            tags,
+            &Options::new(options.scheme),
+            options.sample_level,
+        )?;
+        let lap = Laplacian::umbrella(faces, num_vertices);
+        let block = if options.method == Method::Pdm { 1 } else { 3 };
+        let pattern = Pattern::new(&op.position, &lap, block);
+        let values = vec![0.0; pattern.nnz()];
+        let bbox_diagonal = bbox_diagonal(target.points());
+        Ok(Self {
+            target,
+            options: options.clone(),
+            op,
+            pattern,
+            solver: CholeskySolver::new(),
+            values,
+            hdiag: Vec::new(),
+            q: Vec::new(),
+            bbox_diagonal,
+            setup: t0.elapsed(),
+        })
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &FitOptions {
+        &self.options
+    }
+
+    /// Changes `λ` (e.g. between stages); the pattern and factorization are kept.
+    pub fn set_lambda(&mut self, lambda: f64) {
+        self.options.lambda = lambda;
+    }
+
+    /// The sampling operator (`m × n` limit stencils at the sample level).
+    pub fn sampling_operator(&self) -> &SamplingOperator {
+        &self.op
+    }
+
+    /// The pattern of the normal matrix.
+    pub fn pattern(&self) -> &Pattern {
+        &self.pattern
+    }
+
+    /// Number of samples `m`.
+    pub fn num_samples(&self) -> usize {
+        self.op.position.nrows()
+    }
+
+    /// Errors of `control` (`n by 3`, normalized units) with fresh samples and foot points.
+    /// Cost: one `C·P` and `m` foot-point queries.
+    pub fn evaluate(&self, control: &[[f64; 3]]) -> ErrorStats {
+        let mut t = PhaseTimings::default();
+        self.state(control, &mut t).stats
+    }
+
+    fn state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State {
+        let t0 = Instant::now();
+        let samples = self.op.position.apply(control);
+        let t1 = Instant::now();
+        let feet = self.target.foot_points(&samples);
+        let t2 = Instant::now();
+        let stats = self.stats(control, &samples, &feet);
+        t.sample += t1 - t0;
+        t.project += t2 - t1;
+        t.evaluate += t2.elapsed();
+        State {
+            samples,
+            feet,
+            stats,
+        }
+    }
+
+    fn stats(&self, control: &[[f64; 3]], s: &[[f64; 3]], feet: &[FootPoint]) -> ErrorStats {
+        let (sum, max) = s
+            .par_iter()
+            .zip(feet.par_iter())
+            .map(|(s, f)| {
+                let d2 = (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum::<f64>();
+                (d2, d2)
+            })
+            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+        let m = s.len().max(1) as f64;
+        let n = control.len().max(1) as f64;
+        let e_rms = (sum / m).sqrt();
+        let e_max = max.sqrt();
+        let smooth = if self.options.lambda > 0.0 {
+            self.options.lambda / n * self.pattern.laplacian().energy(control)
+        } else {
+            0.0
+        };
+        ErrorStats {
+            e_max,
+            e_rms,
+            e_max_diag: e_max / self.bbox_diagonal,
+            e_rms_diag: e_rms / self.bbox_diagonal,
+            objective: sum / m + smooth,
+        }
+    }
+
+    /// Fits: iterates on `control` (`n by 3`, normalized units; updated in place to the best
+    /// accepted control points) until a stopping rule of the options fires. `progress`, when
+    /// given, is called after each iteration.
+    ///
+    /// Errors: non-finite input or results, an indefinite system without LM damping.
+    /// Cost per iteration: one fill of `H` (O(m·s²)), one numeric Cholesky, `m` foot-point
+    /// queries per trial.
+    pub fn run(
+        &mut self,
+        control: &mut [[f64; 3]],
+        mut progress: Option<&mut dyn FnMut(&IterationRow)>,
+    ) -> Result<FitReport, FitError> {
+        let n = self.pattern.num_points();
+        if control.len() != n {
+            return Err(FitError::BadInput(format!(
+                "{} control points given, the mesh has {n}",
+                control.len()
+            )));
+        }
+        if control.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(FitError::NonFinite {
+                iteration: 0,
+                phase: Phase::Setup,
+                what: "initial control points",
+            });
+        }
+        let opts = self.options.clone();
+        let mut cur = self.state(control, &mut PhaseTimings::default());
+        check_finite(cur.stats.objective, 0, Phase::Evaluate, "objective")?;
+        let mut report = FitReport {
+            method: opts.method,
+            step: opts.step,
+            num_control_points: n,
+            num_samples: self.num_samples(),
+            initial: cur.stats,
+            iterations: Vec::new(),
+            stop: StopReason::MaxIterations,
+            setup: self.setup,
+        };
+        if self.reached(&cur.stats) {
+            report.stop = StopReason::Tolerance;
+            return Ok(report);
+        }
+        let mut mu = f64::NAN;
+        let mut nu = 2.0;
+        let mut grad: Vec<[f64; 3]> = Vec::new();
+        let mut stale = true;
+        let mut trial_p = vec![[0.0; 3]; n];
+        for it in 1..=opts.max_iterations {
+            let mut t = PhaseTimings::default();
+            if stale {
+                let t0 = Instant::now();
+                grad = self.assemble(control, &cur);
+                t.assemble += t0.elapsed();
+                stale = false;
+            }
+            let max_diag = self.hdiag.iter().fold(0.0f64, |a, &b| a.max(b));
+            let mean_diag = self.hdiag.iter().sum::<f64>() / self.hdiag.len().max(1) as f64;
+            let ridge = opts.ridge * mean_diag;
+            if opts.step == StepControl::LevenbergMarquardt && mu.is_nan() {
+                mu = opts.lm_tau * max_diag;
+            }
+            let damping = if opts.step == StepControl::LevenbergMarquardt {
+                mu
+            } else {
+                0.0
+            };
+            let shift = ridge + damping;
+            let t0 = Instant::now();
+            let delta = match self.solve_step(&grad, shift) {
+                Ok(d) => d,
+                Err(SolveFailure::NotPositiveDefinite { index }) => {
+                    if opts.step == StepControl::LevenbergMarquardt && mu < MU_MAX * max_diag {
+                        mu *= nu;
+                        nu *= 2.0;
+                        continue;
+                    }
+                    return Err(FitError::NotPositiveDefinite {
+                        iteration: it,
+                        phase: Phase::Solve,
+                        pivot: index,
+                        damping,
+                        mean_diagonal: mean_diag,
+                    });
+                }
+                Err(SolveFailure::Other(s)) => return Err(FitError::Solver(s)),
+            };
+            t.solve += t0.elapsed();
+            if delta.iter().flatten().any(|x| !x.is_finite()) {
+                return Err(FitError::NonFinite {
+                    iteration: it,
+                    phase: Phase::Solve,
+                    what: "solution of the normal equations",
+                });
+            }
+            // g·δ: the directional derivative of the model is 2 g·δ.
+            let gd: f64 = grad
+                .iter()
+                .zip(&delta)
+                .map(|(g, d)| g[0] * d[0] + g[1] * d[1] + g[2] * d[2])
+                .sum();
+            let dd: f64 = delta.iter().flatten().map(|x| x * x).sum();
+            let f0 = cur.stats.objective;
+            let mut step_length = 1.0;
+            let mut gain_ratio = f64::NAN;
+            let (accepted, trial) = loop {
+                for ((p, c), d) in trial_p.iter_mut().zip(control.iter()).zip(&delta) {
+                    *p = [
+                        c[0] + step_length * d[0],
+                        c[1] + step_length * d[1],
+                        c[2] + step_length * d[2],
+                    ];
+                }
+                let trial = self.state(&trial_p, &mut t);
+                check_finite(trial.stats.objective, it, Phase::Evaluate, "objective")?;
+                let f1 = trial.stats.objective;
+                match opts.step {
+                    StepControl::None => break (true, trial),
+                    StepControl::LevenbergMarquardt => {
+                        let predicted = -gd + shift * dd;
+                        gain_ratio = (f0 - f1) / predicted;
+                        let ok = predicted > 0.0 && gain_ratio > 0.0;
+                        if ok {
+                            mu *= (1.0f64 / 3.0).max(1.0 - (2.0 * gain_ratio - 1.0).powi(3));
+                            nu = 2.0;
+                        } else {
+                            mu *= nu;
+                            nu *= 2.0;
+                        }
+                        break (ok, trial);
+                    }
+                    StepControl::Armijo => {
+                        if f1 <= f0 + opts.armijo_c1 * step_length * 2.0 * gd {
+                            break (true, trial);
+                        }
+                        let tries = (step_length.ln() / opts.armijo_beta.ln()).round() as usize;
+                        if tries >= opts.armijo_max_backtracks {
+                            break (false, trial);
+                        }
+                        step_length *= opts.armijo_beta;
+                    }
+                }
+            };
+            let trial_objective = trial.stats.objective;
+            if accepted {
+                control.copy_from_slice(&trial_p);
+                cur = trial;
+                stale = true;
+            }
+            let row = IterationRow {
+                iteration: it,
+                accepted,
+                errors: cur.stats,
+                trial_objective,
+                damping,
+                step_length,
+                gain_ratio,
+                timings: t,
+            };
+            report.iterations.push(row);
+            if let Some(cb) = progress.as_mut() {
+                cb(&row);
+            }
+            if self.reached(&cur.stats) {
+                report.stop = StopReason::Tolerance;
+                break;
+            }
+            if accepted && (f0 - trial_objective).abs() < opts.min_relative_decrease * f0 {
+                report.stop = StopReason::Stalled;
+                break;
+            }
+            let no_descent = match opts.step {
+                StepControl::LevenbergMarquardt => !accepted && mu > MU_MAX * max_diag,
+                StepControl::Armijo => !accepted,
+                StepControl::None => false,
+            };
+            if no_descent {
+                report.stop = StopReason::NoDescent;
+                break;
+            }
+        }
+        Ok(report)
+    }
+
+    fn reached(&self, s: &ErrorStats) -> bool {
+        (self.options.tolerance_rms > 0.0 && s.e_rms <= self.options.tolerance_rms)
+            || (self.options.tolerance_max > 0.0 && s.e_max <= self.options.tolerance_max)
+    }
+
+    /// Fills `H` (values and its diagonal copy) at the current state; returns `g`.
+    fn assemble(&mut self, control: &[[f64; 3]], cur: &State) -> Vec<[f64; 3]> {
+        let m = cur.samples.len().max(1) as f64;
+        let n = control.len().max(1) as f64;
+        let (w_e, w_s) = (1.0 / m, self.options.lambda / n);
+        let method = self.options.method;
+        let coupled = self.pattern.block() == 3;
+        if coupled {
+            self.q.resize(cur.feet.len(), [[0.0; 3]; 3]);
+            self.q
+                .par_iter_mut()
+                .zip(cur.feet.par_iter())
+                .for_each(|(q, f)| *q = error_matrix(method, f));
+        }
+        self.pattern
+            .fill(&self.op.position, &self.q, w_e, w_s, &mut self.values);
+        self.hdiag = self
+            .pattern
+            .diag_slots()
+            .iter()
+            .map(|&s| self.values[s])
+            .collect();
+        let v: Vec<[f64; 3]> = cur.feet.iter().map(|f| f.point).collect();
+        let q = if coupled { Some(&self.q[..]) } else { None };
+        let r = weighted_residuals(&cur.samples, &v, q);
+        self.pattern.gradient(&r, control, w_e, w_s)
+    }
+
+    /// Solves `(H + shift·I) δ = −g`.
+    fn solve_step(&mut self, g: &[[f64; 3]], shift: f64) -> Result<Vec<[f64; 3]>, SolveFailure> {
+        for (&s, &h) in self.pattern.diag_slots().iter().zip(&self.hdiag) {
+            self.values[s] = h + shift;
+        }
+        let n = g.len();
+        let mut rhs = vec![0.0; 3 * n];
+        let coupled = self.pattern.block() == 3;
+        for (i, gi) in g.iter().enumerate() {
+            for (a, &ga) in gi.iter().enumerate() {
+                let idx = if coupled { 3 * i + a } else { a * n + i };
+                rhs[idx] = -ga;
+            }
+        }
+        let nrhs = if coupled { 1 } else { 3 };
+        self.solver
+            .solve(&self.pattern, &self.values, &mut rhs, nrhs)?;
+        Ok((0..n)
+            .map(|i| {
+                std::array::from_fn(|a| {
+                    if coupled {
+                        rhs[3 * i + a]
+                    } else {
+                        rhs[a * n + i]
+                    }
+                })
+            })
+            .collect())
+    }
+}
+
+fn check_finite(
+    x: f64,
+    iteration: usize,
+    phase: Phase,
+    what: &'static str,
+) -> Result<(), FitError> {
+    if x.is_finite() {
+        Ok(())
+    } else {
+        Err(FitError::NonFinite {
+            iteration,
+            phase,
+            what,
+        })
+    }
+}
+
+fn bbox_diagonal(p: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for x in p {
+        for a in 0..3 {
+            lo[a] = lo[a].min(x[a]);
+            hi[a] = hi[a].max(x[a]);
+        }
+    }
+    let d = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
+    if d.is_finite() && d > 0.0 {
+        d
+    } else {
+        1.0
+    }
+}
+
+/// Result of the one-shot [`fit`].
+#[derive(Clone, Debug)]
+pub struct FitResult {
+    /// The fitted control points (`n by 3`, normalized units; map back with
+    /// [`Target::to_original`]).
+    pub control_points: Vec<[f64; 3]>,
+    /// The iteration log.
+    pub report: FitReport,
+}
+
+/// One-shot fit of `control_mesh` (positions in the target's normalized units, no creases)
+/// to `target` with `options`. See [`Fitter`] for reuse across calls and stages.
+pub fn fit(
+    target: &Target,
+    control_mesh: &PolyMesh,
+    options: &FitOptions,
+) -> Result<FitResult, FitError> {
+    let mut fitter = Fitter::new(
+        target,
+        &control_mesh.faces,
+        control_mesh.num_vertices(),
+        &Tags::new(),
+        options,
+    )?;
+    let mut control_points = control_mesh.positions.clone();
+    let report = fitter.run(&mut control_points, None)?;
+    Ok(FitResult {
+        control_points,
+        report,
+    })
+}

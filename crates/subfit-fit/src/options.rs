@@ -1,0 +1,222 @@
+//! Options of the fitting loop (Cheng et al. 2007, §II-B, §II-E, §III-C; DESIGN.md §3.4).
+
+use subfit_subdiv::Scheme;
+
+pub use crate::terms::Method;
+
+/// Step control on the true (re-projected) objective (Cheng 2007 §III-C).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum StepControl {
+    /// Take the minimizer of the quadratic model as it is (PDM, TDM, SDM).
+    None,
+    /// Levenberg–Marquardt damping `H + μI` with the gain ratio
+    /// `ρ = actual / predicted decrease` and the update of Madsen, Nielsen & Tingleff (2004):
+    /// accept when `ρ > 0`, then `μ ← μ·max(1/3, 1 − (2ρ − 1)³)`, `ν ← 2`; otherwise
+    /// `μ ← μν`, `ν ← 2ν`. The objective never increases. The default.
+    #[default]
+    LevenbergMarquardt,
+    /// Armijo backtracking on the step length `t ∈ {1, β, β², …}`:
+    /// accept the first `t` with `F(P + tδ) ≤ F(P) + c₁ t ∇Fᵀδ`.
+    Armijo,
+}
+
+/// The eight variants named in Cheng 2007 (§II-D, §IV-C).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Variant {
+    /// Point distance minimization, no step control.
+    Pdm,
+    /// Tangent distance minimization, no step control.
+    Tdm,
+    /// Squared distance minimization, no step control.
+    Sdm,
+    /// TDM with Levenberg–Marquardt damping.
+    TdmLm,
+    /// SDM with Levenberg–Marquardt damping.
+    SdmLm,
+    /// PDM with Armijo step control.
+    PdmSc,
+    /// TDM with Armijo step control.
+    TdmSc,
+    /// SDM with Armijo step control.
+    SdmSc,
+}
+
+impl Variant {
+    /// All eight variants, in the order above.
+    pub const ALL: [Variant; 8] = [
+        Variant::Pdm,
+        Variant::Tdm,
+        Variant::Sdm,
+        Variant::TdmLm,
+        Variant::SdmLm,
+        Variant::PdmSc,
+        Variant::TdmSc,
+        Variant::SdmSc,
+    ];
+
+    /// The error term and step control of the variant.
+    pub fn parts(self) -> (Method, StepControl) {
+        use StepControl as S;
+        match self {
+            Variant::Pdm => (Method::Pdm, S::None),
+            Variant::Tdm => (Method::Tdm, S::None),
+            Variant::Sdm => (Method::Sdm, S::None),
+            Variant::TdmLm => (Method::Tdm, S::LevenbergMarquardt),
+            Variant::SdmLm => (Method::Sdm, S::LevenbergMarquardt),
+            Variant::PdmSc => (Method::Pdm, S::Armijo),
+            Variant::TdmSc => (Method::Tdm, S::Armijo),
+            Variant::SdmSc => (Method::Sdm, S::Armijo),
+        }
+    }
+
+    /// The paper's name (`"PDM"`, `"SDMLM"`, `"TDMSC"`, …).
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Pdm => "PDM",
+            Variant::Tdm => "TDM",
+            Variant::Sdm => "SDM",
+            Variant::TdmLm => "TDMLM",
+            Variant::SdmLm => "SDMLM",
+            Variant::PdmSc => "PDMSC",
+            Variant::TdmSc => "TDMSC",
+            Variant::SdmSc => "SDMSC",
+        }
+    }
+}
+
+/// Options of [`crate::fit`] and [`crate::Fitter`]. All lengths are in the target's normalized
+/// units (the unit cube, Cheng 2007 §II-B step 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Subdivision scheme of the control mesh. Default [`Scheme::Loop`].
+    pub scheme: Scheme,
+    /// Refinement level `l` at which the limit surface is sampled (one sample per level-`l`
+    /// vertex, about `4^l ·` #faces samples for triangles). Default 3.
+    pub sample_level: usize,
+    /// Error term. Default [`Method::Sdm`].
+    pub method: Method,
+    /// Step control. Default [`StepControl::LevenbergMarquardt`].
+    pub step: StepControl,
+    /// Smoothing weight `λ` of `F_s = λ/n Σ|W(P_i)|²` (§II-E; dimensionless, as the error term
+    /// is a mean over samples). Default `1e-3` (the papers' starting value); 0 disables it.
+    pub lambda: f64,
+    /// Maximum number of iterations (solves; rejected LM / Armijo trials count). Default 20.
+    pub max_iterations: usize,
+    /// Stop when `E_rms` (normalized units) falls to or below this. Default 0 (off).
+    pub tolerance_rms: f64,
+    /// Stop when `E_max` (normalized units) falls to or below this. Default 0 (off).
+    pub tolerance_max: f64,
+    /// Stop when an accepted iteration lowers the objective by less than this fraction of it.
+    /// Default `1e-9`.
+    pub min_relative_decrease: f64,
+    /// Tikhonov shift added to the diagonal of `H`, relative to the mean diagonal entry; keeps
+    /// TD systems (rank-deficient tangentially without smoothing) factorizable. Dimensionless.
+    /// Default `1e-9`.
+    pub ridge: f64,
+    /// LM: initial damping `μ₀ = τ · max diag(H)` (Madsen–Nielsen–Tingleff `τ`). Default `1e-3`.
+    pub lm_tau: f64,
+    /// Armijo: sufficient-decrease constant `c₁`. Default `1e-4`.
+    pub armijo_c1: f64,
+    /// Armijo: backtracking factor `β ∈ (0, 1)`. Default 0.5.
+    pub armijo_beta: f64,
+    /// Armijo: maximum number of halvings per iteration. Default 12.
+    pub armijo_max_backtracks: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            scheme: Scheme::Loop,
+            sample_level: 3,
+            method: Method::Sdm,
+            step: StepControl::LevenbergMarquardt,
+            lambda: 1e-3,
+            max_iterations: 20,
+            tolerance_rms: 0.0,
+            tolerance_max: 0.0,
+            min_relative_decrease: 1e-9,
+            ridge: 1e-9,
+            lm_tau: 1e-3,
+            armijo_c1: 1e-4,
+            armijo_beta: 0.5,
+            armijo_max_backtracks: 12,
+        }
+    }
+}
+
+impl FitOptions {
+    /// Default options with the method and step control of a paper variant.
+    pub fn variant(v: Variant) -> Self {
+        let (method, step) = v.parts();
+        Self {
+            method,
+            step,
+            ..Self::default()
+        }
+    }
+
+    /// Sets the smoothing weight `λ`.
+    pub fn with_lambda(mut self, lambda: f64) -> Self {
+        self.lambda = lambda;
+        self
+    }
+
+    /// Sets the maximum iteration count.
+    pub fn with_max_iterations(mut self, k: usize) -> Self {
+        self.max_iterations = k;
+        self
+    }
+
+    /// Sets the `E_rms` stopping tolerance (normalized units).
+    pub fn with_tolerance_rms(mut self, t: f64) -> Self {
+        self.tolerance_rms = t;
+        self
+    }
+
+    /// Sets the sample level.
+    pub fn with_sample_level(mut self, l: usize) -> Self {
+        self.sample_level = l;
+        self
+    }
+
+    /// Sets the subdivision scheme.
+    pub fn with_scheme(mut self, s: Scheme) -> Self {
+        self.scheme = s;
+        self
+    }
+
+    /// Checks value ranges; returns the offending field's name and value.
+    pub(crate) fn validate(&self) -> Result<(), (&'static str, f64)> {
+        let checks: [(&'static str, f64, bool); 7] = [
+            ("lambda", self.lambda, self.lambda >= 0.0),
+            (
+                "tolerance_rms",
+                self.tolerance_rms,
+                self.tolerance_rms >= 0.0,
+            ),
+            (
+                "tolerance_max",
+                self.tolerance_max,
+                self.tolerance_max >= 0.0,
+            ),
+            ("ridge", self.ridge, self.ridge >= 0.0),
+            ("lm_tau", self.lm_tau, self.lm_tau > 0.0),
+            (
+                "armijo_c1",
+                self.armijo_c1,
+                self.armijo_c1 > 0.0 && self.armijo_c1 < 1.0,
+            ),
+            (
+                "armijo_beta",
+                self.armijo_beta,
+                self.armijo_beta > 0.0 && self.armijo_beta < 1.0,
+            ),
+        ];
+        for (name, v, ok) in checks {
+            if !ok || !v.is_finite() {
+                return Err((name, v));
+            }
+        }
+        Ok(())
+    }
+}

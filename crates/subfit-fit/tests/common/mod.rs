@@ -1,0 +1,55 @@
+//! Shared fixtures: the paper ellipsoid target and its 14-vertex initial control mesh.
+#![allow(dead_code)]
+
+use subfit_mesh::shapes::Shape;
+use subfit_mesh::{PolyMesh, Polygons};
+use subfit_target::{Target, TargetOptions};
+
+/// Semi-axes of Cheng 2007's ellipsoid (original units).
+pub const AXES: [f64; 3] = [0.25, 0.5, 1.0];
+
+/// The ellipsoid sampled with `n` points (with normals), as a target in the unit cube.
+pub fn ellipsoid_target(n: usize) -> Target {
+    let cloud = Shape::PAPER_ELLIPSOID.sample(n, 0.0, 7);
+    Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .expect("ellipsoid target")
+}
+
+/// A 14-vertex triangle mesh of the ellipsoid (original units): the octahedron
+/// `octahedron_mesh(a, b, c)` with each of its 8 faces split 1-to-3 at its centroid, the
+/// centroid pushed out radially onto the ellipsoid (6 + 8 = 14 vertices, 24 triangles; valences
+/// 8 and 3). Cheng 2007 Example 1 starts from a 14-point control mesh of this kind.
+pub fn fourteen_vertex_mesh() -> PolyMesh {
+    let [a, b, c] = AXES;
+    let octa = subfit_mesh::shapes::octahedron_mesh(a, b, c);
+    let mut pos = octa.positions.clone();
+    let mut faces = Polygons::new();
+    for f in octa.faces.iter() {
+        let cen: [f64; 3] = std::array::from_fn(|k| {
+            (octa.positions[f[0] as usize][k]
+                + octa.positions[f[1] as usize][k]
+                + octa.positions[f[2] as usize][k])
+                / 3.0
+        });
+        let s = ((cen[0] / a).powi(2) + (cen[1] / b).powi(2) + (cen[2] / c).powi(2)).sqrt();
+        let id = pos.len() as u32;
+        pos.push([cen[0] / s, cen[1] / s, cen[2] / s]);
+        for e in 0..3 {
+            faces.push(&[f[e], f[(e + 1) % 3], id]);
+        }
+    }
+    PolyMesh::new(pos, faces)
+}
+
+/// `mesh` mapped into the target's normalized coordinates.
+pub fn normalized(target: &Target, mesh: &PolyMesh) -> PolyMesh {
+    let mut m = mesh.clone();
+    for p in &mut m.positions {
+        *p = target.to_normalized(*p);
+    }
+    m
+}
