@@ -660,7 +660,7 @@ impl Evaluator {
                 Node::Failed => return Err(err(depth)),
                 Node::Regular(pc) => return Ok(pc.eval(scheme, u, v, a, depth)),
                 Node::Irregular { mesh, t, kids } => {
-                    if depth >= CACHE_DEPTH || self.at_corner(u, v) {
+                    if depth >= CACHE_DEPTH || self.irregular_corner(mesh, *t, u, v) {
                         return self.descend(mesh.clone(), *t, u, v, a, depth, p.face);
                     }
                     let ch = children(mesh, scheme, *t);
@@ -691,9 +691,18 @@ impl Evaluator {
         make_node(mesh, t, scheme)
     }
 
-    /// Whether `(u, v)` is exactly a corner of the patch domain.
-    fn at_corner(&self, u: f64, v: f64) -> bool {
-        (u == 0.0 || u == 1.0) && (v == 0.0 || v == 1.0) && !(self.triangular() && u + v > 1.0)
+    /// Whether `(u, v)` is exactly a corner of face `t` of `mesh` at an irregular vertex.
+    fn irregular_corner(&self, mesh: &LocalMesh, t: usize, u: f64, v: f64) -> bool {
+        let k = match (self.triangular(), u, v) {
+            (_, 0.0, 0.0) => 0,
+            (_, 1.0, 0.0) => 1,
+            (true, 0.0, 1.0) => 2,
+            (false, 1.0, 1.0) => 2,
+            (false, 0.0, 1.0) => 3,
+            _ => return false,
+        };
+        let adj = mesh.adjacency();
+        !corner_points(mesh, &adj, self.options.scheme, t, k, &mut |_, _| {})
     }
 
     /// Evaluation by repeated local refinement from `mesh` (face `t`, parameters `(u, v)`,
