@@ -80,21 +80,82 @@ pub(crate) fn estimate_point(
             }
         }
     };
-    let radius = nb.last().map_or(0.0, |n| n.distance);
-    let rel: Vec<[f64; 3]> = nb
+    let rel_all: Vec<[f64; 3]> = nb
         .iter()
         .map(|n| sub(points[n.index as usize], p))
         .collect();
-    // PCA about the centroid.
+    let (_, mut lam, mut vecs) = pca(&rel_all);
+    let mut m = rel_all.len();
+    // Adaptive scale: where the full neighbourhood is not surface-like (ambiguous, or large
+    // surface variation λ0/Σλ, e.g. it crosses a thin part), try the nearest SMALL_K. Only for
+    // `Knn`: a `Radius` neighbourhood is an explicit choice of scale (e.g. to average noise).
+    if prescribed.is_none() && matches!(hood, Neighborhood::Knn(_)) && m > SMALL_K {
+        let full_var = variation(&lam);
+        if lam[0] >= ambiguity_ratio * lam[1] || full_var > MAX_VARIATION {
+            let (_, lam2, vecs2) = pca(&rel_all[..SMALL_K]);
+            if variation(&lam2) < full_var {
+                (lam, vecs, m) = (lam2, vecs2, SMALL_K);
+            }
+        }
+    }
+    let used = &nb[..m];
+    let rel = &rel_all[..m];
+    let radius = used.last().map_or(0.0, |n| n.distance);
+    let ambiguous = prescribed.is_none() && lam[0] >= ambiguity_ratio * lam[1];
+    let n = prescribed
+        .or_else(|| normalize(vecs[0]))
+        .unwrap_or([0.0, 0.0, 1.0]);
+    let e1 =
+        normalize(sub(vecs[2], scale(n, dot(vecs[2], n)))).unwrap_or_else(|| any_orthogonal(n));
+    let h = if radius > 0.0 { radius } else { 1.0 };
+    let w: Vec<f64> = used
+        .iter()
+        .map(|n| (-(n.distance / h).powi(2)).exp())
+        .collect();
+    let (quadric, quality) = LocalQuadric::fit(n, e1, rel, &w, h, degree);
+    let graph = nb
+        .iter()
+        .filter(|n| n.index as usize != i)
+        .take(graph_k)
+        .map(|n| n.index)
+        .collect();
+    PointEstimate {
+        quadric,
+        quality,
+        ambiguous,
+        size: m as u32,
+        radius,
+        graph,
+    }
+}
+
+/// Size of the smaller neighbourhood tried where the full one is not surface-like.
+const SMALL_K: usize = 12;
+
+/// Surface variation above which the smaller neighbourhood is tried.
+const MAX_VARIATION: f64 = 0.05;
+
+/// Surface variation `λ0 / (λ0 + λ1 + λ2)` (Pauly et al. 2002), 0 for a plane, 1/3 at most.
+fn variation(lam: &[f64; 3]) -> f64 {
+    let s = lam[0] + lam[1] + lam[2];
+    if s > 0.0 {
+        lam[0] / s
+    } else {
+        0.0
+    }
+}
+
+/// Centroid (relative), eigenvalues (ascending) and eigenvectors of the covariance of `rel`.
+fn pca(rel: &[[f64; 3]]) -> ([f64; 3], [f64; 3], [[f64; 3]; 3]) {
     let inv = 1.0 / rel.len() as f64;
     let mut c = [0.0; 3];
-    for r in &rel {
+    for r in rel {
         for k in 0..3 {
             c[k] += r[k] * inv;
         }
     }
     let mut cv = [[0.0; 3]; 3];
-    for r in &rel {
+    for r in rel {
         let d = sub(*r, c);
         for a in 0..3 {
             for b in a..3 {
@@ -106,32 +167,7 @@ pub(crate) fn estimate_point(
     cv[2][0] = cv[0][2];
     cv[2][1] = cv[1][2];
     let (lam, vecs) = sym3_eigen(cv);
-    let ambiguous = prescribed.is_none() && lam[0] >= ambiguity_ratio * lam[1];
-    let n = prescribed
-        .or_else(|| normalize(vecs[0]))
-        .unwrap_or([0.0, 0.0, 1.0]);
-    let e1 =
-        normalize(sub(vecs[2], scale(n, dot(vecs[2], n)))).unwrap_or_else(|| any_orthogonal(n));
-    let h = if radius > 0.0 { radius } else { 1.0 };
-    let w: Vec<f64> = nb
-        .iter()
-        .map(|n| (-(n.distance / h).powi(2)).exp())
-        .collect();
-    let (quadric, quality) = LocalQuadric::fit(n, e1, &rel, &w, h, degree);
-    let graph = nb
-        .iter()
-        .filter(|n| n.index as usize != i)
-        .take(graph_k)
-        .map(|n| n.index)
-        .collect();
-    PointEstimate {
-        quadric,
-        quality,
-        ambiguous,
-        size: nb.len() as u32,
-        radius,
-        graph,
-    }
+    (c, lam, vecs)
 }
 
 /// [`estimate_point`] for all points in parallel, in chunks, calling `tick(done)` after each.

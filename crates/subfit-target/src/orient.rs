@@ -1,17 +1,30 @@
 //! Consistent normal orientation by minimum-spanning-tree propagation (Hoppe, DeRose, Duchamp,
-//! McDonald, Stuetzle 1992, "Surface reconstruction from unorganized points", §3.3).
+//! McDonald, Stuetzle 1992, "Surface reconstruction from unorganized points", §3.3), with three
+//! safeguards for sparse samplings of thin parts (where neighbourhoods cross sheets):
 //!
-//! The Riemannian graph is the symmetrized k-nearest-neighbour graph; an edge `(i, j)` costs
-//! `1 − |n_i·n_j|` (Hoppe), plus optionally `τ · (|n_i·ê| + |n_j·ê|)/2` with `ê` the unit edge
-//! direction: edges that leave the tangent plane (e.g. across a thin plate, where the unoriented
-//! normals are parallel and Hoppe's cost is 0) become expensive. Each connected component is
-//! seeded at its point of largest `z`, whose normal is oriented towards `+z` (outward for closed
-//! shapes), and orientation is propagated along the minimum spanning tree (Prim's algorithm).
+//! 1. **Edge cost.** The Riemannian graph is the (symmetrized) k-nearest-neighbour graph; an edge
+//!    `(i, j)` costs `1 − |n_i·n_j|` (Hoppe), plus `τ · (|n_i·ê| + |n_j·ê|)/2` with `ê` the unit
+//!    edge direction (edges leaving the tangent plane, e.g. across a thin plate where the
+//!    unoriented normals are parallel and Hoppe's cost is 0, become expensive), plus a penalty
+//!    per endpoint whose normal is ambiguous (those points are attached last, as leaves, instead
+//!    of relaying the orientation).
+//! 2. **Global sign per component.** The tree (Kruskal on sorted `f32` costs, union–find) is
+//!    traversed from an arbitrary seed; then the sign of each component is chosen so that
+//!    `Σ_i a_i n_i·(p_i − c)` (divergence theorem: 3 × the enclosed volume for a closed surface
+//!    with outward normals, `a_i` the area per point, `c` the centroid) is positive. When that sum
+//!    is not decisive, or the component does not look closed (`|Σ_i a_i n_i|` not small, as it is
+//!    for a closed surface), the point of largest `z` faces `+z` (ties `+x`, then `+y`).
+//! 3. **Consensus pass.** A point whose normal disagrees with the weighted majority of its
+//!    neighbours (weights `|n_i·n_j|` times the in-plane fraction of the edge, lower for
+//!    ambiguous neighbours) is flipped; repeated until stable (a few sweeps).
+//!
+//! Points with a prescribed (fixed) normal keep it and orient their components: they are merged
+//! into one tree root before Kruskal's algorithm. Cost O(E log E) for E = #P·k edges (parallel
+//! sort), the rest O(E).
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use rayon::prelude::*;
 
-use crate::vec3::{dot, normalize, scale, sub};
+use crate::vec3::{add, dot, norm, normalize, scale, sub};
 
 /// Outcome of [`orient_normals`].
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -22,146 +35,329 @@ pub struct Orientation {
     pub components: usize,
 }
 
-/// Orients `normals` in place (see the module doc). `graph[i]` lists neighbours of `i`; the
-/// graph is symmetrized here. Points with `fixed[i]` keep their normal and seed the propagation
-/// first (their components need no `+z` seed). Cost O(E log E) for E edges, serial.
+/// The k-nearest-neighbour graph: row `i` is `targets[i * stride .. (i + 1) * stride]`, padded
+/// with `u32::MAX` when a point has fewer neighbours. Self-loops are ignored.
+#[derive(Clone, Copy, Debug)]
+pub struct KnnGraph<'a> {
+    /// Neighbour indices, `#P · stride`.
+    pub targets: &'a [u32],
+    /// Entries per row (≥ 1).
+    pub stride: usize,
+}
+
+impl KnnGraph<'_> {
+    #[inline]
+    fn row(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+        self.targets[i * self.stride..(i + 1) * self.stride]
+            .iter()
+            .filter(move |&&j| j != u32::MAX && j as usize != i)
+            .map(|&j| j as usize)
+    }
+}
+
+/// Per-point inputs of [`orient_normals`] besides positions and normals.
+#[derive(Clone, Copy, Debug)]
+pub struct OrientInput<'a> {
+    /// Whether the point's normal is ambiguous (`#P`).
+    pub ambiguous: &'a [bool],
+    /// Whether the point's normal is prescribed and must be kept (`#P`).
+    pub fixed: &'a [bool],
+    /// Area weight of each point for the global sign (e.g. squared neighbourhood radius), `#P`.
+    pub area: &'a [f64],
+    /// Tangent penalty `τ ≥ 0` of the edge cost.
+    pub tangent_penalty: f64,
+}
+
+/// Cost added per ambiguous endpoint of an edge.
+const AMBIGUOUS_PENALTY: f64 = 1.0;
+/// A component is treated as closed when `|Σ a n| ≤ this · Σ a`.
+const MAX_FLUX: f64 = 0.25;
+/// Maximum number of consensus sweeps.
+const CONSENSUS_SWEEPS: usize = 8;
+/// The volume sum decides a component's sign when `|Σ a n·(p−c)| ≥ this · Σ a |n·(p−c)|`.
+const VOLUME_DECISIVE: f64 = 0.2;
+
+/// Orients `normals` (unit, `#P by 3`) in place; see the module doc.
 pub fn orient_normals(
     points: &[[f64; 3]],
     normals: &mut [[f64; 3]],
-    graph: &[Vec<u32>],
-    fixed: &[bool],
-    tangent_penalty: f64,
+    graph: KnnGraph<'_>,
+    input: &OrientInput<'_>,
 ) -> Orientation {
     let n = points.len();
-    // Symmetric adjacency in compressed rows.
-    let mut deg = vec![0u32; n + 1];
-    for (i, g) in graph.iter().enumerate() {
-        deg[i] += g.len() as u32;
-        for &j in g {
-            deg[j as usize] += 1;
-        }
-    }
-    let mut off = vec![0usize; n + 1];
-    for i in 0..n {
-        off[i + 1] = off[i] + deg[i] as usize;
-    }
-    let mut fill = off.clone();
-    let mut adj = vec![0u32; off[n]];
-    for (i, g) in graph.iter().enumerate() {
-        for &j in g {
-            adj[fill[i]] = j;
-            fill[i] += 1;
-            adj[fill[j as usize]] = i as u32;
-            fill[j as usize] += 1;
-        }
-    }
-    let cost = |a: usize, b: usize, normals: &[[f64; 3]]| -> f64 {
-        let mut c = 1.0 - dot(normals[a], normals[b]).abs();
-        if tangent_penalty > 0.0 {
-            if let Some(e) = normalize(sub(points[b], points[a])) {
-                c += tangent_penalty * 0.5 * (dot(normals[a], e).abs() + dot(normals[b], e).abs());
-            }
-        }
-        c.max(0.0)
-    };
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    order.sort_unstable_by(|&a, &b| points[b as usize][2].total_cmp(&points[a as usize][2]));
-    let mut visited = vec![false; n];
-    let mut flipped = vec![false; n];
-    let mut components = 0;
-    let mut heap: BinaryHeap<(Reverse<u64>, u32, u32)> = BinaryHeap::new();
-    if fixed.iter().any(|&f| f) {
-        for (i, _) in fixed.iter().enumerate().filter(|(_, &f)| f) {
-            visited[i] = true;
-        }
-        for (i, _) in fixed.iter().enumerate().filter(|(_, &f)| f) {
-            push_edges(i, &off, &adj, &visited, normals, &cost, &mut heap);
-        }
-        propagate(
-            &off,
-            &adj,
-            &mut visited,
-            &mut flipped,
-            normals,
-            &cost,
-            &mut heap,
-        );
-    }
-    for &seed in &order {
-        let seed = seed as usize;
-        if visited[seed] {
-            continue;
-        }
-        components += 1;
-        visited[seed] = true;
-        let nz = normals[seed];
-        // Seed faces +z; ties (horizontal normal) towards +x, then +y.
-        let key = if nz[2] != 0.0 {
-            nz[2]
-        } else if nz[0] != 0.0 {
-            nz[0]
-        } else {
-            nz[1]
-        };
-        if key < 0.0 {
-            normals[seed] = scale(nz, -1.0);
-            flipped[seed] = true;
-        }
-        push_edges(seed, &off, &adj, &visited, normals, &cost, &mut heap);
-        propagate(
-            &off,
-            &adj,
-            &mut visited,
-            &mut flipped,
-            normals,
-            &cost,
-            &mut heap,
-        );
-    }
+    let original: Vec<[f64; 3]> = normals.to_vec();
+    let tree = spanning_tree(points, normals, graph, input);
+    let components = propagate(points, normals, &tree, input);
+    consensus(points, normals, graph, input);
+    let flipped = normals
+        .par_iter()
+        .zip(&original)
+        .map(|(a, b)| dot(*a, *b) < 0.0)
+        .collect();
+    debug_assert_eq!(original.len(), n);
     Orientation {
         flipped,
         components,
     }
 }
 
-/// Prim's loop: grows the tree from the heap's frontier, orienting each new point like its parent.
-fn propagate(
-    off: &[usize],
-    adj: &[u32],
-    visited: &mut [bool],
-    flipped: &mut [bool],
-    normals: &mut [[f64; 3]],
-    cost: &impl Fn(usize, usize, &[[f64; 3]]) -> f64,
-    heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>,
-) {
-    while let Some((_, to, from)) = heap.pop() {
-        let (to, from) = (to as usize, from as usize);
-        if visited[to] {
-            continue;
+/// Edge cost (see the module doc), as an `f32` whose bits order like its value.
+fn edge_key(
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    a: usize,
+    b: usize,
+    inp: &OrientInput<'_>,
+) -> u32 {
+    let mut c = 1.0 - dot(normals[a], normals[b]).abs();
+    if inp.tangent_penalty > 0.0 {
+        if let Some(e) = normalize(sub(points[b], points[a])) {
+            c += inp.tangent_penalty * 0.5 * (dot(normals[a], e).abs() + dot(normals[b], e).abs());
         }
-        visited[to] = true;
-        if dot(normals[from], normals[to]) < 0.0 {
-            normals[to] = scale(normals[to], -1.0);
-            flipped[to] = true;
-        }
-        push_edges(to, off, adj, visited, normals, cost, heap);
     }
+    if inp.ambiguous[a] {
+        c += AMBIGUOUS_PENALTY;
+    }
+    if inp.ambiguous[b] {
+        c += AMBIGUOUS_PENALTY;
+    }
+    (c.max(0.0) as f32).to_bits()
 }
 
-fn push_edges(
-    from: usize,
-    off: &[usize],
-    adj: &[u32],
-    visited: &[bool],
+/// Minimum spanning forest in compressed rows: `(offsets, neighbours)`.
+struct Tree {
+    off: Vec<usize>,
+    adj: Vec<u32>,
+}
+
+fn find(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let p = parent[x as usize];
+        parent[x as usize] = parent[p as usize];
+        x = p;
+    }
+    x
+}
+
+/// Kruskal's algorithm on the kNN graph, fixed points pre-merged into one root.
+fn spanning_tree(
+    points: &[[f64; 3]],
     normals: &[[f64; 3]],
-    cost: &impl Fn(usize, usize, &[[f64; 3]]) -> f64,
-    heap: &mut BinaryHeap<(Reverse<u64>, u32, u32)>,
+    graph: KnnGraph<'_>,
+    inp: &OrientInput<'_>,
+) -> Tree {
+    let n = points.len();
+    let k = graph.stride;
+    // key = cost bits << 32 | slot (i * k + s).
+    let mut keys: Vec<u64> = (0..n)
+        .into_par_iter()
+        .flat_map_iter(|i| {
+            let row = &graph.targets[i * k..(i + 1) * k];
+            row.iter().enumerate().filter_map(move |(s, &j)| {
+                let j = j as usize;
+                // Keep one direction of mutual edges.
+                if j == u32::MAX as usize || j == i {
+                    return None;
+                }
+                if j < i && graph.targets[j * k..(j + 1) * k].contains(&(i as u32)) {
+                    return None;
+                }
+                let key = edge_key(points, normals, i, j, inp);
+                Some((u64::from(key) << 32) | (i * k + s) as u64)
+            })
+        })
+        .collect();
+    keys.par_sort_unstable();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut size = vec![1u32; n];
+    if let Some(f0) = inp.fixed.iter().position(|&f| f) {
+        for (i, _) in inp.fixed.iter().enumerate().filter(|(_, &f)| f) {
+            parent[i] = f0 as u32;
+        }
+    }
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(n);
+    for key in keys {
+        let slot = (key & 0xffff_ffff) as usize;
+        let (a, b) = ((slot / k) as u32, graph.targets[slot]);
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra == rb {
+            continue;
+        }
+        let (big, small) = if size[ra as usize] >= size[rb as usize] {
+            (ra, rb)
+        } else {
+            (rb, ra)
+        };
+        parent[small as usize] = big;
+        size[big as usize] += size[small as usize];
+        edges.push((a, b));
+        if edges.len() + 1 >= n {
+            break;
+        }
+    }
+    let mut off = vec![0usize; n + 1];
+    for &(a, b) in &edges {
+        off[a as usize + 1] += 1;
+        off[b as usize + 1] += 1;
+    }
+    for i in 0..n {
+        off[i + 1] += off[i];
+    }
+    let mut fill = off.clone();
+    let mut adj = vec![0u32; off[n]];
+    for &(a, b) in &edges {
+        adj[fill[a as usize]] = b;
+        fill[a as usize] += 1;
+        adj[fill[b as usize]] = a;
+        fill[b as usize] += 1;
+    }
+    Tree { off, adj }
+}
+
+/// Traverses the forest: components holding fixed points from those, the others from their
+/// highest point, then fixes each free component's global sign. Returns the component count.
+fn propagate(
+    points: &[[f64; 3]],
+    normals: &mut [[f64; 3]],
+    tree: &Tree,
+    inp: &OrientInput<'_>,
+) -> usize {
+    let n = points.len();
+    let mut visited = vec![false; n];
+    let mut stack: Vec<u32> = Vec::new();
+    let mut members: Vec<u32> = Vec::new();
+    let walk = |stack: &mut Vec<u32>,
+                members: &mut Vec<u32>,
+                visited: &mut [bool],
+                normals: &mut [[f64; 3]]| {
+        while let Some(a) = stack.pop() {
+            members.push(a);
+            let na = normals[a as usize];
+            for &b in &tree.adj[tree.off[a as usize]..tree.off[a as usize + 1]] {
+                let b = b as usize;
+                if visited[b] {
+                    continue;
+                }
+                visited[b] = true;
+                if dot(na, normals[b]) < 0.0 {
+                    normals[b] = scale(normals[b], -1.0);
+                }
+                stack.push(b as u32);
+            }
+        }
+    };
+    let mut components = 0;
+    if inp.fixed.iter().any(|&f| f) {
+        components += 1;
+        for (i, _) in inp.fixed.iter().enumerate().filter(|(_, &f)| f) {
+            visited[i] = true;
+            stack.push(i as u32);
+        }
+        walk(&mut stack, &mut members, &mut visited, normals);
+    }
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    order.par_sort_unstable_by(|&a, &b| points[b as usize][2].total_cmp(&points[a as usize][2]));
+    for &seed in &order {
+        if visited[seed as usize] {
+            continue;
+        }
+        components += 1;
+        visited[seed as usize] = true;
+        members.clear();
+        stack.push(seed);
+        walk(&mut stack, &mut members, &mut visited, normals);
+        if !component_sign(points, normals, &members, seed as usize, inp) {
+            for &m in &members {
+                normals[m as usize] = scale(normals[m as usize], -1.0);
+            }
+        }
+    }
+    components
+}
+
+/// Whether a free component's current orientation is to be kept (see the module doc).
+fn component_sign(
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    members: &[u32],
+    seed: usize,
+    inp: &OrientInput<'_>,
+) -> bool {
+    let mut c = [0.0; 3];
+    let mut wsum = 0.0;
+    for &m in members {
+        let w = inp.area[m as usize];
+        for k in 0..3 {
+            c[k] += w * points[m as usize][k];
+        }
+        wsum += w;
+    }
+    if wsum > 0.0 && members.len() >= 4 {
+        let c = scale(c, 1.0 / wsum);
+        let (mut s, mut a, mut spread, mut flux) = (0.0, 0.0, 0.0, [0.0; 3]);
+        for &m in members {
+            let m = m as usize;
+            let d = sub(points[m], c);
+            let t = inp.area[m] * dot(normals[m], d);
+            s += t;
+            a += t.abs();
+            spread += inp.area[m] * dot(d, d).sqrt();
+            flux = add(flux, scale(normals[m], inp.area[m]));
+        }
+        // Closed-looking (the area-weighted normals nearly cancel, as ∮ n dA = 0 for a closed
+        // surface), not flat, and one sign dominating. Open patches use the seed rule.
+        let closed = norm(flux) <= MAX_FLUX * wsum;
+        if closed && a > 1e-3 * spread && s.abs() >= VOLUME_DECISIVE * a {
+            return s > 0.0;
+        }
+    }
+    let nz = normals[seed];
+    let key = if nz[2] != 0.0 {
+        nz[2]
+    } else if nz[0] != 0.0 {
+        nz[0]
+    } else {
+        nz[1]
+    };
+    key >= 0.0
+}
+
+/// Flips points that disagree with the weighted majority of their neighbours, until stable.
+fn consensus(
+    points: &[[f64; 3]],
+    normals: &mut [[f64; 3]],
+    graph: KnnGraph<'_>,
+    inp: &OrientInput<'_>,
 ) {
-    for &to in &adj[off[from]..off[from + 1]] {
-        if !visited[to as usize] {
-            // Non-negative floats order like their bit patterns.
-            let w = cost(from, to as usize, normals).to_bits();
-            heap.push((Reverse(w), to, from as u32));
+    let n = points.len();
+    for _ in 0..CONSENSUS_SWEEPS {
+        let mut changed = 0usize;
+        for i in 0..n {
+            if inp.fixed[i] {
+                continue;
+            }
+            let ni = normals[i];
+            let mut s = 0.0;
+            for j in graph.row(i) {
+                let nj = normals[j];
+                let d = dot(ni, nj);
+                let mut w = d.abs();
+                if let Some(e) = normalize(sub(points[j], points[i])) {
+                    let off_plane = 0.5 * (dot(ni, e).abs() + dot(nj, e).abs());
+                    w *= (1.0 - off_plane).max(0.0);
+                }
+                if inp.ambiguous[j] {
+                    w *= 0.25;
+                }
+                s += w * d.signum();
+            }
+            if s < 0.0 {
+                normals[i] = scale(ni, -1.0);
+                changed += 1;
+            }
+        }
+        if changed == 0 {
+            break;
         }
     }
 }

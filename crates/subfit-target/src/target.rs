@@ -15,7 +15,7 @@ use crate::normalize::Normalization;
 use crate::options::{
     NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
 };
-use crate::orient::orient_normals;
+use crate::orient::{orient_normals, KnnGraph, OrientInput};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
 use crate::vec3::{add, cross, dot, normalize, scale, sub};
 
@@ -197,13 +197,31 @@ impl Target {
             _ => NormalOrigin::Mixed,
         };
         if n_fixed < np {
-            let graph: Vec<Vec<u32>> = estimates.into_iter().map(|e| e.graph).collect();
+            let stride = options.orientation_k;
+            let mut targets = vec![u32::MAX; np * stride];
+            targets
+                .par_chunks_mut(stride)
+                .zip(&estimates)
+                .for_each(|(row, e)| {
+                    for (r, &j) in row.iter_mut().zip(&e.graph) {
+                        *r = j;
+                    }
+                });
+            let ambiguous: Vec<bool> = estimates.iter().map(|e| e.ambiguous).collect();
+            let area: Vec<f64> = estimates.iter().map(|e| e.radius * e.radius).collect();
             let o = orient_normals(
                 &points,
                 &mut normals,
-                &graph,
-                &fixed,
-                options.orientation_tangent_penalty,
+                KnnGraph {
+                    targets: &targets,
+                    stride,
+                },
+                &OrientInput {
+                    ambiguous: &ambiguous,
+                    fixed: &fixed,
+                    area: &area,
+                    tangent_penalty: options.orientation_tangent_penalty,
+                },
             );
             for (q, &f) in quadrics.iter_mut().zip(&o.flipped) {
                 if f {
