@@ -1,0 +1,676 @@
+//! Topology-preserving mesh simplification by quadric-error edge collapse.
+//!
+//! Garland & Heckbert 1997 ("Surface simplification using quadric error metrics"): every vertex
+//! carries the sum of the area-weighted squared-distance quadrics of the planes of its faces;
+//! an edge `ab` costs `pᵀ(Q_a + Q_b)p` at the position `p` minimizing it (a 3×3 solve, with the
+//! endpoints and the midpoint as fallbacks); edges are collapsed cheapest first from a binary
+//! heap whose stale entries are recognised by per-vertex version stamps (lazy invalidation).
+//!
+//! A collapse is legal only when
+//! * it satisfies the **link condition** of Dey, Edelsbrunner, Guha & Nekhayev 1999
+//!   ("Topology preserving edge contraction"): `Lk(a) ∩ Lk(b) = Lk(ab)`. Boundaries are handled
+//!   as in that paper by a virtual vertex `ω` joined to every boundary vertex, so an interior edge
+//!   between two boundary vertices is never collapsed (it would pinch), boundary loops are never
+//!   closed or merged, and a boundary vertex is never moved into the interior;
+//! * no remaining face changes orientation: each changed face normal rotates by at most
+//!   [`SimplifyOptions::max_normal_rotation_deg`];
+//! * no remaining face becomes degenerate (shape quality below
+//!   [`SimplifyOptions::min_triangle_quality`], unless it was already that bad).
+//!
+//! Boundary edges add constraint planes through the edge, perpendicular to its face (weight
+//! [`SimplifyOptions::boundary_weight`] × edge length²), so boundaries keep their shape. When
+//! exactly one endpoint of an edge is on the boundary, the collapse keeps the boundary vertex
+//! where it is.
+//!
+//! Data structure: a flat triangle list with per-vertex face lists updated per collapse. Cost:
+//! `O(E log E)` overall; each collapse touches the two-ring of the kept vertex.
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons, TopologyError};
+
+/// Options of [`simplify`]. Lengths are in the mesh's units; the checks are scale-invariant.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimplifyOptions {
+    /// Stop when at most this many (referenced) vertices remain. Default 1000.
+    pub target_vertices: usize,
+    /// Largest allowed rotation of a face normal by one collapse, in degrees. Default 75
+    /// (valid `(0, 180)`; the task's "no flipped faces" is `< 90`).
+    pub max_normal_rotation_deg: f64,
+    /// Smallest allowed triangle quality `4√3·A / (l₁² + l₂² + l₃²)` (1 for equilateral, 0 for
+    /// degenerate) of a face changed by a collapse, unless the face was already worse. Default 0.02.
+    pub min_triangle_quality: f64,
+    /// Weight of the boundary constraint planes relative to face planes (both are multiplied by
+    /// an area: face area, or boundary edge length²). Default 100.
+    pub boundary_weight: f64,
+}
+
+impl Default for SimplifyOptions {
+    fn default() -> Self {
+        Self {
+            target_vertices: 1000,
+            max_normal_rotation_deg: 75.0,
+            min_triangle_quality: 0.02,
+            boundary_weight: 100.0,
+        }
+    }
+}
+
+/// What [`simplify`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SimplifyReport {
+    /// Referenced vertices of the input.
+    pub vertices_before: usize,
+    /// Vertices of the output.
+    pub vertices_after: usize,
+    /// Triangles of the input (after fan triangulation).
+    pub faces_before: usize,
+    /// Triangles of the output.
+    pub faces_after: usize,
+    /// Edge collapses performed.
+    pub collapses: usize,
+    /// Candidate collapses rejected by the link condition (would change the topology).
+    pub rejected_link: usize,
+    /// Candidates rejected because they join two boundary vertices through the interior, or
+    /// would close a boundary loop.
+    pub rejected_boundary: usize,
+    /// Candidates rejected because a face normal would rotate too far (fold-over).
+    pub rejected_flip: usize,
+    /// Candidates rejected because a face would become degenerate.
+    pub rejected_degenerate: usize,
+    /// Largest quadric error of a performed collapse, as an RMS distance to the accumulated
+    /// planes: `sqrt(pᵀQp / Σ weights)` (mesh units).
+    pub max_error: f64,
+    /// Whether `target_vertices` was reached; `false` means no legal collapse remained.
+    pub reached_target: bool,
+}
+
+/// Why [`simplify`] cannot run.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SimplifyError {
+    /// The input has no faces (a point cloud): contour it first.
+    #[error("the mesh has no faces")]
+    NoFaces,
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFinite {
+        /// The vertex.
+        vertex: usize,
+    },
+    /// The input is not a manifold, consistently oriented surface.
+    #[error("the mesh is not an oriented manifold: {0}")]
+    Topology(#[from] TopologyError),
+}
+
+/// Simplifies a manifold, oriented polygon mesh (faces are fan-triangulated) by
+/// topology-preserving quadric edge collapses until `options.target_vertices` vertices remain or
+/// no legal collapse is left (see the module docs). Genus, boundary loops and components are
+/// preserved; unreferenced input vertices are dropped.
+///
+/// Returns a compact triangle mesh (`#V' by 3` positions, re-indexed; attributes dropped) and a
+/// report. Cost: `O(E log E)` time, `O(V + F)` memory.
+pub fn simplify(
+    mesh: &PolyMesh,
+    options: &SimplifyOptions,
+) -> Result<(PolyMesh, SimplifyReport), SimplifyError> {
+    if mesh.faces.is_empty() {
+        return Err(SimplifyError::NoFaces);
+    }
+    if let Some(v) = mesh
+        .positions
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        return Err(SimplifyError::NonFinite { vertex: v });
+    }
+    let tris = mesh.faces.triangulate_fan();
+    let polys = Polygons::from_triangles(&tris);
+    HalfEdgeMesh::new(&polys, mesh.num_vertices())?;
+
+    let mut c = Collapser::new(mesh.positions.clone(), tris, options);
+    c.run(options.target_vertices);
+    Ok(c.finish())
+}
+
+/// Symmetric 4×4 quadric, upper triangle row by row:
+/// `[a00 a01 a02 a03 a11 a12 a13 a22 a23 a33]`.
+type Quadric = [f64; 10];
+
+fn plane_quadric(n: [f64; 3], p: [f64; 3], w: f64) -> Quadric {
+    let d = -dot(n, p);
+    let v = [n[0], n[1], n[2], d];
+    let mut q = [0.0; 10];
+    let mut k = 0;
+    for i in 0..4 {
+        for j in i..4 {
+            q[k] = w * v[i] * v[j];
+            k += 1;
+        }
+    }
+    q
+}
+
+fn add_q(a: &mut Quadric, b: &Quadric) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+}
+
+fn eval_q(q: &Quadric, p: [f64; 3]) -> f64 {
+    let [x, y, z] = p;
+    q[0] * x * x
+        + 2.0 * q[1] * x * y
+        + 2.0 * q[2] * x * z
+        + 2.0 * q[3] * x
+        + q[4] * y * y
+        + 2.0 * q[5] * y * z
+        + 2.0 * q[6] * y
+        + q[7] * z * z
+        + 2.0 * q[8] * z
+        + q[9]
+}
+
+/// Total plane weight (trace of the 3×3 block, since plane normals are unit).
+fn q_weight(q: &Quadric) -> f64 {
+    q[0] + q[4] + q[7]
+}
+
+/// Minimizer of the quadric: solves `A p = −b`; `None` when `A` is ill-conditioned.
+fn q_minimizer(q: &Quadric) -> Option<[f64; 3]> {
+    let a = [[q[0], q[1], q[2]], [q[1], q[4], q[5]], [q[2], q[5], q[7]]];
+    let b = [-q[3], -q[6], -q[8]];
+    let c0 = cross(a[1], a[2]);
+    let det = dot(a[0], c0);
+    let tr = q[0] + q[4] + q[7];
+    if !(det.abs() > 1e-9 * tr * tr * tr) {
+        return None;
+    }
+    // Cramer's rule via the adjugate (rows of the inverse are the cross products of columns).
+    let c1 = cross(a[2], a[0]);
+    let c2 = cross(a[0], a[1]);
+    let inv = 1.0 / det;
+    let p = [0, 1, 2].map(|k| (c0[k] * b[0] + c1[k] * b[1] + c2[k] * b[2]) * inv);
+    p.iter().all(|x| x.is_finite()).then_some(p)
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    cost: f64,
+    keep: u32,
+    remove: u32,
+    stamp_keep: u32,
+    stamp_remove: u32,
+    pos: [f64; 3],
+}
+
+impl PartialEq for Candidate {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Candidate {
+    /// Reversed, so that `BinaryHeap` pops the cheapest; ties broken by vertex ids.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .cost
+            .total_cmp(&self.cost)
+            .then_with(|| other.remove.cmp(&self.remove))
+            .then_with(|| other.keep.cmp(&self.keep))
+    }
+}
+
+enum Verdict {
+    Ok,
+    Link,
+    Boundary,
+    Flip,
+    Degenerate,
+}
+
+struct Collapser {
+    pos: Vec<[f64; 3]>,
+    quad: Vec<Quadric>,
+    /// Sum of the area-weighted normals of the input faces merged into each vertex.
+    vnormal: Vec<[f64; 3]>,
+    tris: Vec<[u32; 3]>,
+    face_alive: Vec<bool>,
+    vfaces: Vec<Vec<u32>>,
+    boundary: Vec<bool>,
+    stamp: Vec<u32>,
+    alive_vertices: usize,
+    heap: BinaryHeap<Candidate>,
+    min_cos: f64,
+    min_quality: f64,
+    min_area2: f64,
+    report: SimplifyReport,
+    scratch_a: Vec<u32>,
+    scratch_b: Vec<u32>,
+}
+
+impl Collapser {
+    fn new(pos: Vec<[f64; 3]>, tris: Vec<[u32; 3]>, options: &SimplifyOptions) -> Self {
+        let nv = pos.len();
+        let mut vfaces = vec![Vec::new(); nv];
+        for (f, t) in tris.iter().enumerate() {
+            for &v in t {
+                vfaces[v as usize].push(f as u32);
+            }
+        }
+        // Directed edges without a reverse are boundary edges (the input is oriented).
+        let mut directed: Vec<(u32, u32)> = tris
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .collect();
+        directed.sort_unstable();
+        let has = |a: u32, b: u32| directed.binary_search(&(a, b)).is_ok();
+        let mut quad = vec![[0.0; 10]; nv];
+        let mut boundary = vec![false; nv];
+        let mut vnormal = vec![[0.0; 3]; nv];
+        let mut diag2: f64 = 0.0;
+        for t in &tris {
+            let [p0, p1, p2] = t.map(|v| pos[v as usize]);
+            let n = cross(sub(p1, p0), sub(p2, p0));
+            let len = norm(n);
+            diag2 = diag2.max(dot(sub(p1, p0), sub(p1, p0)));
+            for &v in t {
+                vnormal[v as usize] = add(vnormal[v as usize], n);
+            }
+            if len > 0.0 {
+                let nu = scale(n, 1.0 / len);
+                let q = plane_quadric(nu, p0, 0.5 * len);
+                for &v in t {
+                    add_q(&mut quad[v as usize], &q);
+                }
+                for k in 0..3 {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    if !has(b, a) {
+                        boundary[a as usize] = true;
+                        boundary[b as usize] = true;
+                        let e = sub(pos[b as usize], pos[a as usize]);
+                        let m = cross(e, nu);
+                        let ml = norm(m);
+                        if ml > 0.0 {
+                            let w = options.boundary_weight * dot(e, e);
+                            let qb = plane_quadric(scale(m, 1.0 / ml), pos[a as usize], w);
+                            add_q(&mut quad[a as usize], &qb);
+                            add_q(&mut quad[b as usize], &qb);
+                        }
+                    }
+                }
+            }
+        }
+        let alive_vertices = vfaces.iter().filter(|f| !f.is_empty()).count();
+        let report = SimplifyReport {
+            vertices_before: alive_vertices,
+            faces_before: tris.len(),
+            ..SimplifyReport::default()
+        };
+        let nf = tris.len();
+        let mut c = Self {
+            pos,
+            quad,
+            vnormal,
+            tris,
+            face_alive: vec![true; nf],
+            vfaces,
+            boundary,
+            stamp: vec![0; nv],
+            alive_vertices,
+            heap: BinaryHeap::with_capacity(3 * nf / 2 + 16),
+            min_cos: options.max_normal_rotation_deg.to_radians().cos(),
+            min_quality: options.min_triangle_quality,
+            min_area2: (1e-14 * diag2.max(f64::MIN_POSITIVE)).powi(2),
+            report,
+            scratch_a: Vec::new(),
+            scratch_b: Vec::new(),
+        };
+        for &(a, b) in &directed {
+            if a < b || directed.binary_search(&(b, a)).is_err() {
+                c.push(a, b);
+            }
+        }
+        c
+    }
+
+    /// Sorted neighbours of `v` into `out`.
+    fn ring(&self, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        for &f in &self.vfaces[v as usize] {
+            for &u in &self.tris[f as usize] {
+                if u != v {
+                    out.push(u);
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+
+    fn push(&mut self, a: u32, b: u32) {
+        let (ai, bi) = (a as usize, b as usize);
+        let (keep, remove) = if self.boundary[bi] && !self.boundary[ai] {
+            (b, a)
+        } else {
+            (a, b)
+        };
+        let (ki, ri) = (keep as usize, remove as usize);
+        let mut q = self.quad[ki];
+        add_q(&mut q, &self.quad[ri]);
+        let pos = if self.boundary[ki] != self.boundary[ri] {
+            self.pos[ki]
+        } else {
+            let (pa, pb) = (self.pos[ki], self.pos[ri]);
+            let mid = scale(add(pa, pb), 0.5);
+            let len = norm(sub(pa, pb));
+            match q_minimizer(&q) {
+                Some(p) if norm(sub(p, mid)) <= 2.0 * len => p,
+                _ => [pa, pb, mid]
+                    .into_iter()
+                    .min_by(|x, y| eval_q(&q, *x).total_cmp(&eval_q(&q, *y)))
+                    .unwrap_or(mid),
+            }
+        };
+        let cost = eval_q(&q, pos).max(0.0);
+        self.heap.push(Candidate {
+            cost,
+            keep,
+            remove,
+            stamp_keep: self.stamp[ki],
+            stamp_remove: self.stamp[ri],
+            pos,
+        });
+    }
+
+    fn run(&mut self, target: usize) {
+        while self.alive_vertices > target {
+            let Some(c) = self.heap.pop() else { break };
+            let (k, r) = (c.keep as usize, c.remove as usize);
+            if self.stamp[k] != c.stamp_keep
+                || self.stamp[r] != c.stamp_remove
+                || self.vfaces[k].is_empty()
+                || self.vfaces[r].is_empty()
+            {
+                continue;
+            }
+            match self.check(c.keep, c.remove, c.pos) {
+                Verdict::Ok => self.collapse(&c),
+                Verdict::Link => self.report.rejected_link += 1,
+                Verdict::Boundary => self.report.rejected_boundary += 1,
+                Verdict::Flip => self.report.rejected_flip += 1,
+                Verdict::Degenerate => self.report.rejected_degenerate += 1,
+            }
+        }
+        self.report.reached_target = self.alive_vertices <= target;
+    }
+
+    /// Faces containing both `a` and `b`, and their third vertices.
+    fn edge_opposites(&self, a: u32, b: u32) -> ([u32; 2], usize) {
+        let mut opp = [u32::MAX; 2];
+        let mut n = 0;
+        for &f in &self.vfaces[a as usize] {
+            let t = self.tris[f as usize];
+            if t.contains(&b) {
+                if n < 2 {
+                    opp[n] = t.iter().copied().find(|&u| u != a && u != b).unwrap_or(a);
+                }
+                n += 1;
+            }
+        }
+        (opp, n)
+    }
+
+    fn check(&mut self, k: u32, r: u32, p: [f64; 3]) -> Verdict {
+        let (opp, n_opp) = self.edge_opposites(k, r);
+        if n_opp == 0 || n_opp > 2 {
+            return Verdict::Link;
+        }
+        let (ki, ri) = (k as usize, r as usize);
+        // ω (the virtual vertex behind the boundary) is in Lk(k) ∩ Lk(r) but not in Lk(kr)
+        // when both are boundary vertices and kr is an interior edge.
+        if self.boundary[ki] && self.boundary[ri] && n_opp == 2 {
+            return Verdict::Boundary;
+        }
+        // An isolated triangle (a boundary loop of length 3) would vanish.
+        if n_opp == 1 && self.vfaces[ki].len() == 1 && self.vfaces[ri].len() == 1 {
+            return Verdict::Boundary;
+        }
+        let mut ra = std::mem::take(&mut self.scratch_a);
+        let mut rb = std::mem::take(&mut self.scratch_b);
+        self.ring(k, &mut ra);
+        self.ring(r, &mut rb);
+        let link_ok = {
+            let opp = &opp[..n_opp.min(2)];
+            let (mut i, mut j) = (0, 0);
+            let mut ok = true;
+            while i < ra.len() && j < rb.len() {
+                match ra[i].cmp(&rb[j]) {
+                    Ordering::Less => i += 1,
+                    Ordering::Greater => j += 1,
+                    Ordering::Equal => {
+                        if !opp.contains(&ra[i]) {
+                            ok = false;
+                            break;
+                        }
+                        i += 1;
+                        j += 1;
+                    }
+                }
+            }
+            ok
+        };
+        self.scratch_a = ra;
+        self.scratch_b = rb;
+        if !link_ok {
+            return Verdict::Link;
+        }
+        // Lk(k) ∩ Lk(r) must not contain the edge between the two opposite vertices (the
+        // tetrahedron case): a face (k|r, c, d) would be duplicated.
+        if n_opp == 2 {
+            let (c, d) = (opp[0], opp[1]);
+            let dup = [ki, ri].iter().any(|&v| {
+                self.vfaces[v].iter().any(|&f| {
+                    let t = self.tris[f as usize];
+                    t.contains(&c) && t.contains(&d)
+                })
+            });
+            if dup {
+                return Verdict::Link;
+            }
+        }
+        for &v in &[k, r] {
+            for &f in &self.vfaces[v as usize] {
+                let t = self.tris[f as usize];
+                if t.contains(&k) && t.contains(&r) {
+                    continue;
+                }
+                let old = t.map(|u| self.pos[u as usize]);
+                let new = t.map(|u| {
+                    if u == k || u == r {
+                        p
+                    } else {
+                        self.pos[u as usize]
+                    }
+                });
+                let n_old = cross(sub(old[1], old[0]), sub(old[2], old[0]));
+                let n_new = cross(sub(new[1], new[0]), sub(new[2], new[0]));
+                let (l_old, l_new) = (norm(n_old), norm(n_new));
+                if !(l_new * l_new > self.min_area2) {
+                    return Verdict::Degenerate;
+                }
+                if l_old > 0.0 && dot(n_old, n_new) < self.min_cos * l_old * l_new {
+                    return Verdict::Flip;
+                }
+                // Against the accumulated input normals too, so that many small rotations
+                // cannot add up to a fold.
+                let reference = t.iter().fold([0.0; 3], |acc, &u| {
+                    let n = if u == k || u == r {
+                        add(self.vnormal[ki], self.vnormal[ri])
+                    } else {
+                        self.vnormal[u as usize]
+                    };
+                    let l = norm(n);
+                    if l > 0.0 {
+                        add(acc, scale(n, 1.0 / l))
+                    } else {
+                        acc
+                    }
+                });
+                if dot(reference, n_new) <= 0.0 {
+                    return Verdict::Flip;
+                }
+                let q_new = quality(&new, l_new);
+                if q_new < self.min_quality && q_new < quality(&old, l_old) {
+                    return Verdict::Degenerate;
+                }
+            }
+        }
+        Verdict::Ok
+    }
+
+    fn collapse(&mut self, c: &Candidate) {
+        let (k, r) = (c.keep, c.remove);
+        let (ki, ri) = (k as usize, r as usize);
+        let rfaces = std::mem::take(&mut self.vfaces[ri]);
+        for &f in &rfaces {
+            let fi = f as usize;
+            let t = self.tris[fi];
+            if t.contains(&k) {
+                self.face_alive[fi] = false;
+                for &u in &t {
+                    if u != r {
+                        self.vfaces[u as usize].retain(|&g| g != f);
+                    }
+                }
+            } else {
+                for u in self.tris[fi].iter_mut() {
+                    if *u == r {
+                        *u = k;
+                    }
+                }
+                self.vfaces[ki].push(f);
+            }
+        }
+        let q_r = self.quad[ri];
+        add_q(&mut self.quad[ki], &q_r);
+        self.pos[ki] = c.pos;
+        self.vnormal[ki] = add(self.vnormal[ki], self.vnormal[ri]);
+        self.boundary[ki] |= self.boundary[ri];
+        self.alive_vertices -= 1;
+        self.report.collapses += 1;
+        let w = q_weight(&self.quad[ki]);
+        if w > 0.0 {
+            self.report.max_error = self.report.max_error.max((c.cost / w).sqrt());
+        }
+        // Re-evaluate every edge around the kept vertex and its neighbours: costs around `k`
+        // changed, and rejected collapses nearby may have become legal.
+        let mut around = Vec::new();
+        self.ring(k, &mut around);
+        around.push(k);
+        for &v in &around {
+            self.stamp[v as usize] = self.stamp[v as usize].wrapping_add(1);
+        }
+        let mut ring = Vec::new();
+        for &v in &around {
+            self.ring(v, &mut ring);
+            for &u in &ring {
+                if u > v || !around.contains(&u) {
+                    self.push(v, u);
+                }
+            }
+        }
+    }
+
+    fn finish(self) -> (PolyMesh, SimplifyReport) {
+        let mut map = vec![u32::MAX; self.pos.len()];
+        let mut positions = Vec::with_capacity(self.alive_vertices);
+        let mut tris = Vec::new();
+        for (f, t) in self.tris.iter().enumerate() {
+            if !self.face_alive[f] {
+                continue;
+            }
+            let t = t.map(|v| {
+                let m = &mut map[v as usize];
+                if *m == u32::MAX {
+                    *m = positions.len() as u32;
+                    positions.push(self.pos[v as usize]);
+                }
+                *m
+            });
+            tris.push(t);
+        }
+        let mut report = self.report;
+        report.vertices_after = positions.len();
+        report.faces_after = tris.len();
+        (
+            PolyMesh::new(positions, Polygons::from_triangles(&tris)),
+            report,
+        )
+    }
+}
+
+/// `4√3·A / Σ l²` with `2A = area2`.
+fn quality(p: &[[f64; 3]; 3], area2: f64) -> f64 {
+    let s = dot(sub(p[1], p[0]), sub(p[1], p[0]))
+        + dot(sub(p[2], p[1]), sub(p[2], p[1]))
+        + dot(sub(p[0], p[2]), sub(p[0], p[2]));
+    if s > 0.0 {
+        2.0 * 3f64.sqrt() * area2 / s
+    } else {
+        0.0
+    }
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadric_minimizer_of_three_planes_is_their_corner() {
+        let mut q = plane_quadric([1.0, 0.0, 0.0], [0.3, 0.0, 0.0], 1.0);
+        add_q(
+            &mut q,
+            &plane_quadric([0.0, 1.0, 0.0], [0.0, -0.2, 0.0], 2.0),
+        );
+        add_q(
+            &mut q,
+            &plane_quadric([0.0, 0.0, 1.0], [0.0, 0.0, 0.7], 0.5),
+        );
+        let p = q_minimizer(&q).unwrap();
+        for (x, y) in p.iter().zip([0.3, -0.2, 0.7]) {
+            assert!((x - y).abs() < 1e-12);
+        }
+        assert!(eval_q(&q, p).abs() < 1e-12);
+        assert!((eval_q(&q, [0.3, -0.2, 1.7]) - 0.5).abs() < 1e-12);
+        assert_eq!(q_weight(&q), 3.5);
+    }
+}
