@@ -14,6 +14,7 @@ pub mod off;
 pub mod ply;
 pub mod stl;
 mod text;
+pub mod usda;
 pub mod xyz;
 
 use std::io::Write;
@@ -333,6 +334,26 @@ pub fn write_ply_with_properties(
     let mut out = Vec::new();
     ply::write_with_properties(mesh, extra, opts.encoding, opts.single_precision, &mut out)
         .map_err(|e| Error::file(path, ErrorKind::CannotWrite(e.to_string())))?;
+    write_atomic(path, &out)
+}
+
+/// Writes a control cage as USDA (see [`usda`]) atomically. The cage must have faces.
+pub fn write_usda_file(
+    path: &Path,
+    mesh: &PolyMesh,
+    tags: &subfit_mesh::Tags,
+    scheme: usda::UsdScheme,
+    boundary: usda::UsdBoundary,
+) -> Result<()> {
+    if mesh.faces.is_empty() {
+        return Err(Error::file(
+            path,
+            ErrorKind::CannotWrite("a USD mesh needs faces".into()),
+        ));
+    }
+    check_writable(mesh, Format::Ply, &WriteOptions::default(), path)?;
+    let mut out = Vec::new();
+    usda::write(mesh, tags, scheme, boundary, &mut out);
     write_atomic(path, &out)
 }
 
