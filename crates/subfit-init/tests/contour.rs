@@ -1,0 +1,102 @@
+//! Contouring oriented point clouds gives closed manifold meshes of the right genus near the
+//! surface; the entry point simplifies them and reports the genus.
+
+mod common;
+
+use common::topology;
+use subfit_init::{contour, initial_control_mesh, ContourOptions, InitOptions, InitSource};
+use subfit_mesh::shapes::Shape;
+use subfit_target::{Target, TargetOptions};
+
+fn target_of(shape: &Shape, n: usize) -> Target {
+    let cloud = shape.sample(n, 0.0, 7);
+    Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .unwrap()
+}
+
+/// First-order distance `|f| / |∇f|` of a normalized point to the shape, in normalized units.
+fn distance(shape: &Shape, t: &Target, p: [f64; 3]) -> f64 {
+    let q = t.to_original(p);
+    let g = shape.gradient(q);
+    let d = shape.implicit(q).abs() / (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+    t.normalization().length_to_normalized(d)
+}
+
+fn check_contour(shape: Shape, n: usize) {
+    let t = target_of(&shape, n);
+    let (m, rep) = contour(&t, &ContourOptions::default()).unwrap();
+    assert_eq!(topology(&m), (shape.genus(), 0, 1), "{shape:?}: {rep:?}");
+    assert_eq!(rep.genus, shape.genus());
+    let worst = m
+        .positions
+        .iter()
+        .map(|&p| distance(&shape, &t, p))
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1.5 * rep.cell_size,
+        "{shape:?}: {worst} vs cell {rep:?}"
+    );
+}
+
+#[test]
+fn ellipsoid_cloud_contours_to_a_sphere() {
+    check_contour(Shape::PAPER_ELLIPSOID, 6000);
+}
+
+#[test]
+fn torus_cloud_contours_to_genus_one() {
+    check_contour(Shape::DEFAULT_TORUS, 8000);
+}
+
+#[test]
+fn genus2_cloud_contours_to_genus_two() {
+    check_contour(Shape::DEFAULT_GENUS2, 8000);
+}
+
+#[test]
+fn point_cloud_initial_mesh_has_the_expected_genus() {
+    let shape = Shape::DEFAULT_GENUS2;
+    let t = target_of(&shape, 8000);
+    let opts = InitOptions {
+        expected_genus: Some(2),
+        require_genus: true,
+        ..InitOptions::default()
+    };
+    let (m, rep) = initial_control_mesh(&t, None, 150, &opts).unwrap();
+    assert_eq!(rep.source, InitSource::Contour);
+    assert_eq!((rep.genus_target, rep.genus_after), (2, 2));
+    assert!(rep.genus_matches && rep.closed);
+    // The thin handles may leave a few more vertices than asked when no legal collapse remains.
+    assert!((150..=165).contains(&m.num_vertices()), "{rep:?}");
+    assert_eq!(topology(&m), (2, 0, 1));
+    let c = rep.contour.unwrap();
+    let worst = m
+        .positions
+        .iter()
+        .map(|&p| distance(&shape, &t, p))
+        .fold(0.0, f64::max);
+    assert!(worst < 3.0 * c.cell_size, "{worst} vs cell {}", c.cell_size);
+}
+
+#[test]
+fn mesh_target_initial_mesh_keeps_the_genus() {
+    let m0 = subfit_mesh::shapes::torus_mesh(1.0, 0.35, 40, 20, true);
+    let t = Target::from_mesh(&m0, &TargetOptions::default()).unwrap();
+    let (m, rep) = initial_control_mesh(&t, Some(&m0), 100, &InitOptions::default()).unwrap();
+    assert_eq!(rep.source, InitSource::Mesh);
+    assert_eq!((rep.genus_before, rep.genus_after), (1, 1));
+    assert!(rep.genus_matches && rep.closed && rep.contour.is_none());
+    assert_eq!(m.num_vertices(), 100);
+    // Normalized units: inside the unit cube (up to rounding).
+    for p in &m.positions {
+        assert!(p.iter().all(|&c| (-0.01..=1.01).contains(&c)), "{p:?}");
+    }
+    assert!(matches!(
+        initial_control_mesh(&t, Some(&m0), 3, &InitOptions::default()),
+        Err(subfit_init::InitError::TooFewVertices(3))
+    ));
+}
