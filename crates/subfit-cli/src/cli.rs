@@ -27,6 +27,31 @@ pub enum Command {
     Subdivide(SubdivideArgs),
     /// Analyse a target: normalize, estimate normals and principal curvatures per point.
     Analyze(AnalyzeArgs),
+    /// Evaluate the exact limit surface at random (face, u, v) parameters.
+    Eval(EvalArgs),
+}
+
+/// `subfit eval`.
+#[derive(clap::Args, Debug)]
+pub struct EvalArgs {
+    /// The control mesh (any mesh format).
+    pub control: PathBuf,
+    /// Number of random samples.
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    pub samples: u32,
+    /// Subdivision scheme; `auto` picks Loop for all-triangle meshes, Catmull-Clark otherwise.
+    #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
+    pub scheme: SchemeArg,
+    /// Boundary interpolation rule.
+    #[arg(long, value_enum, default_value_t = BoundaryArg::EdgeOnly)]
+    pub boundary: BoundaryArg,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output point cloud (.ply gets the parameters as extra properties `face sub u v`; other
+    /// formats get points and normals).
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 /// `subfit analyze`.

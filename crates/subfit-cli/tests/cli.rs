@@ -341,3 +341,51 @@ fn analyze_writes_normals_curvatures_and_directions() {
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("few.xyz"));
 }
+
+#[test]
+fn eval_writes_exact_limit_samples_with_their_parameters() {
+    let d = tempfile::tempdir().unwrap();
+    let cube = write(d.path(), "cube.obj", CUBE_OBJ.as_bytes());
+    let out = d.path().join("samples.ply");
+    let r = subfit(&[
+        "eval",
+        cube.to_str().unwrap(),
+        "--samples",
+        "500",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let bytes = std::fs::read(&out).unwrap();
+    let header = String::from_utf8_lossy(&bytes[..400]);
+    for p in ["nx", "face", "sub", "u", "v"] {
+        assert!(
+            header.contains(&format!("property double {p}\n")),
+            "{p}: {header}"
+        );
+    }
+    let v: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", out.to_str().unwrap()]).stdout).unwrap();
+    assert_eq!(v["vertices"], 500);
+    // The Catmull-Clark limit of the unit cube lies inside it, around its centre.
+    for k in 0..3 {
+        let lo = v["bbox"]["min"][k].as_f64().unwrap();
+        let hi = v["bbox"]["max"][k].as_f64().unwrap();
+        assert!(lo > 0.0 && hi < 1.0 && lo < 0.5 && hi > 0.5, "{lo} {hi}");
+    }
+    // XYZ output: points and normals only.
+    let xyz = d.path().join("samples.xyz");
+    assert!(subfit(&[
+        "eval",
+        cube.to_str().unwrap(),
+        "--samples",
+        "10",
+        "-o",
+        xyz.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let text = std::fs::read_to_string(&xyz).unwrap();
+    assert_eq!(text.lines().count(), 10);
+    assert_eq!(text.lines().next().unwrap().split_whitespace().count(), 6);
+}

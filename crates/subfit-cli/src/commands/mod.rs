@@ -3,6 +3,7 @@
 mod analyze;
 mod convert;
 mod demo;
+mod eval;
 mod info;
 mod subdivide;
 
@@ -18,5 +19,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Demo(a) => demo::run(a),
         Command::Subdivide(a) => subdivide::run(a),
         Command::Analyze(a) => analyze::run(a),
+        Command::Eval(a) => eval::run(a),
     }
 }

@@ -10,6 +10,25 @@ use subfit::subdiv::{refine, sampling_operator, BoundaryRule, Options, Scheme};
 
 use crate::cli::{BoundaryArg, SchemeArg, SubdivideArgs};
 
+/// The scheme named on the command line, or Loop for all-triangle meshes and Catmull-Clark
+/// otherwise.
+pub fn pick_scheme(arg: SchemeArg, control: &PolyMesh) -> Scheme {
+    match arg {
+        SchemeArg::Loop => Scheme::Loop,
+        SchemeArg::CatmullClark => Scheme::CatmullClark,
+        SchemeArg::Auto if control.faces.is_triangles() => Scheme::Loop,
+        SchemeArg::Auto => Scheme::CatmullClark,
+    }
+}
+
+/// The boundary rule named on the command line.
+pub fn boundary_rule(arg: BoundaryArg) -> BoundaryRule {
+    match arg {
+        BoundaryArg::EdgeOnly => BoundaryRule::EdgeOnly,
+        BoundaryArg::EdgeAndCorner => BoundaryRule::EdgeAndCorner,
+    }
+}
+
 pub fn run(a: SubdivideArgs) -> anyhow::Result<ExitCode> {
     let Some(out_format) = Format::from_path(&a.output) else {
         bail!(
@@ -24,17 +43,8 @@ pub fn run(a: SubdivideArgs) -> anyhow::Result<ExitCode> {
             a.control.display()
         );
     }
-    let scheme = match a.scheme {
-        SchemeArg::Loop => Scheme::Loop,
-        SchemeArg::CatmullClark => Scheme::CatmullClark,
-        SchemeArg::Auto if control.faces.is_triangles() => Scheme::Loop,
-        SchemeArg::Auto => Scheme::CatmullClark,
-    };
-    let boundary = match a.boundary {
-        BoundaryArg::EdgeOnly => BoundaryRule::EdgeOnly,
-        BoundaryArg::EdgeAndCorner => BoundaryRule::EdgeAndCorner,
-    };
-    let options = Options::new(scheme).with_boundary(boundary);
+    let scheme = pick_scheme(a.scheme, &control);
+    let options = Options::new(scheme).with_boundary(boundary_rule(a.boundary));
     let tags = Tags::new();
     let ctx = || format!("{}: cannot subdivide", a.control.display());
 
