@@ -32,6 +32,36 @@ fn torus_points(n: usize) -> Vec<[f64; 3]> {
     out
 }
 
+/// Process CPU time (user + system, all threads) in seconds, from `/proc/self/stat` (Linux; 0
+/// elsewhere). Wall times are noisy on a shared machine: CPU time is printed beside them.
+fn cpu_seconds() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name (which ends with ')'): utime and stime are fields 14, 15.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11..13).map_or(0.0, |v| {
+        v.iter().filter_map(|x| x.parse::<f64>().ok()).sum()
+    });
+    ticks / 100.0 // USER_HZ
+}
+
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_default()
+}
+
+fn build(name: &str, mesh: &PolyMesh, opts: &TargetOptions) -> Target {
+    let c0 = cpu_seconds();
+    let t = Target::from_mesh(mesh, opts).expect(name);
+    let cpu = cpu_seconds() - c0;
+    report(name, &t);
+    println!("  build CPU {cpu:.2} s (load average {})", load_average());
+    t
+}
+
 fn report(name: &str, t: &Target) {
     let s = t.stats();
     let tm = &s.timings;
@@ -65,19 +95,21 @@ fn queries(t: &Target, n: usize) {
         })
         .collect();
     let _ = t.foot_points(&xs[..xs.len().min(10_000)]); // warm-up
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu_seconds());
     let f = t.foot_points(&xs);
-    let dt = t0.elapsed().as_secs_f64();
+    let (dt, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds() - c0);
     let checksum: f64 = f.iter().map(|f| f.distance).sum();
     println!(
-        "  foot points: {n} in {dt:.3} s = {:.2} M/s (checksum {checksum:.3})",
-        n as f64 / dt / 1e6
+        "  foot points: {n} in {dt:.3} s = {:.2} M/s; CPU {cpu:.2} s = {:.2} M/CPU-s (checksum {checksum:.3}, load average {})",
+        n as f64 / dt / 1e6,
+        n as f64 / cpu.max(1e-9) / 1e6,
+        load_average()
     );
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), cpu_seconds());
     let v = t.imls_batch(&xs[..n / 4]);
-    let dt = t0.elapsed().as_secs_f64();
+    let (dt, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds() - c0);
     println!(
-        "  IMLS: {} in {dt:.3} s = {:.2} M/s (h = {:.4}, {} fallbacks)",
+        "  IMLS: {} in {dt:.3} s = {:.2} M/s; CPU {cpu:.2} s (h = {:.4}, {} fallbacks)",
         n / 4,
         (n / 4) as f64 / dt / 1e6,
         t.imls_radius(),
@@ -97,11 +129,9 @@ fn main() {
                     normals: NormalSource::Estimate,
                     ..opts.clone()
                 };
-                let t = Target::from_mesh(&cloud, &est).expect("igea");
-                report("igea (points, estimated normals)", &t);
+                let t = build("igea (points, estimated normals)", &cloud, &est);
                 queries(&t, 2_000_000);
-                let t = Target::from_mesh(&mesh, &opts).expect("igea mesh");
-                report("igea (mesh: face normals + BVH)", &t);
+                build("igea (mesh: face normals + BVH)", &mesh, &opts);
             }
             Err(e) => println!("igea: cannot read {}: {e}", path.display()),
         }
@@ -109,7 +139,10 @@ fn main() {
         println!("SUBFIT_DATA not set: skipping igea");
     }
     let pts = torus_points(1_000_000);
-    let t = Target::from_points(&pts, None, &opts).expect("torus");
-    report("torus 1M (estimated normals)", &t);
+    let t = build(
+        "torus 1M (estimated normals)",
+        &PolyMesh::point_cloud(pts, None),
+        &opts,
+    );
     queries(&t, 2_000_000);
 }

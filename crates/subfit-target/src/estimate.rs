@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use crate::neighbors::{Neighbor, PointIndex};
+use crate::neighbors::{morton_order, Neighbor, PointIndex};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
 use crate::vec3::{any_orthogonal, dot, normalize, scale, sub};
 
@@ -27,15 +27,15 @@ impl Default for Neighborhood {
 }
 
 /// Result of the estimation at one point.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct PointEstimate {
     pub quadric: LocalQuadric,
     pub quality: FitQuality,
     pub ambiguous: bool,
     pub size: u32,
     pub radius: f64,
-    /// Nearest neighbours (excluding the point), for the orientation graph.
-    pub graph: Vec<u32>,
+    /// Distance to the nearest other point (`+∞` if none).
+    pub nn_dist: f64,
 }
 
 /// Per-point estimation settings (from [`crate::TargetOptions`]).
@@ -54,18 +54,21 @@ pub(crate) const MIN_NEIGHBORS: usize = 10;
 ///
 /// `prescribed`: a unit normal to use as the frame normal instead of the PCA one.
 /// `ambiguity_ratio`: the point is flagged ambiguous when `λ0 ≥ ratio · λ1` (smallest two
-/// covariance eigenvalues nearly equal). `graph_k`: number of neighbours kept for orientation.
+/// covariance eigenvalues nearly equal). `graph_row` (`graph_k` entries) receives the nearest
+/// neighbours kept for orientation, padded with `u32::MAX`. `scratch` is reused between calls.
 pub(crate) fn estimate_point(
     points: &[[f64; 3]],
     index: &PointIndex,
     i: usize,
     prescribed: Option<[f64; 3]>,
     params: &EstimateParams,
+    graph_row: &mut [u32],
+    scratch: &mut Scratch,
 ) -> PointEstimate {
     let EstimateParams {
         hood,
         ambiguity_ratio,
-        graph_k,
+        graph_k: _,
         degree,
     } = *params;
     let p = points[i];
@@ -80,11 +83,10 @@ pub(crate) fn estimate_point(
             }
         }
     };
-    let rel_all: Vec<[f64; 3]> = nb
-        .iter()
-        .map(|n| sub(points[n.index as usize], p))
-        .collect();
-    let (_, mut lam, mut vecs) = pca(&rel_all);
+    let Scratch { rel: rel_all, w } = scratch;
+    rel_all.clear();
+    rel_all.extend(nb.iter().map(|n| sub(points[n.index as usize], p)));
+    let (_, mut lam, mut vecs) = pca(rel_all);
     let mut m = rel_all.len();
     // Adaptive scale: where the full neighbourhood is not surface-like (ambiguous, or large
     // surface variation λ0/Σλ, e.g. it crosses a thin part), try the nearest SMALL_K. Only for
@@ -108,24 +110,27 @@ pub(crate) fn estimate_point(
     let e1 =
         normalize(sub(vecs[2], scale(n, dot(vecs[2], n)))).unwrap_or_else(|| any_orthogonal(n));
     let h = if radius > 0.0 { radius } else { 1.0 };
-    let w: Vec<f64> = used
+    w.clear();
+    w.extend(used.iter().map(|n| (-(n.distance / h).powi(2)).exp()));
+    let (quadric, quality) = LocalQuadric::fit(n, e1, rel, w, h, degree);
+    graph_row.fill(u32::MAX);
+    for (g, n) in graph_row
+        .iter_mut()
+        .zip(nb.iter().filter(|n| n.index as usize != i))
+    {
+        *g = n.index;
+    }
+    let nn_dist = nb
         .iter()
-        .map(|n| (-(n.distance / h).powi(2)).exp())
-        .collect();
-    let (quadric, quality) = LocalQuadric::fit(n, e1, rel, &w, h, degree);
-    let graph = nb
-        .iter()
-        .filter(|n| n.index as usize != i)
-        .take(graph_k)
-        .map(|n| n.index)
-        .collect();
+        .find(|n| n.index as usize != i)
+        .map_or(f64::INFINITY, |n| n.distance);
     PointEstimate {
+        nn_dist,
         quadric,
         quality,
         ambiguous,
         size: m as u32,
         radius,
-        graph,
     }
 }
 
@@ -170,34 +175,64 @@ fn pca(rel: &[[f64; 3]]) -> ([f64; 3], [f64; 3], [[f64; 3]; 3]) {
     (c, lam, vecs)
 }
 
+/// Per-thread buffers of [`estimate_point`].
+#[derive(Default)]
+pub(crate) struct Scratch {
+    rel: Vec<[f64; 3]>,
+    w: Vec<f64>,
+}
+
 /// [`estimate_point`] for all points in parallel, in chunks, calling `tick(done)` after each.
+/// Points are visited in Morton order (kd-tree locality); results are in point order, with the
+/// orientation graph as rows of `params.graph_k` entries (padded with `u32::MAX`).
 pub(crate) fn estimate_all(
     points: &[[f64; 3]],
     index: &PointIndex,
     prescribed: &[Option<[f64; 3]>],
     params: &EstimateParams,
     tick: &(dyn Fn(usize) + Sync),
-) -> Vec<PointEstimate> {
+) -> (Vec<PointEstimate>, Vec<u32>) {
     const CHUNK: usize = 1 << 15;
-    let mut out = Vec::with_capacity(points.len());
+    let n = points.len();
+    let k = params.graph_k.max(1);
+    let order = morton_order(points);
+    let mut sorted = Vec::with_capacity(n);
+    let mut graph_sorted = vec![u32::MAX; n * k];
     let mut start = 0;
-    while start < points.len() {
-        let end = (start + CHUNK).min(points.len());
-        let part: Vec<PointEstimate> = (start..end)
-            .into_par_iter()
-            .map(|i| {
+    while start < n {
+        let end = (start + CHUNK).min(n);
+        let part: Vec<PointEstimate> = order[start..end]
+            .par_iter()
+            .zip(graph_sorted[start * k..end * k].par_chunks_mut(k))
+            .map_init(Scratch::default, |scratch, (&i, row)| {
+                let i = i as usize;
                 estimate_point(
                     points,
                     index,
                     i,
                     prescribed.get(i).copied().flatten(),
                     params,
+                    row,
+                    scratch,
                 )
             })
             .collect();
-        out.extend(part);
+        sorted.extend(part);
         start = end;
         tick(start);
     }
-    out
+    let mut rank = vec![0u32; n];
+    for (r, &i) in order.iter().enumerate() {
+        rank[i as usize] = r as u32;
+    }
+    let estimates = rank.par_iter().map(|&r| sorted[r as usize]).collect();
+    let mut graph = vec![u32::MAX; n * k];
+    graph
+        .par_chunks_mut(k)
+        .zip(rank.par_iter())
+        .for_each(|(row, &r)| {
+            let r = r as usize;
+            row.copy_from_slice(&graph_sorted[r * k..(r + 1) * k]);
+        });
+    (estimates, graph)
 }

@@ -150,6 +150,41 @@ impl PointIndex {
     }
 }
 
+/// Spreads the low 21 bits of `x` to every third bit.
+#[inline]
+fn spread3(x: u64) -> u64 {
+    let mut x = x & 0x1f_ffff;
+    x = (x | x << 32) & 0x1f_0000_0000_ffff;
+    x = (x | x << 16) & 0x1f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+/// Indices of `xs` sorted by the Morton code of the point (normalized coordinates, clamped to
+/// the unit cube; 21 bits per axis). Parallel, O(n log n).
+pub(crate) fn morton_order(xs: &[[f64; 3]]) -> Vec<u32> {
+    let cell = |c: f64| -> u64 {
+        let t = if c.is_finite() {
+            c.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (t * f64::from((1u32 << 21) - 1)) as u64
+    };
+    let mut keys: Vec<(u64, u32)> = xs
+        .par_iter()
+        .enumerate()
+        .map(|(i, x)| {
+            let code = spread3(cell(x[0])) | spread3(cell(x[1])) << 1 | spread3(cell(x[2])) << 2;
+            (code, i as u32)
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.into_iter().map(|(_, i)| i).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

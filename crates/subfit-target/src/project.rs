@@ -24,6 +24,9 @@ const MAX_ITER: usize = 10;
 /// Newton step tolerance (normalized units).
 const TOL: f64 = 1e-14;
 
+/// Batches at least this large are processed in Morton order.
+const SPATIAL_SORT_MIN: usize = 4096;
+
 /// The foot point of a query point on the target, with everything the PD/TD/SD terms need.
 /// All in normalized units.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -100,17 +103,20 @@ impl Target {
     /// plus a few Newton steps. Accurate where the nearest data point's quadric represents the
     /// surface (dense sampling, `|d|` well below the local radii of curvature); not checked.
     ///
-    /// When the data point nearest to the first foot point differs from the one nearest to `x`
-    /// (queries far from the surface or near strong curvature), the projection is redone once on
-    /// that point's quadric, which represents the surface better there.
+    /// When the data point nearest to the first foot point may differ from the one nearest to
+    /// `x` (queries far from the surface or near strong curvature), the projection is redone once
+    /// on that point's quadric, which represents the surface better there. That second query is
+    /// skipped when the foot point lies within half the nearest-neighbour spacing of the data
+    /// point (then no other data point can be nearer to it: triangle inequality).
     pub fn foot_point(&self, x: [f64; 3]) -> FootPoint {
         let i = self.index().nearest(&x).index;
-        let f = foot_point_on(
-            &self.quadrics()[i as usize],
-            self.points()[i as usize],
-            x,
-            i,
-        );
+        let pi = self.points()[i as usize];
+        let f = foot_point_on(&self.quadrics()[i as usize], pi, x, i);
+        let d = sub(f.point, pi);
+        let h = 0.5 * self.nearest_neighbor_distances()[i as usize];
+        if dot(d, d) < h * h {
+            return f;
+        }
         let j = self.index().nearest(&f.point).index;
         if j == i {
             return f;
@@ -124,8 +130,11 @@ impl Target {
     }
 
     /// [`Self::foot_point`] for many points, in parallel (rayon); `#Q` results in order.
+    /// Large batches are processed in Morton (Z-curve) order of the queries for cache locality.
     pub fn foot_points(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
-        xs.par_iter().map(|&x| self.foot_point(x)).collect()
+        let mut out = vec![FootPoint::default(); xs.len()];
+        self.foot_points_into(xs, &mut out);
+        out
     }
 
     /// [`Self::foot_points`] into a caller-owned buffer (`out.len()` must equal `xs.len()`).
@@ -135,9 +144,24 @@ impl Target {
     #[track_caller]
     pub fn foot_points_into(&self, xs: &[[f64; 3]], out: &mut [FootPoint]) {
         assert_eq!(xs.len(), out.len(), "foot_points_into: length mismatch");
+        if xs.len() < SPATIAL_SORT_MIN {
+            out.par_iter_mut()
+                .zip(xs.par_iter())
+                .for_each(|(o, &x)| *o = self.foot_point(x));
+            return;
+        }
+        let order = crate::neighbors::morton_order(xs);
+        let sorted: Vec<FootPoint> = order
+            .par_iter()
+            .map(|&q| self.foot_point(xs[q as usize]))
+            .collect();
+        let mut rank = vec![0u32; xs.len()];
+        for (r, &q) in order.iter().enumerate() {
+            rank[q as usize] = r as u32;
+        }
         out.par_iter_mut()
-            .zip(xs.par_iter())
-            .for_each(|(o, &x)| *o = self.foot_point(x));
+            .zip(rank.par_iter())
+            .for_each(|(o, &r)| *o = sorted[r as usize]);
     }
 
     /// Exact closest point on the target's triangles (mesh targets only; `None` for point

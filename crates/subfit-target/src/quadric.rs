@@ -137,16 +137,16 @@ impl LocalQuadric {
         } else {
             1.0
         };
-        let local: Vec<[f64; 4]> = rel
-            .iter()
-            .zip(w)
-            .map(|(r, &wj)| [dot(*r, e1) * s, dot(*r, e2) * s, dot(*r, n) * s, wj])
-            .collect();
+        let local = || {
+            rel.iter()
+                .zip(w)
+                .map(move |(r, &wj)| [dot(*r, e1) * s, dot(*r, e2) * s, dot(*r, n) * s, wj])
+        };
         let scaled = if degree >= 3 && rel.len() >= 14 {
-            solve_jet::<10>(&local, FitQuality::Full)
-                .or_else(|| solve_jet::<6>(&local, FitQuality::Damped))
+            solve_jet::<10>(local(), FitQuality::Full)
+                .or_else(|| solve_jet::<6>(local(), FitQuality::Damped))
         } else {
-            solve_jet::<6>(&local, FitQuality::Full)
+            solve_jet::<6>(local(), FitQuality::Full)
         };
         let Some((x, quality)) = scaled else {
             return (q, FitQuality::PlaneOnly);
@@ -266,12 +266,12 @@ impl LocalQuadric {
 /// over scaled local points `[u, v, z, weight]`. A tiny ridge keeps the solve defined;
 /// returns `None` when the system is numerically singular.
 fn solve_jet<const N: usize>(
-    pts: &[[f64; 4]],
+    pts: impl Iterator<Item = [f64; 4]>,
     quality: FitQuality,
 ) -> Option<([f64; 10], FitQuality)> {
     let mut a = SMatrix::<f64, N, N>::zeros();
     let mut b = SVector::<f64, N>::zeros();
-    for &[u, v, z, wj] in pts {
+    for [u, v, z, wj] in pts {
         let all = [
             1.0,
             u,

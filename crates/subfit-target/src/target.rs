@@ -37,6 +37,8 @@ pub struct Target {
     index: PointIndex,
     bvh: Option<TriangleBvh>,
     input_to_point: Vec<u32>,
+    /// Per point: distance to the nearest other point (for the foot-point shortcut).
+    nn_dist: Vec<f64>,
     imls_radius: f64,
     stats: TargetStats,
 }
@@ -176,7 +178,7 @@ impl Target {
             graph_k: options.orientation_k,
             degree: options.jet_degree,
         };
-        let estimates = estimate_all(&points, &index, &prescribed, &params, &tick);
+        let (estimates, graph) = estimate_all(&points, &index, &prescribed, &params, &tick);
         stats.timings.estimate = t.elapsed();
         summarize_estimates(&estimates, &mut stats);
 
@@ -184,6 +186,7 @@ impl Target {
         let t = Instant::now();
         report(Phase::Orient, 0, np);
         let mut quadrics: Vec<LocalQuadric> = estimates.iter().map(|e| e.quadric).collect();
+        let nn_dist: Vec<f64> = estimates.iter().map(|e| e.nn_dist).collect();
         let mut normals: Vec<[f64; 3]> = quadrics
             .par_iter()
             .zip(&prescribed)
@@ -198,22 +201,13 @@ impl Target {
         };
         if n_fixed < np {
             let stride = options.orientation_k;
-            let mut targets = vec![u32::MAX; np * stride];
-            targets
-                .par_chunks_mut(stride)
-                .zip(&estimates)
-                .for_each(|(row, e)| {
-                    for (r, &j) in row.iter_mut().zip(&e.graph) {
-                        *r = j;
-                    }
-                });
             let ambiguous: Vec<bool> = estimates.iter().map(|e| e.ambiguous).collect();
             let area: Vec<f64> = estimates.iter().map(|e| e.radius * e.radius).collect();
             let o = orient_normals(
                 &points,
                 &mut normals,
                 KnnGraph {
-                    targets: &targets,
+                    targets: &graph,
                     stride,
                 },
                 &OrientInput {
@@ -267,6 +261,7 @@ impl Target {
             index,
             bvh,
             input_to_point,
+            nn_dist,
             imls_radius,
             stats,
         })
@@ -315,6 +310,11 @@ impl Target {
     /// For each input point, the index of its distinct point (`#input` entries).
     pub fn input_to_point(&self) -> &[u32] {
         &self.input_to_point
+    }
+
+    /// Per point: distance to its nearest other point (normalized units), `#P`.
+    pub fn nearest_neighbor_distances(&self) -> &[f64] {
+        &self.nn_dist
     }
 
     /// The kd-tree over [`Self::points`].
