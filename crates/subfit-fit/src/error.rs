@@ -4,7 +4,7 @@ use subfit_subdiv::SubdivError;
 
 /// The phase of an iteration, for diagnostics and timings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Phase {
+pub enum FitPhase {
     /// Building the sampling operator, the pattern and the symbolic factorization.
     Setup,
     /// Evaluating the sample points `S = C·P`.
@@ -42,8 +42,8 @@ pub enum FitError {
     NotPositiveDefinite {
         /// Iteration (1-based) in which it happened.
         iteration: usize,
-        /// Phase ([`Phase::Solve`]).
-        phase: Phase,
+        /// FitPhase ([`FitPhase::Solve`]).
+        phase: FitPhase,
         /// Index of the failing pivot in the factorization's order.
         pivot: usize,
         /// Damping `μ` in effect.
@@ -56,8 +56,8 @@ pub enum FitError {
     NonFinite {
         /// Iteration (1-based; 0 = the initial evaluation).
         iteration: usize,
-        /// Phase in which it was detected.
-        phase: Phase,
+        /// FitPhase in which it was detected.
+        phase: FitPhase,
         /// What was not finite.
         what: &'static str,
     },

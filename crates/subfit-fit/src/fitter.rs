@@ -11,7 +11,7 @@ use subfit_subdiv::{sampling_operator, Options, SamplingOperator};
 use subfit_target::{FootPoint, Target};
 
 use crate::assemble::{weighted_residuals, Pattern};
-use crate::error::{FitError, Phase};
+use crate::error::{FitError, FitPhase};
 use crate::options::{FitOptions, Method, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
@@ -144,14 +144,14 @@ impl<'t> Fitter<'t> {
     }
 
     fn stats(&self, control: &[[f64; 3]], s: &[[f64; 3]], feet: &[FootPoint]) -> ErrorStats {
-        let (sum, max) = s
+        // Squared distances in parallel, summed serially: deterministic for any thread count.
+        let d2: Vec<f64> = s
             .par_iter()
             .zip(feet.par_iter())
-            .map(|(s, f)| {
-                let d2 = (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum::<f64>();
-                (d2, d2)
-            })
-            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1.max(b.1)));
+            .map(|(s, f)| (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum::<f64>())
+            .collect();
+        let sum: f64 = d2.iter().sum();
+        let max = d2.iter().fold(0.0f64, |a, &b| a.max(b));
         let m = s.len().max(1) as f64;
         let n = control.len().max(1) as f64;
         let e_rms = (sum / m).sqrt();
@@ -192,13 +192,13 @@ impl<'t> Fitter<'t> {
         if control.iter().flatten().any(|x| !x.is_finite()) {
             return Err(FitError::NonFinite {
                 iteration: 0,
-                phase: Phase::Setup,
+                phase: FitPhase::Setup,
                 what: "initial control points",
             });
         }
         let opts = self.options.clone();
         let mut cur = self.state(control, &mut PhaseTimings::default());
-        check_finite(cur.stats.objective, 0, Phase::Evaluate, "objective")?;
+        check_finite(cur.stats.objective, 0, FitPhase::Evaluate, "objective")?;
         let mut report = FitReport {
             method: opts.method,
             step: opts.step,
@@ -213,8 +213,10 @@ impl<'t> Fitter<'t> {
             report.stop = StopReason::Tolerance;
             return Ok(report);
         }
-        let mut mu = f64::NAN;
-        let mut nu = 2.0;
+        let mut lm = Damping {
+            mu: f64::NAN,
+            nu: 2.0,
+        };
         let mut grad: Vec<[f64; 3]> = Vec::new();
         let mut stale = true;
         let mut trial_p = vec![[0.0; 3]; n];
@@ -229,11 +231,11 @@ impl<'t> Fitter<'t> {
             let max_diag = self.hdiag.iter().fold(0.0f64, |a, &b| a.max(b));
             let mean_diag = self.hdiag.iter().sum::<f64>() / self.hdiag.len().max(1) as f64;
             let ridge = opts.ridge * mean_diag;
-            if opts.step == StepControl::LevenbergMarquardt && mu.is_nan() {
-                mu = opts.lm_tau * max_diag;
+            if opts.step == StepControl::LevenbergMarquardt && lm.mu.is_nan() {
+                lm.mu = opts.lm_tau * max_diag;
             }
             let damping = if opts.step == StepControl::LevenbergMarquardt {
-                mu
+                lm.mu
             } else {
                 0.0
             };
@@ -242,14 +244,13 @@ impl<'t> Fitter<'t> {
             let delta = match self.solve_step(&grad, shift) {
                 Ok(d) => d,
                 Err(SolveFailure::NotPositiveDefinite { index }) => {
-                    if opts.step == StepControl::LevenbergMarquardt && mu < MU_MAX * max_diag {
-                        mu *= nu;
-                        nu *= 2.0;
+                    if opts.step == StepControl::LevenbergMarquardt && lm.mu < MU_MAX * max_diag {
+                        lm.reject();
                         continue;
                     }
                     return Err(FitError::NotPositiveDefinite {
                         iteration: it,
-                        phase: Phase::Solve,
+                        phase: FitPhase::Solve,
                         pivot: index,
                         damping,
                         mean_diagonal: mean_diag,
@@ -261,7 +262,7 @@ impl<'t> Fitter<'t> {
             if delta.iter().flatten().any(|x| !x.is_finite()) {
                 return Err(FitError::NonFinite {
                     iteration: it,
-                    phase: Phase::Solve,
+                    phase: FitPhase::Solve,
                     what: "solution of the normal equations",
                 });
             }
@@ -273,46 +274,14 @@ impl<'t> Fitter<'t> {
                 .sum();
             let dd: f64 = delta.iter().flatten().map(|x| x * x).sum();
             let f0 = cur.stats.objective;
-            let mut step_length = 1.0;
-            let mut gain_ratio = f64::NAN;
-            let (accepted, trial) = loop {
-                for ((p, c), d) in trial_p.iter_mut().zip(control.iter()).zip(&delta) {
-                    *p = [
-                        c[0] + step_length * d[0],
-                        c[1] + step_length * d[1],
-                        c[2] + step_length * d[2],
-                    ];
-                }
-                let trial = self.state(&trial_p, &mut t);
-                check_finite(trial.stats.objective, it, Phase::Evaluate, "objective")?;
-                let f1 = trial.stats.objective;
-                match opts.step {
-                    StepControl::None => break (true, trial),
-                    StepControl::LevenbergMarquardt => {
-                        let predicted = -gd + shift * dd;
-                        gain_ratio = (f0 - f1) / predicted;
-                        let ok = predicted > 0.0 && gain_ratio > 0.0;
-                        if ok {
-                            mu *= (1.0f64 / 3.0).max(1.0 - (2.0 * gain_ratio - 1.0).powi(3));
-                            nu = 2.0;
-                        } else {
-                            mu *= nu;
-                            nu *= 2.0;
-                        }
-                        break (ok, trial);
-                    }
-                    StepControl::Armijo => {
-                        if f1 <= f0 + opts.armijo_c1 * step_length * 2.0 * gd {
-                            break (true, trial);
-                        }
-                        let tries = (step_length.ln() / opts.armijo_beta.ln()).round() as usize;
-                        if tries >= opts.armijo_max_backtracks {
-                            break (false, trial);
-                        }
-                        step_length *= opts.armijo_beta;
-                    }
-                }
+            let dir = Direction {
+                delta: &delta,
+                gd,
+                dd,
+                shift,
             };
+            let (accepted, trial, step_length, gain_ratio) =
+                self.try_step(control, &dir, f0, &mut lm, &mut trial_p, &mut t, it)?;
             let trial_objective = trial.stats.objective;
             if accepted {
                 control.copy_from_slice(&trial_p);
@@ -342,7 +311,7 @@ impl<'t> Fitter<'t> {
                 break;
             }
             let no_descent = match opts.step {
-                StepControl::LevenbergMarquardt => !accepted && mu > MU_MAX * max_diag,
+                StepControl::LevenbergMarquardt => !accepted && lm.mu > MU_MAX * max_diag,
                 StepControl::Armijo => !accepted,
                 StepControl::None => false,
             };
@@ -352,6 +321,59 @@ impl<'t> Fitter<'t> {
             }
         }
         Ok(report)
+    }
+
+    /// Evaluates trial control points along `dir` with fresh foot points and decides, per the
+    /// step control, whether to accept (Cheng 2007 §III-C). Returns (accepted, trial state,
+    /// step length, gain ratio); the trial control points are left in `trial_p`.
+    #[allow(clippy::too_many_arguments)]
+    fn try_step(
+        &self,
+        control: &[[f64; 3]],
+        dir: &Direction<'_>,
+        f0: f64,
+        lm: &mut Damping,
+        trial_p: &mut [[f64; 3]],
+        t: &mut PhaseTimings,
+        it: usize,
+    ) -> Result<(bool, State, f64, f64), FitError> {
+        let opts = &self.options;
+        let mut step_length = 1.0;
+        let mut backtracks = 0;
+        loop {
+            for ((p, c), d) in trial_p.iter_mut().zip(control).zip(dir.delta) {
+                *p = std::array::from_fn(|a| c[a] + step_length * d[a]);
+            }
+            let trial = self.state(trial_p, t);
+            check_finite(trial.stats.objective, it, FitPhase::Evaluate, "objective")?;
+            let f1 = trial.stats.objective;
+            match opts.step {
+                StepControl::None => return Ok((true, trial, step_length, f64::NAN)),
+                StepControl::LevenbergMarquardt => {
+                    // Model decrease with (H + sI)δ = −g: −(2gᵀδ + δᵀHδ) = −gᵀδ + s‖δ‖².
+                    let predicted = -dir.gd + dir.shift * dir.dd;
+                    let rho = (f0 - f1) / predicted;
+                    let ok = predicted > 0.0 && rho > 0.0;
+                    if ok {
+                        lm.accept(rho);
+                    } else {
+                        lm.reject();
+                    }
+                    return Ok((ok, trial, step_length, rho));
+                }
+                StepControl::Armijo => {
+                    // The directional derivative of F along δ is 2gᵀδ.
+                    if f1 <= f0 + opts.armijo_c1 * step_length * 2.0 * dir.gd {
+                        return Ok((true, trial, step_length, f64::NAN));
+                    }
+                    if backtracks >= opts.armijo_max_backtracks {
+                        return Ok((false, trial, step_length, f64::NAN));
+                    }
+                    backtracks += 1;
+                    step_length *= opts.armijo_beta;
+                }
+            }
+        }
     }
 
     fn reached(&self, s: &ErrorStats) -> bool {
@@ -418,10 +440,42 @@ impl<'t> Fitter<'t> {
     }
 }
 
+/// A solved step `δ` with the quantities the step control needs.
+struct Direction<'a> {
+    /// `δ`, `n by 3`.
+    delta: &'a [[f64; 3]],
+    /// `gᵀδ` (half the directional derivative of the objective).
+    gd: f64,
+    /// `‖δ‖²`.
+    dd: f64,
+    /// Diagonal shift `μ + ridge` the step was solved with.
+    shift: f64,
+}
+
+/// Levenberg–Marquardt damping state (Madsen, Nielsen & Tingleff 2004, §3.2).
+struct Damping {
+    mu: f64,
+    nu: f64,
+}
+
+impl Damping {
+    /// After an accepted step with gain ratio `rho > 0`.
+    fn accept(&mut self, rho: f64) {
+        self.mu *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
+        self.nu = 2.0;
+    }
+
+    /// After a rejected step (or a failed factorization).
+    fn reject(&mut self) {
+        self.mu *= self.nu;
+        self.nu *= 2.0;
+    }
+}
+
 fn check_finite(
     x: f64,
     iteration: usize,
-    phase: Phase,
+    phase: FitPhase,
     what: &'static str,
 ) -> Result<(), FitError> {
     if x.is_finite() {
