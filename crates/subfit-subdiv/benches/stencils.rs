@@ -69,6 +69,10 @@ fn bench(c: &mut Criterion) {
         ("catmark_10k", Scheme::CatmullClark, 125, 80),
     ];
     for (name, scheme, n, m) in cases {
+        // `ONLY=<case>` times (and profiles) a single case.
+        if std::env::var("ONLY").is_ok_and(|o| o != name) {
+            continue;
+        }
         let (pts, faces) = torus(n, m, scheme == Scheme::Loop);
         let o = Options::new(scheme);
         let (wall, cpu) = (std::time::Instant::now(), cpu_seconds());

@@ -63,18 +63,30 @@ pub(crate) fn limit_topology(topo: &Topology, tags: &Tags, options: &Options) ->
     }
 }
 
+/// The three limit masks of the last neighbourhood seen: consecutive vertices mostly share
+/// their neighbourhood (valence, rule), so the masks are recomputed only when it changes.
+#[derive(Default)]
+struct LimitMasks {
+    hood: Option<Neighborhood>,
+    masks: [Mask; 3],
+}
+
 /// Appends the limit row of vertex `v` (position and two tangent weights per entry; repeated
 /// columns possible) to `row`.
 fn push_limit_row(
     topo: &Topology,
     scheme: Scheme,
     hood: &Neighborhood,
-    masks: &mut [Mask; 3],
+    cache: &mut LimitMasks,
     v: u32,
     row: &mut Vec<(u32, [f64; 3])>,
 ) {
-    let [p, a, b] = masks;
-    scheme.limit_masks(hood, p, a, b);
+    if cache.hood.as_ref() != Some(hood) {
+        let [p, a, b] = &mut cache.masks;
+        scheme.limit_masks(hood, p, a, b);
+        cache.hood = Some(*hood);
+    }
+    let [p, a, b] = &cache.masks;
     row.push((v, [p.vertex, a.vertex, b.vertex]));
     for (i, &u) in topo.vertex_ring(v).iter().enumerate() {
         row.push((u, [p.edges[i], a.edges[i], b.edges[i]]));
@@ -108,7 +120,7 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
         weights: Vec::new(),
     };
     rows.offsets.push(0);
-    let mut masks: [Mask; 3] = Default::default();
+    let mut masks = LimitMasks::default();
     let mut row = Vec::new();
     for (v, hood) in hoods.iter().enumerate() {
         row.clear();
@@ -138,7 +150,7 @@ pub(crate) fn limit_compose(
     compose_rows(
         topo.num_vertices(),
         rhs,
-        <[Mask; 3]>::default,
+        LimitMasks::default,
         |masks, v, row| push_limit_row(topo, options.scheme, &hoods[v], masks, v as u32, row),
     )
 }

@@ -278,91 +278,188 @@ impl<const K: usize> MultiRows<K> {
 
 /// `K` products `L_k · rhs` where the rows of the `L_k` (sharing one support, `K` weights per
 /// entry, columns < `rhs.nrows()`, repeats allowed) are generated on the fly by
-/// `lhs_row(state, i, row)`, so the left factors are never stored. Parallel over blocks of rows,
-/// with one `init()` state per worker. Entries below [`DROP_TOLERANCE`] relative to their row's
-/// largest are dropped; columns are sorted within each row.
+/// `lhs_row(state, i, row)`, so the left factors are never stored. Entries below
+/// [`DROP_TOLERANCE`] relative to their row's largest are dropped; columns are sorted within
+/// each row.
+///
+/// Rows are produced in waves of [`WAVE`] blocks of [`BLOCK`] rows: the blocks of a wave are
+/// computed in parallel (one `init()` state and one dense scratch row of `rhs.ncols` entries per
+/// worker) into buffers reused from wave to wave, then appended to the output, whose capacity is
+/// extrapolated from the first wave. So the output is written once and no large temporary is
+/// allocated per call beyond one wave's buffers.
 pub(crate) fn compose_rows<const K: usize, S>(
     nrows: usize,
     rhs: &StencilMatrix,
-    init: impl Fn() -> S + Sync + Send,
+    init: impl Fn() -> S,
     lhs_row: impl Fn(&mut S, usize, &mut Vec<(u32, [f64; K])>) + Sync + Send,
-) -> [StencilMatrix; K] {
-    const BLOCK: usize = 2048;
-    let nblocks = nrows.div_ceil(BLOCK);
-    type Block = (Vec<usize>, Vec<u32>, Vec<f64>);
-    let blocks: Vec<[Block; K]> = (0..nblocks)
-        .into_par_iter()
-        .map_init(
-            || {
-                let scratch = (vec![[0.0f64; K]; rhs.ncols], vec![false; rhs.ncols]);
-                (scratch, Vec::<u32>::new(), Vec::new(), init())
-            },
-            |((acc, mark), touched, lrow, state), blk| {
-                let rows = blk * BLOCK..((blk + 1) * BLOCK).min(nrows);
-                let mut out: [Block; K] = std::array::from_fn(|_| Default::default());
-                for i in rows {
-                    lrow.clear();
-                    lhs_row(state, i, lrow);
-                    for &(j, w) in lrow.iter() {
-                        let (c2, w2) = rhs.row(j as usize);
-                        for (&c, &u) in c2.iter().zip(w2) {
-                            let c = c as usize;
-                            if !mark[c] {
-                                mark[c] = true;
-                                touched.push(c as u32);
-                            }
-                            let a = &mut acc[c];
-                            for k in 0..K {
-                                a[k] += w[k] * u;
-                            }
-                        }
-                    }
-                    touched.sort_unstable();
-                    let mut big = [0.0f64; K];
-                    for &c in touched.iter() {
-                        for k in 0..K {
-                            big[k] = big[k].max(acc[c as usize][k].abs());
-                        }
-                    }
-                    for (k, (lens, idx, wts)) in out.iter_mut().enumerate() {
-                        let before = idx.len();
-                        for &c in touched.iter() {
-                            let w = acc[c as usize][k];
-                            if w.abs() > DROP_TOLERANCE * big[k] {
-                                idx.push(c);
-                                wts.push(w);
-                            }
-                        }
-                        lens.push(idx.len() - before);
-                    }
-                    for &c in touched.iter() {
-                        acc[c as usize] = [0.0; K];
-                        mark[c as usize] = false;
-                    }
-                    touched.clear();
-                }
-                out
-            },
-        )
-        .collect();
+) -> [StencilMatrix; K]
+where
+    S: Send,
+{
     let mut out: [StencilMatrix; K] = std::array::from_fn(|_| StencilMatrix::new(rhs.ncols));
-    for (k, m) in out.iter_mut().enumerate() {
-        let nnz = blocks.iter().map(|b| b[k].1.len()).sum();
-        m.indices.reserve_exact(nnz);
-        m.weights.reserve_exact(nnz);
+    for m in &mut out {
         m.offsets.reserve_exact(nrows);
-        let mut end = 0;
-        for b in &blocks {
-            let (lens, idx, wts) = &b[k];
-            for &l in lens {
-                end += l;
-                m.offsets.push(end);
+    }
+    // One task slot per block of a wave, each with its own output buffers and scratch, both
+    // reused from wave to wave (small enough to stay in cache; no allocation per wave).
+    let nslots = nrows.div_ceil(BLOCK).min(WAVE);
+    let mut slots: Vec<([RowBlock; K], Scratch<K, S>)> = (0..nslots)
+        .map(|_| {
+            let bufs = std::array::from_fn(|_| RowBlock::default());
+            (bufs, Scratch::new(rhs.ncols, init()))
+        })
+        .collect();
+    let mut first = 0;
+    while first < nrows {
+        let nblocks = (nrows - first).div_ceil(BLOCK).min(WAVE);
+        slots[..nblocks]
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(b, (blk, scratch))| {
+                let rows = first + b * BLOCK..(first + (b + 1) * BLOCK).min(nrows);
+                blk.iter_mut().for_each(RowBlock::clear);
+                for i in rows {
+                    scratch.lrow.clear();
+                    lhs_row(&mut scratch.state, i, &mut scratch.lrow);
+                    scratch.accumulate(rhs);
+                    scratch.emit(blk);
+                }
+            });
+        let done = (first + nblocks * BLOCK).min(nrows);
+        for (k, m) in out.iter_mut().enumerate() {
+            if first == 0 {
+                // Extrapolate the total from the first wave, generously: unused capacity is
+                // never touched (so costs no memory) and is given back below.
+                let wave_nnz: usize = slots.iter().map(|s| s.0[k].indices.len()).sum();
+                let guess = (wave_nnz as f64 * nrows as f64 / done as f64 * 1.25) as usize;
+                m.indices.reserve_exact(guess);
+                m.weights.reserve_exact(guess);
             }
-            m.indices.extend_from_slice(idx);
-            m.weights.extend_from_slice(wts);
+            for (blk, _) in &slots[..nblocks] {
+                let RowBlock {
+                    lens,
+                    indices,
+                    weights,
+                } = &blk[k];
+                let mut end = m.indices.len();
+                for &l in lens {
+                    end += l as usize;
+                    m.offsets.push(end);
+                }
+                m.indices.extend_from_slice(indices);
+                m.weights.extend_from_slice(weights);
+            }
         }
+        first = done;
+    }
+    for m in &mut out {
+        m.indices.shrink_to_fit();
+        m.weights.shrink_to_fit();
     }
     out
+}
+
+/// Rows per parallel task in [`compose_rows`].
+const BLOCK: usize = 256;
+/// Tasks per wave in [`compose_rows`].
+const WAVE: usize = 8;
+
+/// Rows of one output matrix computed by one task: row lengths, then the entries.
+#[derive(Default)]
+struct RowBlock {
+    lens: Vec<u32>,
+    indices: Vec<u32>,
+    weights: Vec<f64>,
+}
+
+impl RowBlock {
+    fn clear(&mut self) {
+        self.lens.clear();
+        self.indices.clear();
+        self.weights.clear();
+    }
+}
+
+/// Per-worker state of [`compose_rows`]: a dense accumulator over the columns of `rhs` with a
+/// marker array and the list of touched columns (Gustavson), the current left row, and the
+/// caller's state.
+struct Scratch<const K: usize, S> {
+    acc: Vec<[f64; K]>,
+    mark: Vec<bool>,
+    touched: Vec<u32>,
+    ntouched: usize,
+    lrow: Vec<(u32, [f64; K])>,
+    state: S,
+}
+
+impl<const K: usize, S> Scratch<K, S> {
+    fn new(ncols: usize, state: S) -> Self {
+        Self {
+            acc: vec![[0.0; K]; ncols],
+            mark: vec![false; ncols],
+            // One slot more than columns: the branch-free append writes before it counts.
+            touched: vec![0; ncols + 1],
+            ntouched: 0,
+            lrow: Vec::with_capacity(64),
+            state,
+        }
+    }
+
+    /// Accumulates `Σ_j lrow_j · rhs_j` into `acc`, recording touched columns in
+    /// `touched[..ntouched]` (branch-free: most columns repeat, unpredictably).
+    #[inline]
+    fn accumulate(&mut self, rhs: &StencilMatrix) {
+        let (acc, mark, touched) = (&mut self.acc, &mut self.mark, &mut self.touched);
+        let mut n = self.ntouched;
+        for &(j, w) in &self.lrow {
+            let (c2, w2) = rhs.row(j as usize);
+            for (&c, &u) in c2.iter().zip(w2) {
+                let cu = c as usize;
+                touched[n] = c;
+                n += usize::from(!mark[cu]);
+                mark[cu] = true;
+                let a = &mut acc[cu];
+                for k in 0..K {
+                    a[k] += w[k] * u;
+                }
+            }
+        }
+        self.ntouched = n;
+    }
+
+    /// Appends the accumulated row (sorted, pruned) to `blk` and resets the accumulator.
+    #[inline]
+    fn emit(&mut self, blk: &mut [RowBlock; K]) {
+        let (acc, mark) = (&mut self.acc, &mut self.mark);
+        let touched = &mut self.touched[..self.ntouched];
+        self.ntouched = 0;
+        touched.sort_unstable();
+        let mut big = [0.0f64; K];
+        for &c in touched.iter() {
+            let a = &acc[c as usize];
+            for k in 0..K {
+                big[k] = big[k].max(a[k].abs());
+            }
+        }
+        for (k, b) in blk.iter_mut().enumerate() {
+            let before = b.indices.len();
+            b.indices.reserve(touched.len());
+            b.weights.reserve(touched.len());
+            let tol = DROP_TOLERANCE * big[k];
+            for &c in touched.iter() {
+                let w = acc[c as usize][k];
+                if w.abs() > tol {
+                    b.indices.push(c);
+                    b.weights.push(w);
+                }
+            }
+            b.lens.push((b.indices.len() - before) as u32);
+        }
+        for &c in touched.iter() {
+            acc[c as usize] = [0.0; K];
+            mark[c as usize] = false;
+        }
+    }
 }
 
 #[cfg(test)]
