@@ -53,9 +53,10 @@ pub struct LimitSamples {
 /// Cost: `l` refinements and adjacency builds, then one fused pass producing the three
 /// products; memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15 (Catmull-Clark)
 /// control points per row. Measured (`benches/stencils.rs`, release, CPU time summed over
-/// threads on a shared 2-core machine): 10k-face control meshes at level 3 take ≈ 0.9 s for Loop
-/// (320k rows, 11M entries) and ≈ 2.9 s for Catmull-Clark (686k rows, 30M entries); 1k-face
-/// meshes ≈ 0.1 s and 0.2 s.
+/// threads on a shared, loaded 2-core machine): 10k-face control meshes at level 3 take ≈ 0.65 s
+/// for Loop (320k rows, 11M entries) and ≈ 1.9 s for Catmull-Clark (686k rows, 30M entries);
+/// 1k-face meshes ≈ 0.06 s and 0.15 s. About 60 % of it is the two sparse products of the last
+/// level, the rest refinement, adjacency builds and page faults on the output.
 pub fn sampling_operator(
     faces: &Polygons,
     num_vertices: usize,
