@@ -113,8 +113,11 @@ fn main() {
         let mut p = mesh.positions.clone();
         let report = fitter.run(&mut p, None).expect("fit");
         println!(
-            "initial E_rms {:.5} E_max {:.5}",
-            report.initial.e_rms, report.initial.e_max
+            "initial E_rms {:.5} E_max {:.5}; Cholesky factor: {} values ({:.1}× nnz(H))",
+            report.initial.e_rms,
+            report.initial.e_max,
+            fitter.factor_len().unwrap_or(0),
+            fitter.factor_len().unwrap_or(0) as f64 / fitter.pattern().nnz() as f64
         );
         println!(
             "iter acc   E_rms     E_max     total    sample  project assemble  solve  evaluate"

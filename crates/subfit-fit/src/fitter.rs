@@ -114,6 +114,11 @@ impl<'t> Fitter<'t> {
         &self.pattern
     }
 
+    /// Stored values of the Cholesky factor (fill-in measure; `None` before the first solve).
+    pub fn factor_len(&self) -> Option<usize> {
+        self.solver.factor_len()
+    }
+
     /// Number of samples `m`.
     pub fn num_samples(&self) -> usize {
         self.op.position.nrows()

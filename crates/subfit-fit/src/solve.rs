@@ -1,12 +1,13 @@
 //! Sparse Cholesky solve of the (damped) normal equations with `faer` (DESIGN.md §3.3, §6):
-//! the symbolic analysis (fill-reducing ordering, supernodal structure) is done once per
-//! [`Pattern`] and reused by every numeric factorization.
+//! the symbolic analysis (AMD fill-reducing ordering, supernodal structure) is done once per
+//! [`Pattern`] and reused by every numeric factorization; the factor's value buffer and the
+//! workspace are reused too.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::linalg::LltError;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltError as DenseLltError;
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{MatMut, Side};
+use faer::{get_global_parallelism, Conj, MatMut, Side};
 
 use crate::assemble::Pattern;
 
@@ -23,28 +24,37 @@ pub enum SolveFailure {
     Other(String),
 }
 
-/// A sparse `LLᵀ` solver that keeps the symbolic factorization of one [`Pattern`].
+/// A sparse `LLᵀ` solver that keeps the symbolic factorization of one [`Pattern`], the factor's
+/// values and the workspace between calls.
 #[derive(Debug, Default)]
 pub struct CholeskySolver {
-    symbolic: Option<SymbolicLlt<usize>>,
+    symbolic: Option<SymbolicCholesky<usize>>,
+    factor: Vec<f64>,
 }
 
 impl CholeskySolver {
     /// A solver without analysis yet (done at the first [`Self::solve`]).
     pub fn new() -> Self {
-        Self { symbolic: None }
+        Self::default()
     }
 
     /// Forgets the symbolic analysis (call when the pattern changes).
     pub fn reset(&mut self) {
         self.symbolic = None;
+        self.factor = Vec::new();
+    }
+
+    /// Number of stored values of the Cholesky factor (after the first solve), a measure of
+    /// fill-in and of the factorization's memory (8 bytes each).
+    pub fn factor_len(&self) -> Option<usize> {
+        self.symbolic.as_ref().map(SymbolicCholesky::len_val)
     }
 
     /// Factors `A` (upper triangle in `values`, pattern `pattern`) and solves `A X = B` in
     /// place. `rhs` is column-major `dim × nrhs`.
     ///
     /// Cost: one numeric supernodal Cholesky (the first call also the symbolic analysis) plus
-    /// `nrhs` triangular solve pairs.
+    /// `nrhs` triangular solve pairs; parallel per `faer`'s global parallelism (rayon).
     ///
     /// # Panics
     /// If `values.len() != pattern.nnz()` or `rhs.len() != dim · nrhs`.
@@ -65,24 +75,42 @@ impl CholeskySolver {
             None,
             pattern.row_idx(),
         );
-        let symbolic = match &self.symbolic {
-            Some(s) => s.clone(),
-            None => {
-                let s = SymbolicLlt::try_new(sym, Side::Upper)
-                    .map_err(|e| SolveFailure::Other(format!("{e:?}")))?;
-                self.symbolic = Some(s.clone());
-                s
-            }
-        };
+        if self.symbolic.is_none() {
+            let s = factorize_symbolic_cholesky(
+                sym,
+                Side::Upper,
+                Default::default(),
+                Default::default(),
+            )
+            .map_err(|e| SolveFailure::Other(format!("{e:?}")))?;
+            self.factor = vec![0.0; s.len_val()];
+            self.symbolic = Some(s);
+        }
+        let symbolic = self.symbolic.as_ref().expect("analysed above");
+        let par = get_global_parallelism();
         let mat = SparseColMatRef::new(sym, values);
-        let llt = Llt::try_new_with_symbolic(symbolic, mat, Side::Upper).map_err(|e| match e {
-            LltError::Numeric(
-                faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index },
-            ) => SolveFailure::NotPositiveDefinite { index },
-            other => SolveFailure::Other(format!("{other:?}")),
-        })?;
+        let req = symbolic
+            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(nrhs, par));
+        let mut buf = MemBuffer::try_new(req).map_err(|e| SolveFailure::Other(format!("{e:?}")))?;
+        let stack = MemStack::new(&mut buf);
+        let llt = symbolic
+            .factorize_numeric_llt::<f64>(
+                &mut self.factor,
+                mat,
+                Side::Upper,
+                Default::default(),
+                par,
+                stack,
+                Default::default(),
+            )
+            .map_err(|e| match e {
+                DenseLltError::NonPositivePivot { index } => {
+                    SolveFailure::NotPositiveDefinite { index }
+                }
+            })?;
         let x = MatMut::from_column_major_slice_mut(rhs, dim, nrhs);
-        llt.solve_in_place(x);
+        llt.solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
         Ok(())
     }
 }

@@ -5,7 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 use subfit_fit::assemble::{weighted_residuals, Pattern};
 use subfit_fit::smooth::Laplacian;
-use subfit_fit::solve::CholeskySolver;
+use subfit_fit::solve::{CholeskySolver, SolveFailure};
 use subfit_fit::terms::{error_matrix, Mat3, Method};
 use subfit_mesh::shapes::octahedron_mesh;
 use subfit_mesh::{PolyMesh, Tags};
@@ -267,4 +267,25 @@ fn gradient_matches_finite_differences_of_true_objective() {
             }
         }
     }
+}
+
+/// An indefinite matrix gives a typed failure, not NaNs.
+#[test]
+fn indefinite_system_is_reported() {
+    let (mesh, op) = setup(1);
+    let n = mesh.num_vertices();
+    let lap = Laplacian::umbrella(&mesh.faces, n);
+    let pattern = Pattern::new(&op.position, &lap, 3);
+    let q = random_q(op.position.nrows(), Method::Sdm, 3);
+    let mut values = vec![0.0; pattern.nnz()];
+    pattern.fill(&op.position, &q, 1.0, 0.0, &mut values);
+    for v in &mut values {
+        *v = -*v;
+    }
+    let mut rhs = vec![1.0; 3 * n];
+    let r = CholeskySolver::new().solve(&pattern, &values, &mut rhs, 1);
+    assert!(
+        matches!(r, Err(SolveFailure::NotPositiveDefinite { .. })),
+        "{r:?}"
+    );
 }
