@@ -84,6 +84,9 @@ pub struct SimplifyReport {
     pub max_error: f64,
     /// Whether `target_vertices` was reached; `false` means no legal collapse remained.
     pub reached_target: bool,
+    /// How many times the geometric checks were relaxed because no legal collapse remained
+    /// (0–2: first to 85° and 1/4 of the quality bound, then to 89° and 1/50 of it).
+    pub relaxations: usize,
 }
 
 /// Why [`simplify`] cannot run.
@@ -130,6 +133,18 @@ pub fn simplify(
 
     let mut c = Collapser::new(mesh.positions.clone(), tris, options);
     c.run(options.target_vertices);
+    // Stuck before the target: retry the rejected collapses with relaxed geometric checks
+    // (never beyond a 90° normal rotation or a zero-area face).
+    for (deg, quality) in [(85.0, 0.25), (89.0, 0.02)] {
+        if c.alive_vertices <= options.target_vertices {
+            break;
+        }
+        c.relax(
+            options.max_normal_rotation_deg.max(deg),
+            options.min_triangle_quality * quality,
+        );
+        c.run(options.target_vertices);
+    }
     Ok(c.finish())
 }
 
@@ -244,6 +259,8 @@ struct Collapser {
     vfaces: Vec<Vec<u32>>,
     boundary: Vec<bool>,
     stamp: Vec<u32>,
+    /// Whether a collapse of an edge at this vertex was rejected since its edges were last queued.
+    dirty: Vec<bool>,
     alive_vertices: usize,
     heap: BinaryHeap<Candidate>,
     min_cos: f64,
@@ -322,6 +339,7 @@ impl Collapser {
             vfaces,
             boundary,
             stamp: vec![0; nv],
+            dirty: vec![false; nv],
             alive_vertices,
             heap: BinaryHeap::with_capacity(3 * nf / 2 + 16),
             min_cos: options.max_normal_rotation_deg.to_radians().cos(),
@@ -388,6 +406,26 @@ impl Collapser {
         });
     }
 
+    /// Relaxes the geometric checks and re-queues the edges of every vertex that had a
+    /// collapse rejected.
+    fn relax(&mut self, max_rotation_deg: f64, min_quality: f64) {
+        self.report.relaxations += 1;
+        self.min_cos = max_rotation_deg.to_radians().cos();
+        self.min_quality = min_quality;
+        let mut ring = Vec::new();
+        for v in 0..self.pos.len() as u32 {
+            if !self.dirty[v as usize] || self.vfaces[v as usize].is_empty() {
+                continue;
+            }
+            self.dirty[v as usize] = false;
+            self.stamp[v as usize] = self.stamp[v as usize].wrapping_add(1);
+            self.ring(v, &mut ring);
+            for &u in &ring {
+                self.push(v, u);
+            }
+        }
+    }
+
     fn run(&mut self, target: usize) {
         while self.alive_vertices > target {
             let Some(c) = self.heap.pop() else { break };
@@ -399,12 +437,34 @@ impl Collapser {
             {
                 continue;
             }
-            match self.check(c.keep, c.remove, c.pos) {
+            let mut c = c;
+            let mut verdict = self.check(c.keep, c.remove, c.pos);
+            if self.report.relaxations > 0
+                && matches!(verdict, Verdict::Flip | Verdict::Degenerate)
+                && self.boundary[k] == self.boundary[r]
+            {
+                // Stuck: try the half-edge collapses, which leave one endpoint where it is.
+                let mut q = self.quad[k];
+                add_q(&mut q, &self.quad[r]);
+                for p in [self.pos[k], self.pos[r]] {
+                    if matches!(self.check(c.keep, c.remove, p), Verdict::Ok) {
+                        c.pos = p;
+                        c.cost = eval_q(&q, p).max(0.0);
+                        verdict = Verdict::Ok;
+                        break;
+                    }
+                }
+            }
+            match verdict {
                 Verdict::Ok => self.collapse(&c),
                 Verdict::Link => self.report.rejected_link += 1,
                 Verdict::Boundary => self.report.rejected_boundary += 1,
                 Verdict::Flip => self.report.rejected_flip += 1,
                 Verdict::Degenerate => self.report.rejected_degenerate += 1,
+            }
+            if !matches!(verdict, Verdict::Ok) {
+                self.dirty[k] = true;
+                self.dirty[r] = true;
             }
         }
         self.report.reached_target = self.alive_vertices <= target;
@@ -504,7 +564,10 @@ impl Collapser {
                 if !(l_new * l_new > self.min_area2) {
                     return Verdict::Degenerate;
                 }
-                if l_old > 0.0 && dot(n_old, n_new) < self.min_cos * l_old * l_new {
+                // The rotation of a sliver's normal is noise: for those (quality below 0.1)
+                // only the reference check below applies.
+                let q_old = quality(&old, l_old);
+                if q_old >= 0.1 && dot(n_old, n_new) < self.min_cos * l_old * l_new {
                     return Verdict::Flip;
                 }
                 // Against the accumulated input normals too, so that many small rotations
@@ -526,7 +589,7 @@ impl Collapser {
                     return Verdict::Flip;
                 }
                 let q_new = quality(&new, l_new);
-                if q_new < self.min_quality && q_new < quality(&old, l_old) {
+                if q_new < self.min_quality && q_new < q_old {
                     return Verdict::Degenerate;
                 }
             }
@@ -568,15 +631,17 @@ impl Collapser {
         if w > 0.0 {
             self.report.max_error = self.report.max_error.max((c.cost / w).sqrt());
         }
-        // Re-evaluate every edge around the kept vertex and its neighbours: costs around `k`
-        // changed, and rejected collapses nearby may have become legal.
-        let mut around = Vec::new();
+        // Re-queue the edges of the kept vertex (their costs changed) and of the neighbours
+        // that had a collapse rejected (it may have become legal).
+        let mut around = std::mem::take(&mut self.scratch_a);
         self.ring(k, &mut around);
+        around.retain(|&v| self.dirty[v as usize]);
         around.push(k);
         for &v in &around {
             self.stamp[v as usize] = self.stamp[v as usize].wrapping_add(1);
+            self.dirty[v as usize] = false;
         }
-        let mut ring = Vec::new();
+        let mut ring = std::mem::take(&mut self.scratch_b);
         for &v in &around {
             self.ring(v, &mut ring);
             for &u in &ring {
@@ -585,6 +650,8 @@ impl Collapser {
                 }
             }
         }
+        self.scratch_a = around;
+        self.scratch_b = ring;
     }
 
     fn finish(self) -> (PolyMesh, SimplifyReport) {
