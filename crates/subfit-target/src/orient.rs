@@ -45,16 +45,6 @@ pub struct KnnGraph<'a> {
     pub stride: usize,
 }
 
-impl KnnGraph<'_> {
-    #[inline]
-    fn row(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        self.targets[i * self.stride..(i + 1) * self.stride]
-            .iter()
-            .filter(move |&&j| j != u32::MAX && j as usize != i)
-            .map(|&j| j as usize)
-    }
-}
-
 /// Per-point inputs of [`orient_normals`] besides positions and normals.
 #[derive(Clone, Copy, Debug)]
 pub struct OrientInput<'a> {
@@ -255,17 +245,26 @@ fn propagate(
         }
         walk(&mut stack, &mut members, &mut visited, normals);
     }
-    let mut order: Vec<u32> = (0..n as u32).collect();
-    order.par_sort_unstable_by(|&a, &b| points[b as usize][2].total_cmp(&points[a as usize][2]));
-    for &seed in &order {
-        if visited[seed as usize] {
+    for start in 0..n as u32 {
+        if visited[start as usize] {
             continue;
         }
+        // Tree propagation fixes signs relative to the start; the component's global sign is
+        // decided afterwards (volume, or its highest point as the seed).
         components += 1;
-        visited[seed as usize] = true;
+        visited[start as usize] = true;
         members.clear();
-        stack.push(seed);
+        stack.push(start);
         walk(&mut stack, &mut members, &mut visited, normals);
+        let seed = members
+            .iter()
+            .copied()
+            .max_by(|&a, &b| {
+                points[a as usize][2]
+                    .total_cmp(&points[b as usize][2])
+                    .then(b.cmp(&a))
+            })
+            .unwrap_or(start);
         if !component_sign(points, normals, &members, seed as usize, inp) {
             for &m in &members {
                 normals[m as usize] = scale(normals[m as usize], -1.0);
@@ -330,18 +329,19 @@ fn consensus(
     inp: &OrientInput<'_>,
 ) {
     let n = points.len();
-    for _ in 0..CONSENSUS_SWEEPS {
-        let mut changed = 0usize;
-        for i in 0..n {
-            if inp.fixed[i] {
-                continue;
-            }
-            let ni = normals[i];
-            let mut s = 0.0;
-            for j in graph.row(i) {
-                let nj = normals[j];
-                let d = dot(ni, nj);
-                let mut w = d.abs();
+    let k = graph.stride;
+    // Edge weights do not depend on the signs: computed once, in parallel.
+    let weights: Vec<f32> = {
+        let normals = &*normals;
+        (0..n * k)
+            .into_par_iter()
+            .map(|slot| {
+                let (i, j) = (slot / k, graph.targets[slot] as usize);
+                if j == u32::MAX as usize || j == i {
+                    return 0.0;
+                }
+                let (ni, nj) = (normals[i], normals[j]);
+                let mut w = dot(ni, nj).abs();
                 if let Some(e) = normalize(sub(points[j], points[i])) {
                     let off_plane = 0.5 * (dot(ni, e).abs() + dot(nj, e).abs());
                     w *= (1.0 - off_plane).max(0.0);
@@ -349,7 +349,27 @@ fn consensus(
                 if inp.ambiguous[j] {
                     w *= 0.25;
                 }
-                s += w * d.signum();
+                w as f32
+            })
+            .collect()
+    };
+    for _ in 0..CONSENSUS_SWEEPS {
+        let mut changed = 0usize;
+        for i in 0..n {
+            if inp.fixed[i] {
+                continue;
+            }
+            let ni = normals[i];
+            let mut s = 0.0f32;
+            for (&j, &w) in graph.targets[i * k..(i + 1) * k]
+                .iter()
+                .zip(&weights[i * k..(i + 1) * k])
+            {
+                if w > 0.0 && dot(ni, normals[j as usize]) < 0.0 {
+                    s -= w;
+                } else {
+                    s += w;
+                }
             }
             if s < 0.0 {
                 normals[i] = scale(ni, -1.0);

@@ -106,14 +106,15 @@ impl Target {
     /// When the data point nearest to the first foot point may differ from the one nearest to
     /// `x` (queries far from the surface or near strong curvature), the projection is redone once
     /// on that point's quadric, which represents the surface better there. That second query is
-    /// skipped when the foot point lies within half the nearest-neighbour spacing of the data
-    /// point (then no other data point can be nearer to it: triangle inequality).
+    /// skipped when the foot point lies well inside the data point's fitting neighbourhood
+    /// (within half its radius, or half the nearest-neighbour spacing, where no other data point
+    /// can be nearer: triangle inequality).
     pub fn foot_point(&self, x: [f64; 3]) -> FootPoint {
         let i = self.index().nearest(&x).index;
         let pi = self.points()[i as usize];
         let f = foot_point_on(&self.quadrics()[i as usize], pi, x, i);
         let d = sub(f.point, pi);
-        let h = 0.5 * self.nearest_neighbor_distances()[i as usize];
+        let h = 0.5 * self.foot_shortcut_diameters()[i as usize];
         if dot(d, d) < h * h {
             return f;
         }

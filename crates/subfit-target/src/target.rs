@@ -19,6 +19,9 @@ use crate::orient::{orient_normals, KnnGraph, OrientInput};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
 use crate::vec3::{add, cross, dot, normalize, scale, sub};
 
+/// Fraction of the neighbourhood radius doubled into the foot-point shortcut diameter.
+const FOOT_SHORTCUT: f64 = 1.0;
+
 /// Fewest (distinct) points a target may have.
 pub const MIN_POINTS: usize = 10;
 
@@ -37,7 +40,8 @@ pub struct Target {
     index: PointIndex,
     bvh: Option<TriangleBvh>,
     input_to_point: Vec<u32>,
-    /// Per point: distance to the nearest other point (for the foot-point shortcut).
+    /// Per point: the larger of the distance to the nearest other point and
+    /// `2 FOOT_SHORTCUT ×` the neighbourhood radius (foot points within half of it are accepted).
     nn_dist: Vec<f64>,
     imls_radius: f64,
     stats: TargetStats,
@@ -186,7 +190,10 @@ impl Target {
         let t = Instant::now();
         report(Phase::Orient, 0, np);
         let mut quadrics: Vec<LocalQuadric> = estimates.iter().map(|e| e.quadric).collect();
-        let nn_dist: Vec<f64> = estimates.iter().map(|e| e.nn_dist).collect();
+        let nn_dist: Vec<f64> = estimates
+            .iter()
+            .map(|e| e.nn_dist.min(f64::MAX).max(FOOT_SHORTCUT * e.radius))
+            .collect();
         let mut normals: Vec<[f64; 3]> = quadrics
             .par_iter()
             .zip(&prescribed)
@@ -312,8 +319,10 @@ impl Target {
         &self.input_to_point
     }
 
-    /// Per point: distance to its nearest other point (normalized units), `#P`.
-    pub fn nearest_neighbor_distances(&self) -> &[f64] {
+    /// Per point: twice the radius within which a foot point computed on this point's quadric is
+    /// accepted without a second kd-tree query (normalized units), `#P`: the larger of the
+    /// nearest-neighbour spacing and the fitting neighbourhood's radius.
+    pub fn foot_shortcut_diameters(&self) -> &[f64] {
         &self.nn_dist
     }
 
