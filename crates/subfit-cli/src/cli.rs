@@ -29,6 +29,67 @@ pub enum Command {
     Analyze(AnalyzeArgs),
     /// Evaluate the exact limit surface at random (face, u, v) parameters.
     Eval(EvalArgs),
+    /// Fit a control mesh's limit surface to a target (PDM, TDM or SDM).
+    Fit(FitArgs),
+}
+
+/// `subfit fit`.
+#[derive(clap::Args, Debug)]
+pub struct FitArgs {
+    /// The target: a point cloud or a mesh (any supported format).
+    pub target: PathBuf,
+    /// Initial control mesh, in the target's coordinates (any mesh format).
+    #[arg(long)]
+    pub init: PathBuf,
+    /// Error term: point (PDM), tangent (TDM) or squared distance (SDM), Cheng et al. 2007.
+    #[arg(long, value_enum, default_value_t = MethodArg::Sdm)]
+    pub method: MethodArg,
+    /// Step control: none, Levenberg-Marquardt, or Armijo backtracking.
+    #[arg(long, value_enum, default_value_t = StepArg::Lm)]
+    pub step: StepArg,
+    /// Smoothing weight λ (dimensionless; 0 disables smoothing).
+    #[arg(long, default_value_t = 1e-3)]
+    pub lambda: f64,
+    /// Refinement level at which the limit surface is sampled.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=6))]
+    pub sample_level: u32,
+    /// Maximum number of iterations.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub max_iterations: u32,
+    /// Stop when E_rms (unit-cube units) is at most this; exit code 1 if it is not reached.
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Stop when E_max (unit-cube units) is at most this; exit code 1 if it is not reached.
+    #[arg(long)]
+    pub max_error: Option<f64>,
+    /// Subdivision scheme; `auto` picks Loop for all-triangle meshes, Catmull-Clark otherwise.
+    #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
+    pub scheme: SchemeArg,
+    /// Output directory (control.obj, limit.ply, log.csv, report.json).
+    #[arg(short, long, default_value = "subfit-fit")]
+    pub output: PathBuf,
+}
+
+/// An error term named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Point distance minimization.
+    Pdm,
+    /// Tangent distance minimization.
+    Tdm,
+    /// Squared distance minimization.
+    Sdm,
+}
+
+/// A step control named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum StepArg {
+    /// Take the full step.
+    None,
+    /// Levenberg-Marquardt damping with the gain ratio.
+    Lm,
+    /// Armijo backtracking on the step length.
+    Armijo,
 }
 
 /// `subfit eval`.

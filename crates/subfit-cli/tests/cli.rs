@@ -389,3 +389,102 @@ fn eval_writes_exact_limit_samples_with_their_parameters() {
     assert_eq!(text.lines().count(), 10);
     assert_eq!(text.lines().next().unwrap().split_whitespace().count(), 6);
 }
+
+const ELLIPSOID_OCTAHEDRON: &[u8] =
+    b"v 0.25 0 0\nv -0.25 0 0\nv 0 0.5 0\nv 0 -0.5 0\nv 0 0 1\nv 0 0 -1\n\
+f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+#[test]
+fn fit_writes_cage_limit_log_and_report() {
+    let d = tempfile::tempdir().unwrap();
+    let demo = d.path().join("demo");
+    assert!(
+        subfit(&["demo", "-o", demo.to_str().unwrap(), "--points", "8000"])
+            .status
+            .success()
+    );
+    let target = demo.join("ellipsoid.ply");
+    let init = write(d.path(), "octa.obj", ELLIPSOID_OCTAHEDRON);
+    let out = d.path().join("fit");
+    let args = |extra: &[&str]| {
+        let mut v = vec![
+            "fit".to_string(),
+            target.to_str().unwrap().to_string(),
+            "--init".into(),
+            init.to_str().unwrap().into(),
+            "-o".into(),
+            out.to_str().unwrap().into(),
+            "--max-iterations".into(),
+            "8".into(),
+        ];
+        v.extend(extra.iter().map(|s| s.to_string()));
+        v
+    };
+    let run = |extra: &[&str]| {
+        let a = args(extra);
+        subfit(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    // No tolerance asked: success.
+    let r = run(&["--lambda", "0"]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    let e0 = report["initial"]["e_rms"].as_f64().unwrap();
+    let e1 = report["final"]["e_rms"].as_f64().unwrap();
+    assert!(e1 < e0 / 5.0, "{e0} -> {e1}");
+    assert_eq!(report["control_points"], 6);
+    let rows = report["iterations"].as_array().unwrap().len();
+    assert!(rows >= 1 && rows <= 8);
+    let csv = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        rows + 2,
+        "header + initial row + iterations"
+    );
+    // The cage is in the target's coordinates; the limit has normals and faces.
+    let cage: serde_json::Value = serde_json::from_slice(
+        &subfit(&["info", "--json", out.join("control.obj").to_str().unwrap()]).stdout,
+    )
+    .unwrap();
+    assert_eq!(cage["vertices"], 6);
+    let z = cage["bbox"]["max"][2].as_f64().unwrap();
+    // Loop limits shrink: the fitted apex lies outside the target to pull the limit out to it.
+    assert!(z > 1.0 && z < 4.0, "{z}");
+    let limit: serde_json::Value = serde_json::from_slice(
+        &subfit(&["info", "--json", out.join("limit.ply").to_str().unwrap()]).stdout,
+    )
+    .unwrap();
+    assert_eq!(limit["normals"], true);
+    assert_eq!(limit["topology"]["genus"], 0);
+    let lz = limit["bbox"]["max"][2].as_f64().unwrap();
+    assert!((lz - 1.0).abs() < 0.1, "{lz}");
+
+    // An unreachable tolerance: exit code 1, outputs still written.
+    std::fs::remove_dir_all(&out).unwrap();
+    let r = run(&["--tolerance", "1e-9"]);
+    assert_eq!(r.status.code(), Some(1));
+    assert!(out.join("report.json").exists() && out.join("control.obj").exists());
+
+    // Bad options: exit code 2 before any work.
+    for bad in [
+        &["--lambda", "-1"][..],
+        &["--tolerance", "3"][..],
+        &["--method", "xdm"][..],
+    ] {
+        assert_eq!(run(bad).status.code(), Some(2), "{bad:?}");
+    }
+    let r = subfit(&[
+        "fit",
+        target.to_str().unwrap(),
+        "--init",
+        "/nonexistent.obj",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+}

@@ -4,8 +4,10 @@
 //! - [`mesh`]: polygon topology, half-edge view, diagnostics, generated shapes;
 //! - [`io`]: PLY, OBJ, OFF, STL and XYZ readers and writers;
 //! - [`subdiv`]: subdivision schemes, stencils and limit evaluation;
-//! - [`target`]: the shape being fitted (normals, curvature, foot points).
+//! - [`target`]: the shape being fitted (normals, curvature, foot points);
+//! - [`fit`]: the fitting engine (PDM/TDM/SDM, smoothing, LM and Armijo step control).
 
+pub use subfit_fit as fit;
 pub use subfit_io as io;
 pub use subfit_mesh as mesh;
 pub use subfit_subdiv as subdiv;

@@ -4,6 +4,7 @@ mod analyze;
 mod convert;
 mod demo;
 mod eval;
+mod fit;
 mod info;
 mod subdivide;
 
@@ -20,5 +21,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Subdivide(a) => subdivide::run(a),
         Command::Analyze(a) => analyze::run(a),
         Command::Eval(a) => eval::run(a),
+        Command::Fit(a) => fit::run(a),
     }
 }
