@@ -100,3 +100,30 @@ fn mesh_target_initial_mesh_keeps_the_genus() {
         Err(subfit_init::InitError::TooFewVertices(3))
     ));
 }
+
+#[test]
+fn noisy_torus_cloud_still_has_genus_one() {
+    let shape = Shape::DEFAULT_TORUS;
+    let cloud = shape.sample(8000, 0.002, 11);
+    let t = Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .unwrap();
+    let (m, rep) = contour(&t, &ContourOptions::default()).unwrap();
+    assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
+}
+
+#[test]
+fn invalid_contour_options_are_errors() {
+    let t = target_of(&Shape::PAPER_ELLIPSOID, 2000);
+    let bad = ContourOptions {
+        min_component_fraction: 2.0,
+        ..ContourOptions::default()
+    };
+    assert!(matches!(
+        contour(&t, &bad),
+        Err(subfit_init::ContourError::InvalidOption(_))
+    ));
+}

@@ -136,3 +136,34 @@ fn real_meshes_keep_their_genus() {
         assert_eq!(topology(&out).1, 0, "{file}");
     }
 }
+
+#[test]
+fn result_is_invariant_to_scale() {
+    let m = torus_mesh(1.0, 0.35, 40, 20, true);
+    let (ref_out, ref_rep) = simplify(&m, &opts(150)).unwrap();
+    let scaled = |s: f64| {
+        let mut ms = m.clone();
+        for p in &mut ms.positions {
+            *p = p.map(|c| c * s);
+        }
+        simplify(&ms, &opts(150)).unwrap()
+    };
+    // Powers of two scale exactly: the same collapses in the same order.
+    for s in [2f64.powi(-20), 2f64.powi(20)] {
+        let (out, rep) = scaled(s);
+        assert_eq!(out.faces, ref_out.faces, "scale {s}");
+        for (p, q) in out.positions.iter().zip(&ref_out.positions) {
+            assert_eq!(p.map(|c| c / s), *q);
+        }
+        assert_eq!(rep.max_error / s, ref_rep.max_error);
+    }
+    // Other factors round differently (and the regular torus has many cost ties), so only the
+    // outcome is compared.
+    for s in [1e-6, 1e6] {
+        let (out, rep) = scaled(s);
+        assert_eq!(out.num_vertices(), 150);
+        assert_eq!(topology(&out), (1, 0, 1));
+        let rel = (rep.max_error / s / ref_rep.max_error - 1.0).abs();
+        assert!(rel < 0.5, "scale {s}: {rep:?}");
+    }
+}
