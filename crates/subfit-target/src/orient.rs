@@ -24,6 +24,7 @@
 
 use rayon::prelude::*;
 
+use crate::neighbors::morton_order;
 use crate::vec3::{add, dot, norm, normalize, scale, sub};
 
 /// Outcome of [`orient_normals`].
@@ -67,7 +68,9 @@ const CONSENSUS_SWEEPS: usize = 8;
 /// The volume sum decides a component's sign when `|Σ a n·(p−c)| ≥ this · Σ a |n·(p−c)|`.
 const VOLUME_DECISIVE: f64 = 0.2;
 
-/// Orients `normals` (unit, `#P by 3`) in place; see the module doc.
+/// Orients `normals` (unit, `#P by 3`) in place; see the module doc. The work is done on a copy
+/// renumbered in Morton order of the points (memory locality; points are expected in the unit
+/// cube, others still work, with less locality).
 pub fn orient_normals(
     points: &[[f64; 3]],
     normals: &mut [[f64; 3]],
@@ -75,16 +78,52 @@ pub fn orient_normals(
     input: &OrientInput<'_>,
 ) -> Orientation {
     let n = points.len();
-    let original: Vec<[f64; 3]> = normals.to_vec();
-    let tree = spanning_tree(points, normals, graph, input);
-    let components = propagate(points, normals, &tree, input);
-    consensus(points, normals, graph, input);
+    let k = graph.stride;
+    let order = morton_order(points);
+    let mut rank = vec![0u32; n];
+    for (r, &i) in order.iter().enumerate() {
+        rank[i as usize] = r as u32;
+    }
+    let gather = |v: &[bool]| -> Vec<bool> { order.par_iter().map(|&i| v[i as usize]).collect() };
+    let pts: Vec<[f64; 3]> = order.par_iter().map(|&i| points[i as usize]).collect();
+    let mut nrm: Vec<[f64; 3]> = order.par_iter().map(|&i| normals[i as usize]).collect();
+    let area: Vec<f64> = order.par_iter().map(|&i| input.area[i as usize]).collect();
+    let (ambiguous, fixed) = (gather(input.ambiguous), gather(input.fixed));
+    let mut targets = vec![u32::MAX; n * k];
+    targets
+        .par_chunks_mut(k)
+        .zip(order.par_iter())
+        .for_each(|(row, &i)| {
+            let i = i as usize;
+            for (t, &j) in row.iter_mut().zip(&graph.targets[i * k..(i + 1) * k]) {
+                if j != u32::MAX {
+                    *t = rank[j as usize];
+                }
+            }
+        });
+    let graph = KnnGraph {
+        targets: &targets,
+        stride: k,
+    };
+    let input = OrientInput {
+        ambiguous: &ambiguous,
+        fixed: &fixed,
+        area: &area,
+        tangent_penalty: input.tangent_penalty,
+    };
+    let tree = spanning_tree(&pts, &nrm, graph, &input);
+    let components = propagate(&pts, &mut nrm, &tree, &input);
+    consensus(&pts, &mut nrm, graph, &input);
     let flipped = normals
-        .par_iter()
-        .zip(&original)
-        .map(|(a, b)| dot(*a, *b) < 0.0)
+        .par_iter_mut()
+        .zip(rank.par_iter())
+        .map(|(o, &r)| {
+            let new = nrm[r as usize];
+            let f = dot(*o, new) < 0.0;
+            *o = new;
+            f
+        })
         .collect();
-    debug_assert_eq!(original.len(), n);
     Orientation {
         flipped,
         components,
