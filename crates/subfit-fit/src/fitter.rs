@@ -48,7 +48,7 @@ pub struct Fitter<'t> {
 impl<'t> Fitter<'t> {
     /// Prepares fitting `faces` (over `num_vertices` control points, with crease/corner `tags`)
     /// to `target`. Builds the sampling operator at `options.sample_level`, the umbrella
-    /// Laplacian and the pattern of `H`. The control points themselves are given to
+    /// Laplacian, the pattern of `H` and its symbolic Cholesky analysis. The control points themselves are given to
     /// [`Self::run`], in the target's normalized coordinates.
     ///
     /// Errors: invalid options, invalid control topology (see [`subfit_subdiv::SubdivError`]).
@@ -80,12 +80,16 @@ impl<'t> Fitter<'t> {
         let pattern = Pattern::new(&op.position, &lap, block);
         let values = vec![0.0; pattern.nnz()];
         let bbox_diagonal = bbox_diagonal(target.points());
+        let mut solver = CholeskySolver::new();
+        solver
+            .analyse(&pattern)
+            .map_err(|e| FitError::Solver(format!("symbolic analysis: {e:?}")))?;
         Ok(Self {
             target,
             options: options.clone(),
             op,
             pattern,
-            solver: CholeskySolver::new(),
+            solver,
             values,
             hdiag: Vec::new(),
             q: Vec::new(),

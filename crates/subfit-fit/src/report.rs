@@ -102,8 +102,8 @@ pub struct FitReport {
     pub iterations: Vec<IterationRow>,
     /// Why the loop stopped.
     pub stop: StopReason,
-    /// Setup time (sampling operator, pattern, symbolic analysis happen in
-    /// [`crate::Fitter::new`] and the first solve; this is the time spent in `new`).
+    /// Setup time spent in [`crate::Fitter::new`]: sampling operator, pattern and the symbolic
+    /// Cholesky analysis.
     pub setup: std::time::Duration,
 }
 

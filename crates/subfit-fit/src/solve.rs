@@ -50,6 +50,23 @@ impl CholeskySolver {
         self.symbolic.as_ref().map(SymbolicCholesky::len_val)
     }
 
+    /// The symbolic analysis (fill-reducing ordering, elimination tree, supernodes) of
+    /// `pattern`, unless already done. Cost: roughly one numeric factorization or less.
+    pub fn analyse(&mut self, pattern: &Pattern) -> Result<(), SolveFailure> {
+        if self.symbolic.is_none() {
+            let s = factorize_symbolic_cholesky(
+                symbolic_ref(pattern),
+                Side::Upper,
+                Default::default(),
+                Default::default(),
+            )
+            .map_err(|e| SolveFailure::Other(format!("{e:?}")))?;
+            self.factor = vec![0.0; s.len_val()];
+            self.symbolic = Some(s);
+        }
+        Ok(())
+    }
+
     /// Factors `A` (upper triangle in `values`, pattern `pattern`) and solves `A X = B` in
     /// place. `rhs` is column-major `dim × nrhs`.
     ///
@@ -68,24 +85,8 @@ impl CholeskySolver {
     ) -> Result<(), SolveFailure> {
         let dim = pattern.dim();
         assert_eq!(rhs.len(), dim * nrhs, "rhs length");
-        let sym = SymbolicSparseColMatRef::new_checked(
-            dim,
-            dim,
-            pattern.col_ptr(),
-            None,
-            pattern.row_idx(),
-        );
-        if self.symbolic.is_none() {
-            let s = factorize_symbolic_cholesky(
-                sym,
-                Side::Upper,
-                Default::default(),
-                Default::default(),
-            )
-            .map_err(|e| SolveFailure::Other(format!("{e:?}")))?;
-            self.factor = vec![0.0; s.len_val()];
-            self.symbolic = Some(s);
-        }
+        self.analyse(pattern)?;
+        let sym = symbolic_ref(pattern);
         let symbolic = self.symbolic.as_ref().expect("analysed above");
         let par = get_global_parallelism();
         let mat = SparseColMatRef::new(sym, values);
@@ -113,4 +114,10 @@ impl CholeskySolver {
         llt.solve_in_place_with_conj(Conj::No, x, par, MemStack::new(&mut buf));
         Ok(())
     }
+}
+
+/// The CSC pattern of `pattern` as a `faer` symbolic matrix.
+fn symbolic_ref(pattern: &Pattern) -> SymbolicSparseColMatRef<'_, usize> {
+    let dim = pattern.dim();
+    SymbolicSparseColMatRef::new_checked(dim, dim, pattern.col_ptr(), None, pattern.row_idx())
 }
