@@ -92,7 +92,10 @@ fn prism() -> (Vec<[f64; 3]>, Polygons) {
     (pts, faces)
 }
 
-fn corpus() -> Vec<(&'static str, Scheme, Vec<[f64; 3]>, Polygons, Tags)> {
+/// A named test mesh: scheme, positions, faces, tags.
+type Case = (&'static str, Scheme, Vec<[f64; 3]>, Polygons, Tags);
+
+fn corpus() -> Vec<Case> {
     let (tp, tf) = torus(6, 5, true);
     let (qp, qf) = torus(6, 5, false);
     let (gp, gf) = grid(4, true);
