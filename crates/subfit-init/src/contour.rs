@@ -12,6 +12,9 @@
 //! So the surface cannot grow sheets away from the data, and a scan with holes larger than the
 //! band leaks (its inside is taken as outside; the surface then hugs the band's inner side).
 //!
+//! If most band nodes next to the outside region are negative, the normals point inward and the
+//! IMLS values are negated ([`ContourReport::flipped`]).
+//!
 //! Then small components are removed ([`ContourOptions::min_component_fraction`]). Vertices on
 //! shared grid edges are welded by edge keys. Cost: `O(N³)` flags for an `N`-cell grid plus one
 //! IMLS evaluation per band node (parallel in `subfit-target`).
@@ -64,6 +67,9 @@ pub struct ContourReport {
     pub band_nodes: usize,
     /// Nodes off the band classified inside by the flood fill.
     pub enclosed_nodes: usize,
+    /// Whether the IMLS sign was flipped because most band nodes next to the outside were
+    /// negative (inward-pointing normals).
+    pub flipped: bool,
     /// Components of the raw contour.
     pub components_found: usize,
     /// Components kept.
@@ -169,6 +175,24 @@ pub fn contour(
             }
         }
     }
+    // Band nodes next to the outside should be positive; if most are negative the normals
+    // point inward: flip the sign of the IMLS values.
+    let (mut pos_rim, mut neg_rim) = (0usize, 0usize);
+    for &i in &band_ids {
+        if grid.neighbors6(i).any(|j| !in_band[j] && value[j] == far) {
+            if value[i] < 0.0 {
+                neg_rim += 1;
+            } else {
+                pos_rim += 1;
+            }
+        }
+    }
+    let flipped = neg_rim > pos_rim;
+    if flipped {
+        for &i in &band_ids {
+            value[i] = -value[i];
+        }
+    }
     let mut enclosed = 0;
     for v in value.iter_mut().filter(|v| v.is_nan()) {
         *v = -far;
@@ -191,6 +215,7 @@ pub fn contour(
         band_cells: band,
         band_nodes: band_ids.len(),
         enclosed_nodes: enclosed,
+        flipped,
         components_found: found,
         components_kept: kept,
         vertices: mesh.num_vertices(),

@@ -31,6 +31,7 @@ fn check_contour(shape: Shape, n: usize) {
     let (m, rep) = contour(&t, &ContourOptions::default()).unwrap();
     assert_eq!(topology(&m), (shape.genus(), 0, 1), "{shape:?}: {rep:?}");
     assert_eq!(rep.genus, shape.genus());
+    assert!(!rep.flipped);
     let worst = m
         .positions
         .iter()
@@ -126,4 +127,32 @@ fn invalid_contour_options_are_errors() {
         contour(&t, &bad),
         Err(subfit_init::ContourError::InvalidOption(_))
     ));
+}
+
+#[test]
+fn inward_normals_are_detected_and_flipped() {
+    let shape = Shape::DEFAULT_TORUS;
+    let cloud = shape.sample(6000, 0.0, 3);
+    let inward: Vec<[f64; 3]> = cloud
+        .normals
+        .as_ref()
+        .unwrap()
+        .iter()
+        .map(|n| n.map(|c| -c))
+        .collect();
+    let t =
+        Target::from_points(&cloud.positions, Some(&inward), &TargetOptions::default()).unwrap();
+    let (m, rep) = contour(&t, &ContourOptions::default()).unwrap();
+    assert!(rep.flipped, "{rep:?}");
+    assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
+    let worst = m
+        .positions
+        .iter()
+        .map(|&p| distance(&shape, &t, p))
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 1.5 * rep.cell_size,
+        "{worst} vs cell {}",
+        rep.cell_size
+    );
 }
