@@ -439,7 +439,7 @@ fn fit_writes_cage_limit_log_and_report() {
     assert!(e1 < e0 / 5.0, "{e0} -> {e1}");
     assert_eq!(report["control_points"], 6);
     let rows = report["iterations"].as_array().unwrap().len();
-    assert!(rows >= 1 && rows <= 8);
+    assert!((1..=8).contains(&rows));
     let csv = std::fs::read_to_string(out.join("log.csv")).unwrap();
     assert_eq!(
         csv.lines().count(),
