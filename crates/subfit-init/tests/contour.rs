@@ -156,3 +156,30 @@ fn inward_normals_are_detected_and_flipped() {
         rep.cell_size
     );
 }
+
+#[test]
+fn real_point_clouds_and_meshes_keep_their_genus() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    for (file, genus) in [("rocker-arm.off", 1), ("fertility.off", 4)] {
+        let (m, _) =
+            subfit_io::read_file(&dir.join(file), &subfit_io::ReadOptions::default()).unwrap();
+        // The vertices alone, normals estimated and oriented by the target.
+        let t = Target::from_points(&m.positions, None, &TargetOptions::default()).unwrap();
+        let opts = InitOptions {
+            expected_genus: Some(genus),
+            require_genus: true,
+            ..InitOptions::default()
+        };
+        let (out, rep) = initial_control_mesh(&t, None, 1000, &opts).unwrap();
+        assert_eq!(topology(&out), (genus, 0, 1), "{file}: {rep:?}");
+        assert!(out.num_vertices() <= 1050, "{file}: {rep:?}");
+        // The mesh itself.
+        let t = Target::from_mesh(&m, &TargetOptions::default()).unwrap();
+        let (out, rep) = initial_control_mesh(&t, Some(&m), 900, &opts).unwrap();
+        assert_eq!(rep.source, InitSource::Mesh);
+        assert_eq!(topology(&out), (genus, 0, 1), "{file}: {rep:?}");
+        assert_eq!(out.num_vertices(), 900, "{file}: {rep:?}");
+    }
+}
