@@ -1,8 +1,8 @@
 //! The initial control mesh (DESIGN.md §3.6: it has the target's topology, checked and reported).
 //!
-//! Mesh targets are simplified ([`crate::simplify`], Garland & Heckbert 1997 with the link
-//! condition of Dey et al. 1999), as Cheng et al. 2007 §I do after Marinov & Kobbelt; point
-//! clouds are contoured first ([`crate::contour`]: IMLS of Xie et al. 2023 on a grid, marching
+//! Mesh targets are simplified ([`crate::simplify`](mod@crate::simplify), Garland & Heckbert 1997 with the link
+//! condition of Dey et al. 1999), like the method of reference 13 in Cheng et al. 2007 §I; point
+//! clouds are contoured first ([`crate::contour`](mod@crate::contour): IMLS of Xie et al. 2023 on a grid, marching
 //! tetrahedra) and then simplified, as Cheng et al. 2004 §4.3 (marching cubes on an octree, then
 //! simplification).
 

@@ -1,12 +1,12 @@
 //! Initial control meshes with the target's topology (DESIGN.md §2 `subfit-init`, §3.6;
 //! Cheng et al. 2004 §4.3, Cheng et al. 2007 §II-C).
 //!
-//! * [`simplify`]: topology-preserving quadric-error edge collapse (Garland & Heckbert 1997) with
+//! * [`simplify`](mod@simplify): topology-preserving quadric-error edge collapse (Garland & Heckbert 1997) with
 //!   the link condition of Dey et al. 1999, for mesh targets and for contoured point clouds.
-//! * [`contour`]: a point cloud's IMLS function (Xie et al. 2023 eq. 2–3) sampled on a grid and
+//! * [`contour`](mod@contour): a point cloud's IMLS function (Xie et al. 2023 eq. 2–3) sampled on a grid and
 //!   contoured by marching tetrahedra (the ambiguity-free variant of Lorensen & Cline 1987), which
 //!   always yields a closed, manifold, consistently oriented surface.
-//! * [`init`]: the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
+//! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
 //!   contoured then simplified; the genus is checked against the target's and reported.
 //!
 //! Everything works in the target's normalized units (the unit cube). The library prints nothing.
