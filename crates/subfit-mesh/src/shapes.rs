@@ -477,3 +477,55 @@ mod tests {
         assert_eq!(cube_mesh(1.0).faces.len(), 6);
     }
 }
+
+/// A 14-vertex initial control mesh for an ellipsoid with semi-axes `a`, `b`, `c` in the style
+/// of Cheng et al. 2007, Examples 1–10: the octahedron [`octahedron_mesh`] with each face split
+/// 1-to-3 at its centroid, the centroid pushed out radially onto the ellipsoid (6 + 8 = 14
+/// vertices, 24 triangles; valences 8 and 3). `far = false` gives the mesh "near the shape"
+/// (Example 1: all vertices on the ellipsoid); `far = true` moves it farther away (Example 2):
+/// the vertices are scaled by 1.6, 0.6 and 1.5 along x, y, z and shifted by 0.1·(a, b, c).
+pub fn cheng_ellipsoid_cage(a: f64, b: f64, c: f64, far: bool) -> PolyMesh {
+    let octa = octahedron_mesh(a, b, c);
+    let mut pos = octa.positions.clone();
+    let mut faces = Polygons::with_capacity(24, 72);
+    for f in octa.faces.iter() {
+        let cen: [f64; 3] = std::array::from_fn(|k| {
+            (octa.positions[f[0] as usize][k]
+                + octa.positions[f[1] as usize][k]
+                + octa.positions[f[2] as usize][k])
+                / 3.0
+        });
+        let s = ((cen[0] / a).powi(2) + (cen[1] / b).powi(2) + (cen[2] / c).powi(2)).sqrt();
+        let id = pos.len() as u32;
+        pos.push([cen[0] / s, cen[1] / s, cen[2] / s]);
+        faces.push(&[f[0], f[1], id]);
+        faces.push(&[f[1], f[2], id]);
+        faces.push(&[f[2], f[0], id]);
+    }
+    if far {
+        for p in &mut pos {
+            *p = [
+                1.6 * p[0] + 0.1 * a,
+                0.6 * p[1] + 0.1 * b,
+                1.5 * p[2] + 0.1 * c,
+            ];
+        }
+    }
+    PolyMesh::new(pos, faces)
+}
+
+#[cfg(test)]
+mod cage_tests {
+    use super::*;
+
+    #[test]
+    fn cheng_cage_has_14_vertices_on_the_ellipsoid() {
+        let near = cheng_ellipsoid_cage(0.25, 0.5, 1.0, false);
+        assert_eq!(near.positions.len(), 14);
+        assert_eq!(near.faces.len(), 24);
+        let s = Shape::PAPER_ELLIPSOID;
+        assert!(near.positions.iter().all(|&p| s.implicit(p).abs() < 1e-12));
+        let far = cheng_ellipsoid_cage(0.25, 0.5, 1.0, true);
+        assert!(far.positions.iter().all(|&p| s.implicit(p).abs() > 0.05));
+    }
+}
