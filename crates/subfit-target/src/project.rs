@@ -106,9 +106,9 @@ impl Target {
     /// When the data point nearest to the first foot point may differ from the one nearest to
     /// `x` (queries far from the surface or near strong curvature), the projection is redone once
     /// on that point's quadric, which represents the surface better there. That second query is
-    /// skipped when the foot point lies well inside the data point's fitting neighbourhood
-    /// (within half its radius, or half the nearest-neighbour spacing, where no other data point
-    /// can be nearer: triangle inequality).
+    /// skipped when the foot point lies within half the nearest-neighbour spacing of the data
+    /// point (then no other data point can be nearer to it: triangle inequality), so the result
+    /// is the same as with the second query.
     pub fn foot_point(&self, x: [f64; 3]) -> FootPoint {
         let i = self.index().nearest(&x).index;
         let pi = self.points()[i as usize];
