@@ -31,6 +31,34 @@ pub enum Command {
     Eval(EvalArgs),
     /// Fit a control mesh's limit surface to a target (PDM, TDM or SDM).
     Fit(FitArgs),
+    /// Benchmarks and studies that print figures.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `subfit bench …`.
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Reproduce Cheng et al. 2007 Examples 1–4 and 6–10 on the ellipsoid: error-curve CSVs and
+    /// SVG plots of E_rms per iteration, one line per method.
+    Convergence(ConvergenceArgs),
+}
+
+/// `subfit bench convergence`.
+#[derive(clap::Args, Debug)]
+pub struct ConvergenceArgs {
+    /// Output directory for `exampleN.csv`, `exampleN.svg` and `summary.json`.
+    #[arg(short, long, default_value = "subfit-convergence")]
+    pub output: PathBuf,
+    /// Points sampled on each target ellipsoid.
+    #[arg(long, default_value_t = 30_000, value_parser = clap::value_parser!(u32).range(1000..=10_000_000))]
+    pub points: u32,
+    /// Iterations per run.
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub iterations: u32,
+    /// Run only these examples (e.g. `--examples 1,2`).
+    #[arg(long, value_delimiter = ',')]
+    pub examples: Vec<u32>,
 }
 
 /// `subfit fit`.

@@ -8,6 +8,7 @@
 
 mod cli;
 mod commands;
+mod plot;
 mod progress;
 
 use std::process::ExitCode;

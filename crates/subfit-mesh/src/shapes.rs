@@ -483,7 +483,7 @@ mod tests {
 /// 1-to-3 at its centroid, the centroid pushed out radially onto the ellipsoid (6 + 8 = 14
 /// vertices, 24 triangles; valences 8 and 3). `far = false` gives the mesh "near the shape"
 /// (Example 1: all vertices on the ellipsoid); `far = true` moves it farther away (Example 2):
-/// the vertices are scaled by 1.6, 0.6 and 1.5 along x, y, z and shifted by 0.1·(a, b, c).
+/// the vertices are scaled by 2.0, 0.5 and 1.8 along x, y, z and shifted by 0.15·(a, b, c).
 pub fn cheng_ellipsoid_cage(a: f64, b: f64, c: f64, far: bool) -> PolyMesh {
     let octa = octahedron_mesh(a, b, c);
     let mut pos = octa.positions.clone();
@@ -505,9 +505,9 @@ pub fn cheng_ellipsoid_cage(a: f64, b: f64, c: f64, far: bool) -> PolyMesh {
     if far {
         for p in &mut pos {
             *p = [
-                1.6 * p[0] + 0.1 * a,
-                0.6 * p[1] + 0.1 * b,
-                1.5 * p[2] + 0.1 * c,
+                2.0 * p[0] + 0.15 * a,
+                0.5 * p[1] + 0.15 * b,
+                1.8 * p[2] + 0.15 * c,
             ];
         }
     }

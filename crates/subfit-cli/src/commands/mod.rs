@@ -1,6 +1,7 @@
 //! One module per subcommand; `run` dispatches.
 
 mod analyze;
+mod bench;
 mod convert;
 mod demo;
 mod eval;
@@ -22,5 +23,6 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Analyze(a) => analyze::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Bench(b) => bench::run(b),
     }
 }
