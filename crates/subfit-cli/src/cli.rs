@@ -31,9 +31,29 @@ pub enum Command {
     Eval(EvalArgs),
     /// Fit a control mesh's limit surface to a target (PDM, TDM or SDM).
     Fit(FitArgs),
+    /// Two-sided distances (RMS, mean, max / Hausdorff) between two surfaces or point sets.
+    Compare(CompareArgs),
     /// Benchmarks and studies that print figures.
     #[command(subcommand)]
     Bench(BenchCommand),
+}
+
+/// `subfit compare`.
+#[derive(clap::Args, Debug)]
+pub struct CompareArgs {
+    /// First surface (a mesh) or point set.
+    pub a: PathBuf,
+    /// Second surface (a mesh) or point set.
+    pub b: PathBuf,
+    /// Points sampled uniformly by area on each mesh (point sets use all their points).
+    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u32).range(100..=100_000_000))]
+    pub samples: u32,
+    /// Random seed of the sampling.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `subfit bench …`.

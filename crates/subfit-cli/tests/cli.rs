@@ -488,3 +488,56 @@ fn fit_writes_cage_limit_log_and_report() {
     ]);
     assert_eq!(r.status.code(), Some(2));
 }
+
+#[test]
+fn compare_measures_two_sided_distances_between_concentric_cubes() {
+    let d = tempfile::tempdir().unwrap();
+    let inner = write(d.path(), "inner.obj", CUBE_OBJ.as_bytes());
+    // The same cube grown by 0.05 on every side.
+    let outer_obj: String = CUBE_OBJ
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(xyz) => {
+                let c: Vec<f64> = xyz
+                    .split_whitespace()
+                    .map(|t| t.parse::<f64>().unwrap() * 1.1 - 0.05)
+                    .collect();
+                format!("v {} {} {}\n", c[0], c[1], c[2])
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    let outer = write(d.path(), "outer.obj", outer_obj.as_bytes());
+    let r = subfit(&[
+        "compare",
+        inner.to_str().unwrap(),
+        outer.to_str().unwrap(),
+        "--json",
+        "--samples",
+        "4000",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let c: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    let g = |a: &str, b: &str| c[a][b].as_f64().unwrap();
+    // Every point of the inner cube is 0.05 from the outer one.
+    assert!((g("a_to_b", "rms") - 0.05).abs() < 1e-12);
+    assert!((g("a_to_b", "max") - 0.05).abs() < 1e-12);
+    // Points of the outer cube are between 0.05 (face centres) and 0.05·√3 (corners) away.
+    assert!(g("b_to_a", "mean") > 0.05 && g("b_to_a", "max") <= 0.05 * 3f64.sqrt() + 1e-12);
+    assert!((c["hausdorff"].as_f64().unwrap() - g("b_to_a", "max")).abs() < 1e-15);
+    assert_eq!(c["a_to_b"]["samples"], 4000);
+
+    // A point set against a mesh: its own vertices lie on it.
+    let pts = write(d.path(), "corners.xyz", b"0 0 0\n1 0 0\n0 1 0\n1 1 1\n");
+    let r = subfit(&[
+        "compare",
+        pts.to_str().unwrap(),
+        inner.to_str().unwrap(),
+        "--json",
+        "--samples",
+        "500",
+    ]);
+    let c: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(c["a_to_b"]["samples"], 4);
+    assert!(c["a_to_b"]["max"].as_f64().unwrap() < 1e-15);
+}

@@ -2,6 +2,7 @@
 
 mod analyze;
 mod bench;
+mod compare;
 mod convert;
 mod demo;
 mod eval;
@@ -23,6 +24,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Analyze(a) => analyze::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Compare(a) => compare::run(a),
         Command::Bench(b) => bench::run(b),
     }
 }

@@ -1,0 +1,195 @@
+//! `subfit compare A B`: two-sided distances between two surfaces or point sets.
+//!
+//! A mesh is sampled uniformly by area (`--samples` points, seeded) and queried through the
+//! exact closest point on its triangles (BVH); a point set is used as it is and queried through
+//! its nearest point (kd-tree). Distances are reported in the units of the files and as a
+//! fraction of B's bounding-box diagonal: RMS, mean and max in each direction, the two-sided RMS
+//! over both sample sets, and the Hausdorff distance (the larger max). Limit surfaces of control
+//! meshes are compared by tessellating them first (`subfit subdivide --limit`).
+
+use std::process::ExitCode;
+
+use anyhow::{bail, Context};
+use rayon::prelude::*;
+use serde::Serialize;
+use subfit::mesh::PolyMesh;
+use subfit::target::{PointIndex, TriangleBvh};
+
+use crate::cli::CompareArgs;
+
+/// One side of the comparison: where its samples are and how to measure distance to it.
+struct Surface {
+    samples: Vec<[f64; 3]>,
+    query: Query,
+}
+
+enum Query {
+    Mesh(TriangleBvh),
+    Points(PointIndex),
+}
+
+impl Query {
+    fn distance(&self, x: [f64; 3]) -> f64 {
+        match self {
+            Query::Mesh(b) => b.closest(x).map_or(f64::INFINITY, |c| c.distance),
+            Query::Points(p) => p.nearest(&x).distance,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct Direction {
+    samples: usize,
+    rms: f64,
+    mean: f64,
+    max: f64,
+}
+
+#[derive(Serialize)]
+struct Comparison {
+    a: String,
+    b: String,
+    a_to_b: Direction,
+    b_to_a: Direction,
+    two_sided_rms: f64,
+    hausdorff: f64,
+    /// B's bounding-box diagonal; the `*_fraction` values divide by it.
+    reference_diagonal: f64,
+    two_sided_rms_fraction: f64,
+    hausdorff_fraction: f64,
+}
+
+pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
+    let (ma, _) = crate::progress::load(&a.a)?;
+    let (mb, _) = crate::progress::load(&a.b)?;
+    let sa = surface(&ma, a.samples as usize, a.seed).with_context(|| a.a.display().to_string())?;
+    let sb = surface(&mb, a.samples as usize, a.seed ^ 0x9e37_79b9)
+        .with_context(|| a.b.display().to_string())?;
+    let sp = crate::progress::spinner("measuring distances");
+    let dab: Vec<f64> = sa
+        .samples
+        .par_iter()
+        .map(|&x| sb.query.distance(x))
+        .collect();
+    let dba: Vec<f64> = sb
+        .samples
+        .par_iter()
+        .map(|&x| sa.query.distance(x))
+        .collect();
+    sp.finish_and_clear();
+    let (ab, ba) = (stats(&dab), stats(&dba));
+    let n = (dab.len() + dba.len()) as f64;
+    let two_sided_rms =
+        ((ab.rms * ab.rms * dab.len() as f64 + ba.rms * ba.rms * dba.len() as f64) / n).sqrt();
+    let hausdorff = ab.max.max(ba.max);
+    let diag = mb
+        .bounding_box()
+        .map(|(lo, hi)| (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt())
+        .unwrap_or(0.0);
+    let frac = |v: f64| if diag > 0.0 { v / diag } else { f64::NAN };
+    let c = Comparison {
+        a: a.a.display().to_string(),
+        b: a.b.display().to_string(),
+        two_sided_rms,
+        hausdorff,
+        reference_diagonal: diag,
+        two_sided_rms_fraction: frac(two_sided_rms),
+        hausdorff_fraction: frac(hausdorff),
+        a_to_b: ab,
+        b_to_a: ba,
+    };
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&c)?);
+    } else {
+        for (name, d) in [("A → B", &c.a_to_b), ("B → A", &c.b_to_a)] {
+            println!(
+                "{name}   {} samples: RMS {:.6e}  mean {:.6e}  max {:.6e}",
+                d.samples, d.rms, d.mean, d.max
+            );
+        }
+        println!(
+            "two-sided RMS {:.6e} ({:.3e} of the diagonal); Hausdorff {:.6e} ({:.3e} of the diagonal)",
+            c.two_sided_rms, c.two_sided_rms_fraction, c.hausdorff, c.hausdorff_fraction
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn stats(d: &[f64]) -> Direction {
+    let n = d.len().max(1) as f64;
+    Direction {
+        samples: d.len(),
+        rms: (d.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
+        mean: d.iter().sum::<f64>() / n,
+        max: d.iter().copied().fold(0.0, f64::max),
+    }
+}
+
+fn surface(m: &PolyMesh, n: usize, seed: u64) -> anyhow::Result<Surface> {
+    if m.positions.is_empty() {
+        bail!("no points");
+    }
+    if m.faces.is_empty() {
+        let index = PointIndex::new(&m.positions).context("cannot index the points")?;
+        return Ok(Surface {
+            samples: m.positions.clone(),
+            query: Query::Points(index),
+        });
+    }
+    let tris = m.faces.triangulate_fan();
+    let samples = sample_triangles(&m.positions, &tris, n, seed);
+    if samples.is_empty() {
+        bail!("all faces have zero area");
+    }
+    Ok(Surface {
+        samples,
+        query: Query::Mesh(TriangleBvh::new(m.positions.clone(), tris)),
+    })
+}
+
+/// `n` points uniformly by area on the triangles (seeded SplitMix64; inverse CDF over the
+/// cumulative areas, then uniform barycentric coordinates).
+fn sample_triangles(p: &[[f64; 3]], tris: &[[u32; 3]], n: usize, seed: u64) -> Vec<[f64; 3]> {
+    let area = |t: &[u32; 3]| {
+        let (a, b, c) = (p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
+        let (u, v) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let w = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
+    };
+    let mut cum = Vec::with_capacity(tris.len());
+    let mut total = 0.0;
+    for t in tris {
+        total += area(t);
+        cum.push(total);
+    }
+    if !(total > 0.0 && total.is_finite()) {
+        return Vec::new();
+    }
+    let mut state = seed;
+    let mut next = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| {
+            let r = next() * total;
+            let i = cum.partition_point(|&c| c < r).min(tris.len() - 1);
+            let (mut s, mut t) = (next(), next());
+            if s + t > 1.0 {
+                (s, t) = (1.0 - s, 1.0 - t);
+            }
+            let [a, b, c] = tris[i].map(|v| p[v as usize]);
+            std::array::from_fn(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]))
+        })
+        .collect()
+}
