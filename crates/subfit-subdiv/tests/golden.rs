@@ -47,28 +47,11 @@ fn golden_dir() -> Option<PathBuf> {
     None
 }
 
-/// A tiny OBJ reader: `v x y z` and `f a b c …` (1-based, `a/b/c` forms allowed).
+/// Reads a golden control mesh with the project's OBJ reader.
 fn read_obj(path: &std::path::Path) -> (Vec<[f64; 3]>, Polygons) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut pts = Vec::new();
-    let mut faces = Polygons::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
-                pts.push([c[0], c[1], c[2]]);
-            }
-            Some("f") => {
-                let f: Vec<u32> = it
-                    .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                    .collect();
-                faces.push(&f);
-            }
-            _ => {}
-        }
-    }
-    (pts, faces)
+    let (mesh, _) = subfit_io::read_file(path, &subfit_io::ReadOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    (mesh.positions, mesh.faces)
 }
 
 /// Rows `x y z nx ny nz` after a count line.
