@@ -530,11 +530,14 @@ impl Collapser {
         if !link_ok {
             return Verdict::Link;
         }
-        // Lk(k) ∩ Lk(r) must not contain the edge between the two opposite vertices (the
-        // tetrahedron case): a face (k|r, c, d) would be duplicated.
+        // Lk(k) ∩ Lk(r) must not contain the edge `cd` between the two opposite vertices (the
+        // tetrahedron case). `cd` is in Lk(k) when the face (k, c, d) exists, in Lk(r) when
+        // (r, c, d) does: only both together would duplicate a face. (One alone is the common
+        // case of a valence-3 endpoint, which must stay collapsible: marching tetrahedra make
+        // many, and blocking them stalled the Igea contour at ~2,400 vertices.)
         if n_opp == 2 {
             let (c, d) = (opp[0], opp[1]);
-            let dup = [ki, ri].iter().any(|&v| {
+            let dup = [ki, ri].iter().all(|&v| {
                 self.vfaces[v].iter().any(|&f| {
                     let t = self.tris[f as usize];
                     t.contains(&c) && t.contains(&d)

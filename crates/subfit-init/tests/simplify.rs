@@ -167,3 +167,29 @@ fn result_is_invariant_to_scale() {
         assert!(rel < 0.5, "scale {s}: {rep:?}");
     }
 }
+
+/// Valence-3 vertices (a vertex inserted in each octahedron face) must be removable: a collapse
+/// `k → r` with `k` of valence 3 turns the face `(k, c, d)` into `(r, c, d)`, which is legal
+/// unless `(r, c, d)` exists too. Rejecting it stalled point-cloud contours (regression).
+#[test]
+fn valence_three_vertices_are_collapsible() {
+    let base = subfit_mesh::shapes::octahedron_mesh(1.0, 1.0, 1.0);
+    let mut positions = base.positions.clone();
+    let mut tris = Vec::new();
+    for t in base.faces.iter() {
+        let c = centroid(&base, t);
+        let len = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        // Slightly outside the face, so that no collapse is a fold.
+        positions.push(c.map(|x| x * 1.1 / (len * 3f64.sqrt())));
+        let m = (positions.len() - 1) as u32;
+        tris.extend([[t[0], t[1], m], [t[1], t[2], m], [t[2], t[0], m]]);
+    }
+    let m = subfit_mesh::PolyMesh::new(positions, subfit_mesh::Polygons::from_triangles(&tris));
+    assert_eq!(topology(&m), (0, 0, 1));
+    for n in [6, 4] {
+        let (out, rep) = simplify(&m, &opts(n)).unwrap();
+        assert!(rep.reached_target, "target {n}: {rep:?}");
+        assert_eq!(out.num_vertices(), n);
+        assert_eq!(topology(&out), (0, 0, 1));
+    }
+}
