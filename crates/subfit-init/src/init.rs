@@ -15,7 +15,7 @@ use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
 use crate::simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
 
 /// Options of [`initial_control_mesh`].
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct InitOptions {
     /// Simplification options; `target_vertices` is replaced by the requested vertex count.
     pub simplify: SimplifyOptions,
@@ -28,6 +28,50 @@ pub struct InitOptions {
     /// Fail with [`InitError::GenusMismatch`] when the result's genus differs from the target's.
     /// Default `false` (the mismatch is only reported).
     pub require_genus: bool,
+    /// Point clouds: when the contour has fewer than this many vertices per requested control
+    /// vertex and [`ContourOptions::resolution`] is automatic, the cloud is contoured again on a
+    /// finer grid (the vertex count grows with the resolution squared; at most
+    /// [`ContourOptions::max_resolution`]), so that the simplification has room to place the
+    /// control vertices. Default 8.
+    pub contour_vertices_per_control: f64,
+}
+
+impl Default for InitOptions {
+    fn default() -> Self {
+        Self {
+            simplify: SimplifyOptions::default(),
+            contour: ContourOptions::default(),
+            expected_genus: None,
+            require_genus: false,
+            contour_vertices_per_control: 8.0,
+        }
+    }
+}
+
+/// The default control-vertex count for a target of `target_points` points:
+/// `clamp(round(1.5·√points), 200, 2000)` — 550 for Igea's 134k points (Cheng et al. 2007
+/// Tab. IV start from 526), 300 for the rocker arm's 40k. The same rule as `subfit fit`'s
+/// default. Cost `O(1)`.
+pub fn default_control_points(target_points: usize) -> usize {
+    ((1.5 * (target_points as f64).sqrt()).round() as usize).clamp(200, 2000)
+}
+
+/// Fewest vertices of a triangulated surface of genus `genus` with `boundary_loops` boundary
+/// loops (one component). Closed: Heawood's bound `⌈(7 + √(1 + 48g)) / 2⌉` (4 for a sphere,
+/// 7 for a torus, 11 for genus 4), attained by minimal triangulations for every `g` but 2 (10;
+/// Jungerman & Ringel 1980); with
+/// boundary: at least 3 per loop, and Heawood's bound when `g > 0`. A necessary condition
+/// only: simplification usually stops well above it (see
+/// [`SimplifyReport::reached_target`]). Cost `O(1)`.
+pub fn min_vertices_for_topology(genus: u32, boundary_loops: usize) -> usize {
+    let heawood = ((7.0 + (1.0 + 48.0 * f64::from(genus)).sqrt()) / 2.0 - 1e-9).ceil() as usize;
+    // Jungerman & Ringel 1980: the bound is attained for every orientable genus but 2.
+    let heawood = if genus == 2 { 10 } else { heawood };
+    match boundary_loops {
+        0 => heawood.max(4),
+        b if genus == 0 => (3 * b).max(3),
+        b => (3 * b).max(heawood),
+    }
 }
 
 /// Where the initial mesh came from.
@@ -85,6 +129,31 @@ pub enum InitError {
     /// `n_vertices` is below 4 (no closed triangle mesh has fewer).
     #[error("at least 4 control vertices are needed, {0} requested")]
     TooFewVertices(usize),
+    /// The mesh target is not an oriented 2-manifold (the error names the edge, vertex or
+    /// face); its points can still be contoured (pass `mesh = None`).
+    #[error("the target mesh is not an oriented manifold: {0}")]
+    InvalidMesh(TopologyError),
+    /// A mesh target's vertex has a NaN or infinite coordinate.
+    #[error("target mesh vertex {0} has a non-finite coordinate")]
+    NonFinite(usize),
+    /// The requested vertex count is below what the topology allows
+    /// ([`min_vertices_for_topology`], summed over the components).
+    #[error(
+        "{requested} control vertices requested, but a surface with {components} component(s), \
+         genus {genus} and {boundary_loops} boundary loop(s) needs at least {minimum}"
+    )]
+    TooFewForTopology {
+        /// The requested count.
+        requested: usize,
+        /// The smallest possible count.
+        minimum: usize,
+        /// Total genus of the surface to simplify.
+        genus: u32,
+        /// Its boundary loops.
+        boundary_loops: usize,
+        /// Its connected components.
+        components: usize,
+    },
     /// The mesh target cannot be simplified.
     #[error("simplification failed: {0}")]
     Simplify(#[from] SimplifyError),
@@ -128,32 +197,28 @@ pub fn initial_control_mesh(
     let dense = match mesh {
         Some(m) if !m.faces.is_empty() => {
             report.source = InitSource::Mesh;
-            let mut m = PolyMesh::new(
-                m.positions
-                    .iter()
-                    .map(|&p| target.to_normalized(p))
-                    .collect(),
-                m.faces.clone(),
-            );
-            m.faces = subfit_mesh::Polygons::from_triangles(&m.faces.triangulate_fan());
-            m
+            normalized_mesh(target, m)?
         }
         _ => {
             report.source = InitSource::Contour;
             let t = Instant::now();
-            let (m, c) = contour(target, &options.contour)?;
+            let (m, c) = contour_for(target, n_vertices, options)?;
             report.timings.contour = t.elapsed();
             report.contour = Some(c);
             m
         }
     };
-    let before = HalfEdgeMesh::from_mesh(&dense)?;
+    let before = HalfEdgeMesh::from_mesh(&dense).map_err(|e| match report.source {
+        InitSource::Mesh => InitError::InvalidMesh(e),
+        InitSource::Contour => InitError::Topology(e),
+    })?;
     report.genus_before = before.genus();
     report.genus_target = match (report.source, options.expected_genus) {
         (InitSource::Contour, Some(g)) => g,
         _ => report.genus_before,
     };
     let loops_before = before.boundary_loops().len();
+    check_topology_allows(&before, n_vertices)?;
     drop(before);
 
     let t = Instant::now();
@@ -180,4 +245,91 @@ pub fn initial_control_mesh(
         });
     }
     Ok((out, report))
+}
+
+/// `m` (original coordinates) mapped into the target's normalized units and fan-triangulated;
+/// checked for non-finite coordinates.
+fn normalized_mesh(target: &Target, m: &PolyMesh) -> Result<PolyMesh, InitError> {
+    if let Some(v) = m
+        .positions
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        return Err(InitError::NonFinite(v));
+    }
+    let positions = m
+        .positions
+        .iter()
+        .map(|&p| target.to_normalized(p))
+        .collect();
+    let tris = m.faces.triangulate_fan();
+    Ok(PolyMesh::new(
+        positions,
+        subfit_mesh::Polygons::from_triangles(&tris),
+    ))
+}
+
+/// The contour of the target's points, re-contoured once on a finer grid when it has fewer
+/// than [`InitOptions::contour_vertices_per_control`] vertices per requested control vertex
+/// and the resolution is automatic; the finer contour is used only when its genus and
+/// component count agree with the coarse one's.
+fn contour_for(
+    target: &Target,
+    n_vertices: usize,
+    options: &InitOptions,
+) -> Result<(PolyMesh, ContourReport), InitError> {
+    let (m, c) = contour(target, &options.contour)?;
+    let wanted = options.contour_vertices_per_control * n_vertices as f64;
+    if options.contour.resolution.is_some()
+        || !(wanted > c.vertices as f64)
+        || c.resolution >= options.contour.max_resolution
+    {
+        return Ok((m, c));
+    }
+    // Vertices grow with the square of the resolution; 10 % margin.
+    let factor = (wanted / c.vertices.max(1) as f64).sqrt() * 1.1;
+    let res = ((c.resolution as f64 * factor).ceil() as usize)
+        .clamp(c.resolution + 1, options.contour.max_resolution);
+    let finer = ContourOptions {
+        resolution: Some(res),
+        ..options.contour.clone()
+    };
+    // A finer grid resolves more of the IMLS function's noise: on thin parts it can open
+    // spurious handles (the armadillo at 2.5 cells per radius). The coarse contour's topology
+    // is the more trustworthy; keep it when the two disagree.
+    match contour(target, &finer) {
+        Ok((fm, fc)) if fc.genus == c.genus && fc.components_kept == c.components_kept => {
+            Ok((fm, fc))
+        }
+        _ => Ok((m, c)),
+    }
+}
+
+/// [`InitError::TooFewForTopology`] when `n_vertices` is below the sum over the components of
+/// [`min_vertices_for_topology`].
+fn check_topology_allows(he: &HalfEdgeMesh, n_vertices: usize) -> Result<(), InitError> {
+    let comps = he.components();
+    let genera = he.component_genera();
+    let mut loops = vec![0usize; comps.count];
+    for lp in he.boundary_loops() {
+        if let Some(l) = lp.first().map(|v| comps.vertex_labels[v.idx()] as usize) {
+            loops[l] += 1;
+        }
+    }
+    let minimum: usize = genera
+        .iter()
+        .zip(&loops)
+        .map(|(&g, &b)| min_vertices_for_topology(g, b))
+        .sum();
+    let (genus, loops) = (genera.iter().sum(), loops.iter().sum());
+    if n_vertices < minimum {
+        return Err(InitError::TooFewForTopology {
+            requested: n_vertices,
+            minimum,
+            genus,
+            boundary_loops: loops,
+            components: comps.count,
+        });
+    }
+    Ok(())
 }

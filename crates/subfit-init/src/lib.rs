@@ -19,5 +19,8 @@ pub mod init;
 pub mod simplify;
 
 pub use contour::{contour, ContourError, ContourOptions, ContourReport};
-pub use init::{initial_control_mesh, InitError, InitOptions, InitReport, InitSource, InitTimings};
+pub use init::{
+    default_control_points, initial_control_mesh, min_vertices_for_topology, InitError,
+    InitOptions, InitReport, InitSource, InitTimings,
+};
 pub use simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
