@@ -31,11 +31,39 @@ pub enum Command {
     Eval(EvalArgs),
     /// Fit a control mesh's limit surface to a target (PDM, TDM or SDM).
     Fit(FitArgs),
+    /// Build an initial control mesh with the target's topology (QEM simplification of a mesh,
+    /// or an implicit surface of the points contoured and simplified).
+    Init(InitArgs),
     /// Two-sided distances (RMS, mean, max / Hausdorff) between two surfaces or point sets.
     Compare(CompareArgs),
     /// Benchmarks and studies that print figures.
     #[command(subcommand)]
     Bench(BenchCommand),
+}
+
+/// `subfit init`.
+#[derive(clap::Args, Debug)]
+pub struct InitArgs {
+    /// The target: a point cloud or a mesh (any supported format).
+    pub target: PathBuf,
+    /// Control points (vertices) of the cage [default: clamp(round(1.5·√points), 200, 2000),
+    /// the rule of `subfit fit`].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
+    pub control_points: Option<u32>,
+    /// Ignore the target's faces: contour an implicit surface of its points instead of
+    /// simplifying the mesh.
+    #[arg(long)]
+    pub from_points: bool,
+    /// Fail (exit code 2) when the cage's genus differs from the target's (a mesh target's, or
+    /// `--genus` for a point cloud).
+    #[arg(long)]
+    pub require_genus: bool,
+    /// Genus expected of a point-cloud target (checked with `--require-genus`, reported otherwise).
+    #[arg(long)]
+    pub genus: Option<u32>,
+    /// Output control mesh (.obj, .ply, .off or .stl), in the target's coordinates.
+    #[arg(short, long, default_value = "control.obj")]
+    pub output: PathBuf,
 }
 
 /// `subfit compare`.

@@ -8,6 +8,7 @@ mod demo;
 mod eval;
 mod fit;
 mod info;
+mod init;
 mod subdivide;
 
 use std::process::ExitCode;
@@ -24,6 +25,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Analyze(a) => analyze::run(a),
         Command::Eval(a) => eval::run(a),
         Command::Fit(a) => fit::run(a),
+        Command::Init(a) => init::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Bench(b) => bench::run(b),
     }

@@ -1,0 +1,194 @@
+//! `subfit init TARGET [--control-points N] [--from-points] -o control.obj`: an initial control
+//! mesh with the target's topology (DESIGN.md §3.6), written in the target's coordinates.
+//!
+//! Mesh targets are simplified (topology-preserving QEM); point clouds, or any target with
+//! `--from-points`, are contoured (IMLS + marching tetrahedra) and then simplified. The default
+//! size is [`subfit::init::default_control_points`]: `clamp(round(1.5·√points), 200, 2000)`.
+
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use subfit::init::{
+    default_control_points, initial_control_mesh, InitOptions, InitReport, InitSource,
+};
+use subfit::io::{Encoding, Format, WriteOptions};
+use subfit::mesh::{diagnose_mesh, PolyMesh};
+use subfit::target::{Target, TargetOptions};
+
+use crate::cli::InitArgs;
+
+pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
+    // Validate the flags before reading anything.
+    match Format::from_path(&a.output) {
+        None => bail!(
+            "{}: cannot tell the output format from the extension (use .obj, .ply, .off or .stl)",
+            a.output.display()
+        ),
+        Some(Format::Xyz) => bail!(
+            "{}: a point format cannot hold a control mesh (use .obj, .ply, .off or .stl)",
+            a.output.display()
+        ),
+        Some(_) => {}
+    }
+    if a.output.is_dir() {
+        bail!("{}: is a directory", a.output.display());
+    }
+
+    let t0 = Instant::now();
+    let (input, _) = crate::progress::load(&a.target)?;
+    let read_time = t0.elapsed();
+    let use_mesh = !a.from_points && !input.faces.is_empty();
+    // The target's own topology, when it has faces.
+    let input_topology = (!input.faces.is_empty()).then(|| diagnose_mesh(&input));
+
+    let t = Instant::now();
+    let sp = crate::progress::spinner("analysing the target");
+    let built = if use_mesh {
+        let opts = TargetOptions {
+            mesh_closest_point: false,
+            ..TargetOptions::default()
+        };
+        Target::build(&input, &opts, None)
+    } else {
+        let cloud = PolyMesh::point_cloud(input.positions.clone(), input.normals.clone());
+        Target::build(&cloud, &TargetOptions::default(), None)
+    };
+    sp.finish_and_clear();
+    let target =
+        built.with_context(|| format!("{}: cannot use as a target", a.target.display()))?;
+    let target_time = t.elapsed();
+
+    let n = a
+        .control_points
+        .map_or_else(|| default_control_points(target.len()), |n| n as usize);
+    let expected_genus = match (&input_topology, a.genus) {
+        (_, Some(g)) => Some(g),
+        (Some(d), None) => d.genus,
+        (None, None) => None,
+    };
+    if a.require_genus && !use_mesh && expected_genus.is_none() {
+        bail!("--require-genus on a point cloud needs --genus G (the genus it should have)");
+    }
+    let options = InitOptions {
+        expected_genus,
+        require_genus: a.require_genus,
+        ..InitOptions::default()
+    };
+    let sp = crate::progress::spinner(if use_mesh {
+        "simplifying"
+    } else {
+        "contouring and simplifying"
+    });
+    let result = initial_control_mesh(&target, use_mesh.then_some(&input), n, &options);
+    sp.finish_and_clear();
+    let (cage, report) = result.map_err(|e| {
+        let hint = match e {
+            subfit::init::InitError::InvalidMesh(_) => {
+                " (use --from-points to contour its vertices instead)"
+            }
+            _ => "",
+        };
+        anyhow::anyhow!(
+            "{}: cannot build the initial control mesh: {e}{hint}",
+            a.target.display()
+        )
+    })?;
+
+    let t = Instant::now();
+    let out = PolyMesh::new(
+        cage.positions
+            .iter()
+            .map(|&p| target.to_original(p))
+            .collect(),
+        cage.faces.clone(),
+    );
+    let wopts = WriteOptions {
+        format: None,
+        encoding: Encoding::Ascii,
+        single_precision: false,
+    };
+    subfit::io::write_file(&a.output, &out, &wopts)?;
+    let write_time = t.elapsed();
+
+    print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
+    println!(
+        "time: read {:.3} s, target {:.3} s, contour {:.3} s, simplify {:.3} s, write {:.3} s, total {:.3} s",
+        read_time.as_secs_f64(),
+        target_time.as_secs_f64(),
+        report.timings.contour.as_secs_f64(),
+        report.timings.simplify.as_secs_f64(),
+        write_time.as_secs_f64(),
+        t0.elapsed().as_secs_f64()
+    );
+    println!("wrote {}", a.output.display());
+    if !report.simplify.reached_target {
+        eprintln!(
+            "subfit: warning: no legal collapse left at {} vertices ({n} requested)",
+            out.num_vertices()
+        );
+    }
+    if !report.genus_matches {
+        eprintln!(
+            "subfit: warning: the cage has genus {}, the target {}",
+            report.genus_after, report.genus_target
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_summary(
+    a: &InitArgs,
+    target: &Target,
+    input: Option<&subfit::mesh::MeshReport>,
+    r: &InitReport,
+    requested: usize,
+    out: &PolyMesh,
+) {
+    let topo = |g: Option<u32>, loops: usize| match g {
+        Some(g) => format!("genus {g}, {loops} boundary loop(s)"),
+        None => format!("genus unknown (not a manifold), {loops} boundary loop(s)"),
+    };
+    match input {
+        Some(d) => println!(
+            "target {}: {} points, {} faces, {}",
+            a.target.display(),
+            target.len(),
+            d.num_faces,
+            topo(d.genus, d.boundary_loops)
+        ),
+        None => println!(
+            "target {}: {} points (point cloud)",
+            a.target.display(),
+            target.len()
+        ),
+    }
+    match (r.source, &r.contour) {
+        (InitSource::Contour, Some(c)) => println!(
+            "contour: grid {}x{}x{} (cell {:.4} unit cube), {} vertices, {} faces, genus {}, \
+             {} of {} components kept",
+            c.nodes[0],
+            c.nodes[1],
+            c.nodes[2],
+            c.cell_size,
+            c.vertices,
+            c.faces,
+            c.genus,
+            c.components_kept,
+            c.components_found
+        ),
+        _ => println!(
+            "simplified the mesh: {} vertices, {} faces",
+            r.simplify.vertices_before, r.simplify.faces_before
+        ),
+    }
+    println!(
+        "cage: {} vertices ({requested} requested), {} faces, {}, {} component(s); target genus {} ({})",
+        out.num_vertices(),
+        out.num_faces(),
+        topo(Some(r.genus_after), r.boundary_loops.1),
+        r.components,
+        r.genus_target,
+        if r.genus_matches { "same" } else { "DIFFERENT" }
+    );
+}
