@@ -1,0 +1,204 @@
+//! `subfit init`, end to end: cages of the target's genus in the target's coordinates, from a
+//! mesh and from its points; bad inputs exit with code 2 and leave no output file.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn subfit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subfit"))
+        .args(args)
+        .output()
+        .expect("run subfit")
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A torus OBJ (major radius 10, minor 3.5, `nu × nv` quads split into triangles), centred at
+/// (100, 0, 0) so that original and normalized coordinates differ.
+fn torus_obj(nu: usize, nv: usize) -> String {
+    let mut s = String::new();
+    for i in 0..nu {
+        let u = std::f64::consts::TAU * i as f64 / nu as f64;
+        for j in 0..nv {
+            let v = std::f64::consts::TAU * j as f64 / nv as f64;
+            let rho = 10.0 + 3.5 * v.cos();
+            let _ = writeln!(
+                s,
+                "v {} {} {}",
+                100.0 + rho * u.cos(),
+                rho * u.sin(),
+                3.5 * v.sin()
+            );
+        }
+    }
+    let id = |i: usize, j: usize| (i % nu) * nv + (j % nv) + 1;
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            let _ = writeln!(s, "f {a} {b} {c}\nf {a} {c} {d}");
+        }
+    }
+    s
+}
+
+/// Vertex positions and triangles of an OBJ written by subfit.
+fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let (mut v, mut f) = (Vec::new(), Vec::new());
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.map(|x| x.parse().unwrap()).collect();
+                v.push([c[0], c[1], c[2]]);
+            }
+            Some("f") => {
+                let c: Vec<usize> = it
+                    .map(|x| x.split('/').next().unwrap().parse().unwrap())
+                    .collect();
+                assert_eq!(c.len(), 3, "triangles expected: {line}");
+                f.push([c[0], c[1], c[2]]);
+            }
+            _ => {}
+        }
+    }
+    (v, f)
+}
+
+/// Genus of a closed triangle mesh from χ = V − E + F with every edge used twice, checking that
+/// every directed edge appears once (closed, consistently oriented, no non-manifold edge).
+#[track_caller]
+fn closed_genus(v: usize, f: &[[usize; 3]]) -> i64 {
+    let mut directed: Vec<(usize, usize)> = f
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .collect();
+    directed.sort_unstable();
+    let n = directed.len();
+    directed.dedup();
+    assert_eq!(directed.len(), n, "a directed edge is used twice");
+    for &(a, b) in &directed {
+        assert!(
+            directed.binary_search(&(b, a)).is_ok(),
+            "boundary edge {a}-{b}"
+        );
+    }
+    let chi = v as i64 - (n / 2) as i64 + f.len() as i64;
+    (2 - chi) / 2
+}
+
+#[test]
+fn torus_mesh_and_its_points_give_genus_one_cages_in_original_coordinates() {
+    let d = tempfile::tempdir().unwrap();
+    let torus = write(d.path(), "torus.obj", &torus_obj(90, 36));
+    for (name, extra) in [("mesh.obj", None), ("points.obj", Some("--from-points"))] {
+        let out = d.path().join(name);
+        let mut args = vec![
+            "init",
+            torus.to_str().unwrap(),
+            "--control-points",
+            "120",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let r = subfit(&args);
+        let stdout = String::from_utf8_lossy(&r.stdout);
+        assert_eq!(
+            r.status.code(),
+            Some(0),
+            "{name}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert!(stdout.contains("genus 1"), "{stdout}");
+        assert!(stdout.contains("(same)"), "{stdout}");
+        let (v, f) = read_obj(&out);
+        assert!(
+            v.len() <= 120 && v.len() >= 100,
+            "{name}: {} vertices",
+            v.len()
+        );
+        assert_eq!(closed_genus(v.len(), &f), 1, "{name}");
+        // Original coordinates: around (100, 0, 0), within the torus' extent.
+        for p in &v {
+            let rho = ((p[0] - 100.0).powi(2) + p[1] * p[1]).sqrt();
+            let tube = ((rho - 10.0).powi(2) + p[2] * p[2]).sqrt();
+            assert!(
+                (tube - 3.5).abs() < 1.0,
+                "{name}: vertex {p:?} off the torus"
+            );
+        }
+    }
+}
+
+/// Runs `subfit init ARGS -o OUT` and checks exit code 2, one stderr line with every fragment,
+/// and that no output (nor a temporary) was left behind.
+#[track_caller]
+fn expect_bad(dir: &Path, args: &[&str], fragments: &[&str]) {
+    let out = dir.join("cage.obj");
+    let mut all = vec!["init"];
+    all.extend(args);
+    all.extend(["-o", out.to_str().unwrap()]);
+    let r = subfit(&all);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "one line expected: {err}"
+    );
+    for f in fragments {
+        assert!(err.contains(f), "missing `{f}` in: {err}");
+    }
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("cage"))
+        .collect();
+    assert!(left.is_empty(), "{args:?} left {left:?}");
+}
+
+#[test]
+fn bad_inputs_exit_with_2_and_leave_no_file() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let s = |x: &PathBuf| x.to_str().unwrap().to_owned();
+
+    let empty = s(&write(p, "empty.xyz", ""));
+    expect_bad(p, &[&empty], &["empty.xyz"]);
+
+    let five = s(&write(p, "five.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n"));
+    expect_bad(p, &[&five], &["five.xyz", "5 points"]);
+
+    // Three triangles on the edge 0-1 (a fin) among enough points for a target.
+    let mut fin = String::from("v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0.5 -1 0\nv 0.5 0 1\n");
+    for i in 0..10 {
+        let _ = writeln!(fin, "v {} 0.3 {}", 0.1 * i as f64, 0.05 * i as f64);
+    }
+    fin.push_str("f 1 2 3\nf 2 1 4\nf 1 2 5\n");
+    let fin = s(&write(p, "fin.obj", &fin));
+    expect_bad(
+        p,
+        &[&fin, "--control-points", "4"],
+        &["fin.obj", "edge 0-1", "--from-points"],
+    );
+
+    // A torus (genus 1) needs at least 7 vertices.
+    let torus = s(&write(p, "torus.obj", &torus_obj(24, 12)));
+    expect_bad(
+        p,
+        &[&torus, "--control-points", "4"],
+        &["torus.obj", "genus 1", "at least 7"],
+    );
+
+    // A point format cannot hold a cage (checked before reading).
+    let r = subfit(&["init", &torus, "-o", &s(&p.join("cage.xyz"))]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(!p.join("cage.xyz").exists());
+}
