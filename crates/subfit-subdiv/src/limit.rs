@@ -23,7 +23,7 @@ use crate::mask::Mask;
 use crate::refine::{neighborhoods, refine_topology, sharp_edges, topology_for};
 use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
-use crate::stencil::{compose_rows, MultiRows, StencilMatrix};
+use crate::stencil::{compose_rows, MultiRows, Stacked, StencilMatrix};
 use crate::topology::Topology;
 use subfit_mesh::{Polygons, Tags};
 
@@ -149,7 +149,7 @@ pub(crate) fn limit_compose(
     let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
     compose_rows(
         topo.num_vertices(),
-        rhs,
+        Stacked::one(rhs),
         LimitMasks::default,
         |masks, v, row| push_limit_row(topo, options.scheme, &hoods[v], masks, v as u32, row),
     )

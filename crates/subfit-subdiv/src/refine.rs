@@ -24,7 +24,7 @@
 use crate::error::SubdivError;
 use crate::mask::{FaceWeights, Mask};
 use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
-use crate::stencil::StencilMatrix;
+use crate::stencil::{compose_rows, Stacked, StencilMatrix};
 use crate::topology::Topology;
 use subfit_mesh::{Polygons, Tags, SHARPNESS_INFINITE};
 
@@ -128,77 +128,202 @@ pub fn refine(
 
 /// [`refine`] on an already built adjacency (which must suit the scheme).
 pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
-    let scheme = options.scheme;
-    let (nv, ne, nf) = (topo.num_vertices(), topo.num_edges(), topo.num_faces());
-    let sharp = sharp_edges(topo, tags);
-    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
-    let num_child = nv
-        + ne
-        + if scheme == Scheme::CatmullClark {
-            nf
-        } else {
-            0
-        };
-    let mut m = StencilMatrix::new(nv);
+    let rows = RefineRows::new(topo, tags, options);
+    let mut m = StencilMatrix::new(topo.num_vertices());
     let mut row: Vec<(u32, f64)> = Vec::with_capacity(64);
-    let mut mask = Mask::default();
-    for v in 0..nv as u32 {
-        scheme.vertex_point_mask(&hoods[v as usize], &mut mask);
+    let mut cache = VertexMaskCache::default();
+    for i in 0..rows.num_rows() {
         row.clear();
-        row.push((v, mask.vertex));
-        for (&u, &w) in topo.vertex_ring(v).iter().zip(&mask.edges) {
-            row.push((u, w));
-        }
-        debug_assert!(mask.faces.is_empty() || mask.face_weights == FaceWeights::Centers);
-        for (&c, &w) in topo.vertex_corners(v).iter().zip(&mask.faces) {
-            push_face_center(topo, topo.corner_face(c) as usize, w, &mut row);
-        }
+        rows.row(&mut cache, i, None, |c, w| row.push((c, w)));
         m.push_row(&mut row);
-    }
-    for e in 0..ne as u32 {
-        let corners = topo.edge_corners(e);
-        let num_faces = if corners[1] == u32::MAX { 1 } else { 2 };
-        let em = scheme.edge_point_mask(&EdgeNeighborhood {
-            num_faces,
-            sharp: sharp[e as usize],
-        });
-        let [a, b] = topo.edge_vertices(e);
-        row.clear();
-        row.push((a, em.end));
-        row.push((b, em.end));
-        if em.face != 0.0 {
-            for &c in &corners[..num_faces] {
-                match em.face_weights {
-                    FaceWeights::Opposite => {
-                        row.push((topo.corner_vertex(topo.corner_prev(c)), em.face));
-                    }
-                    FaceWeights::Centers => {
-                        push_face_center(topo, topo.corner_face(c) as usize, em.face, &mut row);
-                    }
-                }
-            }
-        }
-        m.push_row(&mut row);
-    }
-    if scheme == Scheme::CatmullClark {
-        for f in 0..nf {
-            row.clear();
-            push_face_center(topo, f, 1.0, &mut row);
-            m.push_row(&mut row);
-        }
     }
     Refinement {
-        faces: child_faces(topo, scheme),
-        num_vertices: num_child,
+        faces: child_faces(topo, options.scheme),
+        num_vertices: rows.num_rows(),
         tags: child_tags(topo, tags),
         matrix: m,
     }
 }
 
-fn push_face_center(topo: &Topology, f: usize, w: f64, row: &mut Vec<(u32, f64)>) {
+/// One refinement step composed with `rhs` (`#V × n`): the returned [`Refinement::matrix`] is
+/// `M · rhs` (`#V_child × n`), computed in parallel with rows of `M` generated on the fly, so
+/// `M` itself is never stored (nor sorted). Cost O(Σ_i Σ_{j ∈ row i of M} nnz(rhs_j)).
+///
+/// # Panics
+/// If `rhs.nrows() != topo.num_vertices()`.
+#[track_caller]
+pub(crate) fn refine_compose(
+    topo: &Topology,
+    tags: &Tags,
+    options: &Options,
+    rhs: &StencilMatrix,
+) -> Refinement {
+    assert_eq!(rhs.nrows(), topo.num_vertices(), "inner dimensions differ");
+    let rows = RefineRows::new(topo, tags, options);
+    let (nv, ne) = (topo.num_vertices(), topo.num_edges());
+    let matrix = match options.scheme {
+        Scheme::Loop => {
+            let [m] = compose_rows(
+                rows.num_rows(),
+                Stacked::one(rhs),
+                VertexMaskCache::default,
+                |cache, i, row| rows.row(cache, i, None, |c, w| row.push((c, [w]))),
+            );
+            m
+        }
+        Scheme::CatmullClark => {
+            // Face points first; vertex and edge points then use them as single rows instead
+            // of re-expanding every face centre (about half the work).
+            let [face_points] = compose_rows(
+                topo.num_faces(),
+                Stacked::one(rhs),
+                VertexMaskCache::default,
+                |cache, f, row| rows.row(cache, nv + ne + f, None, |c, w| row.push((c, [w]))),
+            );
+            let [mut m] = compose_rows(
+                nv + ne,
+                Stacked::two(rhs, &face_points),
+                VertexMaskCache::default,
+                |cache, i, row| rows.row(cache, i, Some(nv as u32), |c, w| row.push((c, [w]))),
+            );
+            m.append_rows(&face_points);
+            m
+        }
+    };
+    Refinement {
+        faces: child_faces(topo, options.scheme),
+        num_vertices: rows.num_rows(),
+        tags: child_tags(topo, tags),
+        matrix,
+    }
+}
+
+/// The vertex-point mask of the last neighbourhood seen: consecutive vertices mostly share
+/// their neighbourhood, so the mask is recomputed only when it changes.
+#[derive(Default)]
+pub(crate) struct VertexMaskCache {
+    hood: Option<Neighborhood>,
+    mask: Mask,
+}
+
+/// The rows of one level of refinement (child vertex order in the module docs), generated on
+/// demand from the parent adjacency.
+pub(crate) struct RefineRows<'a> {
+    topo: &'a Topology,
+    scheme: Scheme,
+    sharp: Vec<bool>,
+    hoods: Vec<Neighborhood>,
+}
+
+impl<'a> RefineRows<'a> {
+    /// Classifies the edges and vertices of `topo`. Cost O(#corners).
+    pub(crate) fn new(topo: &'a Topology, tags: &Tags, options: &Options) -> Self {
+        let sharp = sharp_edges(topo, tags);
+        let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
+        Self {
+            topo,
+            scheme: options.scheme,
+            sharp,
+            hoods,
+        }
+    }
+
+    /// Number of child vertices (`V + E`, plus `F` for Catmull-Clark).
+    pub(crate) fn num_rows(&self) -> usize {
+        let t = self.topo;
+        t.num_vertices()
+            + t.num_edges()
+            + match self.scheme {
+                Scheme::CatmullClark => t.num_faces(),
+                Scheme::Loop => 0,
+            }
+    }
+
+    /// Calls `push(parent vertex, weight)` for the entries of child row `i` (a column may
+    /// repeat; exact zeros may be pushed). With `face_points = Some(base)`, a face centre
+    /// (Catmull-Clark face point of parent face `f`) is pushed as the single column `base + f`
+    /// instead of its vertices.
+    #[inline]
+    pub(crate) fn row(
+        &self,
+        cache: &mut VertexMaskCache,
+        i: usize,
+        face_points: Option<u32>,
+        mut push: impl FnMut(u32, f64),
+    ) {
+        let topo = self.topo;
+        let (nv, ne) = (topo.num_vertices(), topo.num_edges());
+        if i < nv {
+            let v = i as u32;
+            let hood = &self.hoods[i];
+            if cache.hood.as_ref() != Some(hood) {
+                self.scheme.vertex_point_mask(hood, &mut cache.mask);
+                cache.hood = Some(*hood);
+            }
+            let mask = &cache.mask;
+            push(v, mask.vertex);
+            for (&u, &w) in topo.vertex_ring(v).iter().zip(&mask.edges) {
+                push(u, w);
+            }
+            debug_assert!(mask.faces.is_empty() || mask.face_weights == FaceWeights::Centers);
+            for (&c, &w) in topo.vertex_corners(v).iter().zip(&mask.faces) {
+                push_center(
+                    topo,
+                    face_points,
+                    topo.corner_face(c) as usize,
+                    w,
+                    &mut push,
+                );
+            }
+        } else if i < nv + ne {
+            let e = (i - nv) as u32;
+            let corners = topo.edge_corners(e);
+            let num_faces = if corners[1] == u32::MAX { 1 } else { 2 };
+            let em = self.scheme.edge_point_mask(&EdgeNeighborhood {
+                num_faces,
+                sharp: self.sharp[e as usize],
+            });
+            let [a, b] = topo.edge_vertices(e);
+            push(a, em.end);
+            push(b, em.end);
+            if em.face != 0.0 {
+                for &c in &corners[..num_faces] {
+                    match em.face_weights {
+                        FaceWeights::Opposite => {
+                            push(topo.corner_vertex(topo.corner_prev(c)), em.face);
+                        }
+                        FaceWeights::Centers => {
+                            let f = topo.corner_face(c) as usize;
+                            push_center(topo, face_points, f, em.face, &mut push);
+                        }
+                    }
+                }
+            }
+        } else {
+            push_center(topo, None, i - nv - ne, 1.0, &mut push);
+        }
+    }
+}
+
+/// Pushes `w` times the centre of face `f`: its vertices, or the single column `base + f` when
+/// face points are given as rows (`face_points = Some(base)`).
+#[inline]
+fn push_center(
+    topo: &Topology,
+    face_points: Option<u32>,
+    f: usize,
+    w: f64,
+    push: &mut impl FnMut(u32, f64),
+) {
+    if let Some(base) = face_points {
+        push(base + f as u32, w);
+        return;
+    }
     let face = topo.face(f);
     let wf = w / face.len() as f64;
-    row.extend(face.iter().map(|&u| (u, wf)));
+    for &u in face {
+        push(u, wf);
+    }
 }
 
 fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {

@@ -8,7 +8,7 @@
 
 use crate::error::SubdivError;
 use crate::limit::{limit_compose, limit_rows};
-use crate::refine::{refine_topology, topology_for};
+use crate::refine::{refine_compose, refine_topology, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
 use crate::topology::Topology;
@@ -69,11 +69,11 @@ pub fn sampling_operator(
     let mut level_tags = tags.clone();
     let mut product: Option<StencilMatrix> = None;
     for _ in 0..level {
-        let r = refine_topology(&topo, &level_tags, options);
-        product = Some(match product {
-            None => r.matrix,
-            Some(p) => r.matrix.compose(&p),
-        });
+        let r = match &product {
+            None => refine_topology(&topo, &level_tags, options),
+            Some(p) => refine_compose(&topo, &level_tags, options, p),
+        };
+        product = Some(r.matrix);
         topo = Topology::new(&r.faces, r.num_vertices)
             .expect("the refinement of a valid mesh is valid");
         level_faces = r.faces;

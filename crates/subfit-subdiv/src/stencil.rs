@@ -170,6 +170,20 @@ impl StencilMatrix {
         }
     }
 
+    /// Appends the rows of `other` (same column count) below those of `self`.
+    ///
+    /// # Panics
+    /// If the column counts differ.
+    #[track_caller]
+    pub(crate) fn append_rows(&mut self, other: &StencilMatrix) {
+        assert_eq!(self.ncols, other.ncols, "matrices differ in columns");
+        let base = self.nnz();
+        self.offsets
+            .extend(other.offsets[1..].iter().map(|&o| o + base));
+        self.indices.extend_from_slice(&other.indices);
+        self.weights.extend_from_slice(&other.weights);
+    }
+
     /// `y = self · x` for 3-vectors: `x` is `ncols by 3`, the result `nrows by 3`.
     /// Cost O(nnz), parallel over rows.
     ///
@@ -219,7 +233,7 @@ impl StencilMatrix {
         assert_eq!(self.ncols, rhs.nrows(), "inner dimensions differ");
         let [out] = compose_rows(
             self.nrows(),
-            rhs,
+            Stacked::one(rhs),
             || (),
             |_, i, row| {
                 let (c, w) = self.row(i);
@@ -266,7 +280,7 @@ impl<const K: usize> MultiRows<K> {
         assert_eq!(self.ncols, rhs.nrows(), "inner dimensions differ");
         compose_rows(
             self.nrows(),
-            rhs,
+            Stacked::one(rhs),
             || (),
             |_, i, row| {
                 let (a, b) = (self.offsets[i], self.offsets[i + 1]);
@@ -276,37 +290,91 @@ impl<const K: usize> MultiRows<K> {
     }
 }
 
+/// The right-hand side of [`compose_rows`]: the rows of `top` followed by the rows of `bottom`
+/// (if any), over the same columns. Stacking lets a left row refer to rows computed by an
+/// earlier product (e.g. Catmull-Clark face points, computed first and then used by the edge
+/// and vertex points) instead of re-expanding them.
+#[derive(Clone, Copy)]
+pub(crate) struct Stacked<'a> {
+    top: &'a StencilMatrix,
+    bottom: Option<&'a StencilMatrix>,
+}
+
+impl<'a> Stacked<'a> {
+    /// Just `m`.
+    pub(crate) fn one(m: &'a StencilMatrix) -> Self {
+        Self {
+            top: m,
+            bottom: None,
+        }
+    }
+
+    /// The rows of `top`, then those of `bottom`.
+    ///
+    /// # Panics
+    /// If the column counts differ.
+    #[track_caller]
+    pub(crate) fn two(top: &'a StencilMatrix, bottom: &'a StencilMatrix) -> Self {
+        assert_eq!(
+            top.ncols, bottom.ncols,
+            "stacked matrices differ in columns"
+        );
+        Self {
+            top,
+            bottom: Some(bottom),
+        }
+    }
+
+    fn ncols(&self) -> usize {
+        self.top.ncols
+    }
+
+    #[inline]
+    fn row(&self, j: usize) -> (&'a [u32], &'a [f64]) {
+        let n = self.top.nrows();
+        match self.bottom {
+            Some(b) if j >= n => b.row(j - n),
+            _ => self.top.row(j),
+        }
+    }
+}
+
 /// `K` products `L_k · rhs` where the rows of the `L_k` (sharing one support, `K` weights per
-/// entry, columns < `rhs.nrows()`, repeats allowed) are generated on the fly by
+/// entry, columns < the row count of `rhs`, repeats allowed) are generated on the fly by
 /// `lhs_row(state, i, row)`, so the left factors are never stored. Entries below
 /// [`DROP_TOLERANCE`] relative to their row's largest are dropped; columns are sorted within
 /// each row.
 ///
 /// Rows are produced in waves of [`WAVE`] blocks of [`BLOCK`] rows: the blocks of a wave are
 /// computed in parallel (one `init()` state and one dense scratch row of `rhs.ncols` entries per
-/// worker) into buffers reused from wave to wave, then appended to the output, whose capacity is
-/// extrapolated from the first wave. So the output is written once and no large temporary is
-/// allocated per call beyond one wave's buffers.
+/// worker) into buffers reused from wave to wave, then copied in parallel into the output.
+/// The output arrays are allocated zeroed once, sized by extrapolating the first wave (a
+/// zeroed allocation of that size is mapped lazily by the OS, so the unused part costs no
+/// memory and the page faults are taken by the parallel copies), and grown if the guess was
+/// short.
 pub(crate) fn compose_rows<const K: usize, S>(
     nrows: usize,
-    rhs: &StencilMatrix,
+    rhs: Stacked<'_>,
     init: impl Fn() -> S,
     lhs_row: impl Fn(&mut S, usize, &mut Vec<(u32, [f64; K])>) + Sync + Send,
 ) -> [StencilMatrix; K]
 where
     S: Send,
 {
-    let mut out: [StencilMatrix; K] = std::array::from_fn(|_| StencilMatrix::new(rhs.ncols));
+    let ncols = rhs.ncols();
+    let mut out: [StencilMatrix; K] = std::array::from_fn(|_| StencilMatrix::new(ncols));
     for m in &mut out {
         m.offsets.reserve_exact(nrows);
     }
+    // Entries written to each output so far (`indices`/`weights` are longer, zero-filled).
+    let mut len = [0usize; K];
     // One task slot per block of a wave, each with its own output buffers and scratch, both
     // reused from wave to wave (small enough to stay in cache; no allocation per wave).
     let nslots = nrows.div_ceil(BLOCK).min(WAVE);
     let mut slots: Vec<([RowBlock; K], Scratch<K, S>)> = (0..nslots)
         .map(|_| {
             let bufs = std::array::from_fn(|_| RowBlock::default());
-            (bufs, Scratch::new(rhs.ncols, init()))
+            (bufs, Scratch::new(ncols, init()))
         })
         .collect();
     let mut first = 0;
@@ -321,38 +389,66 @@ where
                 for i in rows {
                     scratch.lrow.clear();
                     lhs_row(&mut scratch.state, i, &mut scratch.lrow);
-                    scratch.accumulate(rhs);
+                    scratch.accumulate(&rhs);
                     scratch.emit(blk);
                 }
             });
         let done = (first + nblocks * BLOCK).min(nrows);
+        let slots = &slots[..nblocks];
+        let start = len;
         for (k, m) in out.iter_mut().enumerate() {
-            if first == 0 {
-                // Extrapolate the total from the first wave, generously: unused capacity is
-                // never touched (so costs no memory) and is given back below.
-                let wave_nnz: usize = slots.iter().map(|s| s.0[k].indices.len()).sum();
-                let guess = (wave_nnz as f64 * nrows as f64 / done as f64 * 1.25) as usize;
-                m.indices.reserve_exact(guess);
-                m.weights.reserve_exact(guess);
-            }
-            for (blk, _) in &slots[..nblocks] {
-                let RowBlock {
-                    lens,
-                    indices,
-                    weights,
-                } = &blk[k];
-                let mut end = m.indices.len();
-                for &l in lens {
-                    end += l as usize;
-                    m.offsets.push(end);
+            let wave_nnz: usize = slots.iter().map(|s| s.0[k].indices.len()).sum();
+            let need = len[k] + wave_nnz;
+            if need > m.indices.len() {
+                // Extrapolate the total from the rows done so far, generously: unused zeroed
+                // capacity is never touched (so costs no memory) and is given back below.
+                let guess = (need as f64 * nrows as f64 / done as f64 * 1.25) as usize;
+                let size = guess.max(need);
+                if m.indices.is_empty() {
+                    m.indices = vec![0; size];
+                    m.weights = vec![0.0; size];
+                } else {
+                    m.indices.resize(size, 0);
+                    m.weights.resize(size, 0.0);
                 }
-                m.indices.extend_from_slice(indices);
-                m.weights.extend_from_slice(weights);
+            }
+            for (blk, _) in slots {
+                for &l in &blk[k].lens {
+                    len[k] += l as usize;
+                    m.offsets.push(len[k]);
+                }
             }
         }
+        // Parallel copy of the blocks into their places in the outputs.
+        let mut it = out.iter_mut().zip(start);
+        let mut rest: [(&mut [u32], &mut [f64]); K] = std::array::from_fn(|_| {
+            let (m, s) = it.next().expect("K outputs");
+            (&mut m.indices[s..], &mut m.weights[s..])
+        });
+        let jobs: Vec<_> = slots
+            .iter()
+            .map(|(blk, _)| {
+                let dests: [(&mut [u32], &mut [f64]); K] = std::array::from_fn(|k| {
+                    let n = blk[k].indices.len();
+                    let (i, irest) = std::mem::take(&mut rest[k].0).split_at_mut(n);
+                    let (w, wrest) = std::mem::take(&mut rest[k].1).split_at_mut(n);
+                    rest[k] = (irest, wrest);
+                    (i, w)
+                });
+                (blk, dests)
+            })
+            .collect();
+        jobs.into_par_iter().for_each(|(blk, dests)| {
+            for (b, (i, w)) in blk.iter().zip(dests) {
+                i.copy_from_slice(&b.indices);
+                w.copy_from_slice(&b.weights);
+            }
+        });
         first = done;
     }
-    for m in &mut out {
+    for (m, &l) in out.iter_mut().zip(&len) {
+        m.indices.truncate(l);
+        m.weights.truncate(l);
         m.indices.shrink_to_fit();
         m.weights.shrink_to_fit();
     }
@@ -408,7 +504,7 @@ impl<const K: usize, S> Scratch<K, S> {
     /// Accumulates `Σ_j lrow_j · rhs_j` into `acc`, recording touched columns in
     /// `touched[..ntouched]` (branch-free: most columns repeat, unpredictably).
     #[inline]
-    fn accumulate(&mut self, rhs: &StencilMatrix) {
+    fn accumulate(&mut self, rhs: &Stacked<'_>) {
         let (acc, mark, touched) = (&mut self.acc, &mut self.mark, &mut self.touched);
         let mut n = self.ntouched;
         for &(j, w) in &self.lrow {

@@ -7,9 +7,20 @@
 //! [`crate::Neighborhood`]).
 
 use crate::error::SubdivError;
+use rayon::prelude::*;
 use subfit_mesh::Polygons;
 
 const NONE: u32 = u32::MAX;
+
+/// The rings of a block of consecutive vertices, with offsets relative to the block.
+#[derive(Default)]
+struct RingPart {
+    edge_ends: Vec<u32>,
+    corner_ends: Vec<u32>,
+    edges: Vec<u32>,
+    verts: Vec<u32>,
+    corners: Vec<u32>,
+}
 
 /// Edge and vertex-ring adjacency of a manifold, consistently oriented polygon mesh.
 ///
@@ -90,6 +101,7 @@ impl Topology {
             ring_corners: Vec::new(),
         };
         t.next_vertex = (0..nc as u32)
+            .into_par_iter()
             .map(|c| t.indices[t.corner_next(c) as usize])
             .collect();
         // Outgoing corners per vertex (CSR by counting sort), ascending corner order.
@@ -106,57 +118,119 @@ impl Topology {
             out[fill[v as usize] as usize] = c as u32;
             fill[v as usize] += 1;
         }
+        drop(fill);
         let outgoing =
             |v: u32| &out[out_off[v as usize] as usize..out_off[v as usize + 1] as usize];
-        t.build_edges(&outgoing)?;
-        t.build_rings(&outgoing)?;
+        let twin = t.twins(&outgoing)?;
+        t.build_edges(&twin);
+        t.build_rings(&outgoing, &twin)?;
         Ok(t)
     }
 
-    fn build_edges<'a>(&mut self, outgoing: &impl Fn(u32) -> &'a [u32]) -> Result<(), SubdivError> {
-        for c in 0..self.indices.len() as u32 {
-            let (a, b) = (self.indices[c as usize], self.corner_next_vertex(c));
-            let mut same = outgoing(a)
+    /// The twin of every corner (the corner of the opposite directed edge, `NONE` on a
+    /// boundary), checking that no directed edge is used twice. Parallel over corners.
+    fn twins<'a>(
+        &self,
+        outgoing: &(impl Fn(u32) -> &'a [u32] + Sync),
+    ) -> Result<Vec<u32>, SubdivError> {
+        let nc = self.indices.len();
+        let ends = |c: usize| (self.indices[c], self.next_vertex[c]);
+        let dup = (0..nc).into_par_iter().position_first(|c| {
+            let (a, b) = ends(c);
+            outgoing(a)
                 .iter()
-                .filter(|&&o| self.corner_next_vertex(o) == b);
-            if same.nth(1).is_some() {
-                return Err(SubdivError::NonManifoldEdge { a, b });
-            }
-            if self.corner_edge[c as usize] != NONE {
+                .filter(|&&o| self.next_vertex[o as usize] == b)
+                .nth(1)
+                .is_some()
+        });
+        if let Some(c) = dup {
+            let (a, b) = ends(c);
+            return Err(SubdivError::NonManifoldEdge { a, b });
+        }
+        Ok((0..nc)
+            .into_par_iter()
+            .map(|c| {
+                let (a, b) = ends(c);
+                outgoing(b)
+                    .iter()
+                    .copied()
+                    .find(|&o| self.next_vertex[o as usize] == a)
+                    .unwrap_or(NONE)
+            })
+            .collect())
+    }
+
+    /// Numbers the edges in order of first appearance (corner order).
+    fn build_edges(&mut self, twin: &[u32]) {
+        for (c, &t) in twin.iter().enumerate() {
+            if self.corner_edge[c] != NONE {
                 continue;
             }
             let e = self.edge_verts.len() as u32;
-            self.corner_edge[c as usize] = e;
-            let twin = outgoing(b)
-                .iter()
-                .copied()
-                .find(|&o| self.corner_next_vertex(o) == a)
-                .unwrap_or(NONE);
-            if twin != NONE {
-                self.corner_edge[twin as usize] = e;
+            self.corner_edge[c] = e;
+            if t != NONE {
+                self.corner_edge[t as usize] = e;
             }
-            self.edge_verts.push([a, b]);
-            self.edge_corners.push([c, twin]);
+            self.edge_verts.push([self.indices[c], self.next_vertex[c]]);
+            self.edge_corners.push([c as u32, t]);
         }
+    }
+
+    /// The counter-clockwise rings of all vertices, built in parallel over blocks of vertices
+    /// and concatenated. The step around a vertex `v` from its corner `c` goes to the twin of
+    /// the corner before `c` (the directed edge from `v` to the previous vertex of the face).
+    fn build_rings<'a>(
+        &mut self,
+        outgoing: &(impl Fn(u32) -> &'a [u32] + Sync),
+        twin: &[u32],
+    ) -> Result<(), SubdivError> {
+        const CHUNK: usize = 4096;
+        let nv = self.num_vertices;
+        let this = &*self;
+        let parts: Vec<Result<RingPart, SubdivError>> = (0..nv.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|k| this.ring_part(k * CHUNK..((k + 1) * CHUNK).min(nv), outgoing, twin))
+            .collect();
+        let mut ring_offsets = Vec::with_capacity(nv + 1);
+        let mut face_ring_offsets = Vec::with_capacity(nv + 1);
+        ring_offsets.push(0);
+        face_ring_offsets.push(0);
+        let mut ring_edges = Vec::with_capacity(self.indices.len() + nv);
+        let mut ring_verts = Vec::with_capacity(self.indices.len() + nv);
+        let mut ring_corners = Vec::with_capacity(self.indices.len());
+        for part in parts {
+            let part = part?;
+            let (e0, c0) = (ring_edges.len() as u32, ring_corners.len() as u32);
+            ring_offsets.extend(part.edge_ends.iter().map(|&x| x + e0));
+            face_ring_offsets.extend(part.corner_ends.iter().map(|&x| x + c0));
+            ring_edges.extend_from_slice(&part.edges);
+            ring_verts.extend_from_slice(&part.verts);
+            ring_corners.extend_from_slice(&part.corners);
+        }
+        self.ring_offsets = ring_offsets;
+        self.face_ring_offsets = face_ring_offsets;
+        self.ring_edges = ring_edges;
+        self.ring_verts = ring_verts;
+        self.ring_corners = ring_corners;
         Ok(())
     }
 
-    fn build_rings<'a>(&mut self, outgoing: &impl Fn(u32) -> &'a [u32]) -> Result<(), SubdivError> {
-        let nv = self.num_vertices;
-        self.ring_offsets = Vec::with_capacity(nv + 1);
-        self.face_ring_offsets = Vec::with_capacity(nv + 1);
-        self.ring_offsets.push(0);
-        self.face_ring_offsets.push(0);
-        self.ring_edges.reserve(self.indices.len() + nv);
-        self.ring_corners.reserve(self.indices.len());
-        for v in 0..nv as u32 {
+    /// The rings of the vertices `range` (see [`Self::build_rings`]).
+    fn ring_part<'a>(
+        &self,
+        range: std::ops::Range<usize>,
+        outgoing: &impl Fn(u32) -> &'a [u32],
+        twin: &[u32],
+    ) -> Result<RingPart, SubdivError> {
+        let mut part = RingPart::default();
+        for v in range.start as u32..range.end as u32 {
             let outs = outgoing(v);
             if let Some(&first) = outs.first() {
                 // A boundary vertex starts at the face whose leading edge has no twin.
                 let start = outs
                     .iter()
                     .copied()
-                    .find(|&c| self.is_boundary_edge(self.corner_edge[c as usize]))
+                    .find(|&c| twin[c as usize] == NONE)
                     .unwrap_or(first);
                 let mut cur = start;
                 let mut count = 0usize;
@@ -165,33 +239,28 @@ impl Topology {
                     if count > outs.len() {
                         return Err(SubdivError::NonManifoldVertex { vertex: v });
                     }
-                    self.ring_corners.push(cur);
-                    self.ring_edges.push(self.corner_edge[cur as usize]);
-                    self.ring_verts.push(self.corner_next_vertex(cur));
+                    part.corners.push(cur);
+                    part.edges.push(self.corner_edge[cur as usize]);
+                    part.verts.push(self.next_vertex[cur as usize]);
                     let pc = self.corner_prev(cur);
-                    let p = self.indices[pc as usize];
-                    match outgoing(v)
-                        .iter()
-                        .copied()
-                        .find(|&o| self.corner_next_vertex(o) == p)
-                    {
-                        Some(c2) if c2 == start => break,
-                        Some(c2) => cur = c2,
-                        None => {
-                            self.ring_edges.push(self.corner_edge[pc as usize]);
-                            self.ring_verts.push(p);
+                    match twin[pc as usize] {
+                        NONE => {
+                            part.edges.push(self.corner_edge[pc as usize]);
+                            part.verts.push(self.indices[pc as usize]);
                             break;
                         }
+                        c2 if c2 == start => break,
+                        c2 => cur = c2,
                     }
                 }
                 if count != outs.len() {
                     return Err(SubdivError::NonManifoldVertex { vertex: v });
                 }
             }
-            self.ring_offsets.push(self.ring_edges.len() as u32);
-            self.face_ring_offsets.push(self.ring_corners.len() as u32);
+            part.edge_ends.push(part.edges.len() as u32);
+            part.corner_ends.push(part.corners.len() as u32);
         }
-        Ok(())
+        Ok(part)
     }
 
     /// Number of vertices.

@@ -170,6 +170,61 @@ fn stencil_rows_sum_to_one_and_tangent_rows_to_zero() {
     }
 }
 
+/// `|a - b| <= tol` entry by entry, with the matrices' sparsity patterns allowed to differ by
+/// entries below `tol`.
+fn assert_same_matrix(
+    a: &subfit_subdiv::StencilMatrix,
+    b: &subfit_subdiv::StencilMatrix,
+    tol: f64,
+    what: &str,
+) {
+    assert_eq!(
+        (a.nrows(), a.ncols()),
+        (b.nrows(), b.ncols()),
+        "{what}: shapes"
+    );
+    let mut dense = vec![0.0f64; a.ncols()];
+    for i in 0..a.nrows() {
+        let (ca, wa) = a.row(i);
+        let (cb, wb) = b.row(i);
+        for (&c, &w) in ca.iter().zip(wa) {
+            dense[c as usize] += w;
+        }
+        for (&c, &w) in cb.iter().zip(wb) {
+            dense[c as usize] -= w;
+        }
+        for &c in ca.iter().chain(cb) {
+            let d = std::mem::take(&mut dense[c as usize]);
+            assert!(d.abs() <= tol, "{what}: row {i} column {c} differs by {d}");
+        }
+    }
+}
+
+/// The sampling operator (built with fused, parallel refinement products and Catmull-Clark face
+/// points reused as rows) equals the plain product of the public pieces: the limit stencils of
+/// the level-`l` mesh times `M_l ⋯ M_1` from [`refine`], with the same level-`l` faces.
+#[test]
+fn sampling_operator_equals_the_product_of_refinement_matrices() {
+    for (name, scheme, pts, faces, tags) in corpus() {
+        let o = Options::new(scheme);
+        let (mut f, mut nv, mut t) = (faces.clone(), pts.len(), tags.clone());
+        let mut product = subfit_subdiv::StencilMatrix::identity(pts.len());
+        for level in 1..=3 {
+            let r = refine(&f, nv, &t, &o).unwrap();
+            product = r.matrix.compose(&product);
+            (f, nv, t) = (r.faces, r.num_vertices, r.tags);
+            let s = sampling_operator(&faces, pts.len(), &tags, &o, level).unwrap();
+            assert_eq!(s.faces, f, "{name}: level {level} faces");
+            assert_eq!(s.num_vertices, nv, "{name}: level {level} vertex count");
+            let l = limit_stencils(&f, nv, &t, &o).unwrap();
+            let what = format!("{name} level {level}");
+            assert_same_matrix(&s.position, &l.position.compose(&product), 1e-14, &what);
+            assert_same_matrix(&s.tangent1, &l.tangent1.compose(&product), 1e-13, &what);
+            assert_same_matrix(&s.tangent2, &l.tangent2.compose(&product), 1e-13, &what);
+        }
+    }
+}
+
 #[test]
 fn planar_control_mesh_gives_planar_limit_with_winding_normals() {
     // Tilt the planar grids into the plane n·x = 0.3 with n = (1, 2, 2)/3.
