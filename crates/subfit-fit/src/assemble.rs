@@ -175,6 +175,11 @@ impl Pattern {
         &self.diag_slots
     }
 
+    /// Block rows `i ≤ j` of block column `j`, increasing, the diagonal `j` last.
+    pub fn block_col(&self, j: usize) -> &[u32] {
+        &self.brow[self.bcol_ptr[j]..self.bcol_ptr[j + 1]]
+    }
+
     /// The smoothing operator the pattern was built with.
     pub fn laplacian(&self) -> &Laplacian {
         &self.lap
@@ -182,7 +187,7 @@ impl Pattern {
 
     /// Writes `H = w_e Σ_k (c_k c_kᵀ) ⊗ Q_k + w_s LᵀL ⊗ I` into `values` (`nnz`), overwriting.
     /// For block size 1 the `Q_k` are ignored (taken as `I`; PD). Typically `w_e = 1/m`,
-    /// `w_s = λ/n`.
+    /// `w_s = λ/n`. The `Q_k` must be symmetric: only their upper triangles are read.
     ///
     /// Cost: O(Σ_k s_k² · b²), parallel over block columns; no allocation besides one index map
     /// of `n` entries per rayon thread.
@@ -212,72 +217,140 @@ impl Pattern {
             chunks.push(head);
             rest = tail;
         }
-        chunks.into_par_iter().enumerate().for_each_init(
-            || vec![u32::MAX; self.n],
-            |pos, (j, chunk)| {
-                chunk.fill(0.0);
-                let rows = &self.brow[self.bcol_ptr[j]..self.bcol_ptr[j + 1]];
-                for (p, &i) in rows.iter().enumerate() {
-                    pos[i as usize] = p as u32;
+        if b == 1 {
+            chunks.into_par_iter().enumerate().for_each_init(
+                || vec![u32::MAX; self.n],
+                |pos, (j, chunk)| self.fill_scalar_column(position, w_e, w_s, j, pos, chunk),
+            );
+        } else {
+            chunks.into_par_iter().enumerate().for_each_init(
+                || (vec![u32::MAX; self.n], Vec::new()),
+                |(pos, acc), (j, chunk)| {
+                    self.fill_block_column(position, q, w_e, w_s, j, pos, acc, chunk)
+                },
+            );
+        }
+    }
+
+    /// Block column `j` of `H` for block size 1 (PD) into `chunk` (its value slice).
+    fn fill_scalar_column(
+        &self,
+        position: &StencilMatrix,
+        w_e: f64,
+        w_s: f64,
+        j: usize,
+        pos: &mut [u32],
+        chunk: &mut [f64],
+    ) {
+        chunk.fill(0.0);
+        let rows = self.block_col(j);
+        for (p, &i) in rows.iter().enumerate() {
+            pos[i as usize] = p as u32;
+        }
+        for &(k, ckj) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+            let (idx, wts) = position.row(k as usize);
+            let w = w_e * ckj;
+            for (&i, &cki) in idx.iter().zip(wts) {
+                if i as usize <= j {
+                    chunk[pos[i as usize] as usize] += w * cki;
                 }
-                let nb = rows.len();
-                let base = self.col_ptr[b * j];
-                let offs: [usize; 3] = std::array::from_fn(|c| {
-                    if c < b {
-                        self.col_ptr[b * j + c] - base
-                    } else {
-                        0
-                    }
-                });
-                let mut add = |i: usize, w: f64, qm: Option<&Mat3>| {
-                    let p = pos[i] as usize;
-                    if b == 1 {
-                        chunk[offs[0] + p] += w;
-                        return;
-                    }
-                    let qm = qm.expect("Q for block size 3");
-                    if p + 1 < nb {
-                        for c in 0..3 {
-                            let o = offs[c] + 3 * p;
-                            for a in 0..3 {
-                                chunk[o + a] += w * qm[a][c];
-                            }
-                        }
-                    } else {
-                        for c in 0..3 {
-                            let o = offs[c] + 3 * (nb - 1);
-                            for a in 0..=c {
-                                chunk[o + a] += w * qm[a][c];
-                            }
-                        }
-                    }
-                };
-                for &(k, ckj) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
-                    let (idx, wts) = position.row(k as usize);
-                    let qk = if b == 3 { Some(&q[k as usize]) } else { None };
-                    for (&i, &cki) in idx.iter().zip(wts) {
-                        if i as usize <= j {
-                            add(i as usize, w_e * cki * ckj, qk);
-                        }
-                    }
-                }
-                if w_s != 0.0 {
-                    const I3: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-                    let (rs, lrj) = self.lap_t.row(j);
-                    for (&r, &lrj) in rs.iter().zip(lrj) {
-                        let (idx, wts) = self.lap.row(r as usize);
-                        for (&i, &lri) in idx.iter().zip(wts) {
-                            if i as usize <= j {
-                                add(i as usize, w_s * lri * lrj, Some(&I3));
-                            }
-                        }
+            }
+        }
+        if w_s != 0.0 {
+            let (rs, lrj) = self.lap_t.row(j);
+            for (&r, &lrj) in rs.iter().zip(lrj) {
+                let (idx, wts) = self.lap.row(r as usize);
+                for (&i, &lri) in idx.iter().zip(wts) {
+                    if i as usize <= j {
+                        chunk[pos[i as usize] as usize] += w_s * lri * lrj;
                     }
                 }
-                for &i in rows {
-                    pos[i as usize] = u32::MAX;
+            }
+        }
+        for &i in rows {
+            pos[i as usize] = u32::MAX;
+        }
+    }
+
+    /// Block column `j` of `H` for block size 3 into `chunk` (its value slice). Every block
+    /// `Σ_k c_ki c_kj Q_k + w_s (LᵀL)_ij I` is symmetric (the `Q_k` are), so only its 6
+    /// upper entries are accumulated — in `acc`, one contiguous `[f64; 6]` per block row, which
+    /// vectorizes — and mirrored into the CSC layout at the end.
+    #[allow(clippy::too_many_arguments)]
+    fn fill_block_column(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        w_e: f64,
+        w_s: f64,
+        j: usize,
+        pos: &mut [u32],
+        acc: &mut Vec<[f64; 6]>,
+        chunk: &mut [f64],
+    ) {
+        let rows = self.block_col(j);
+        let nb = rows.len();
+        for (p, &i) in rows.iter().enumerate() {
+            pos[i as usize] = p as u32;
+        }
+        acc.clear();
+        acc.resize(nb, [0.0; 6]);
+        for &(k, ckj) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+            let (idx, wts) = position.row(k as usize);
+            let qk = &q[k as usize];
+            let w = w_e * ckj;
+            let wq = [
+                w * qk[0][0],
+                w * qk[0][1],
+                w * qk[0][2],
+                w * qk[1][1],
+                w * qk[1][2],
+                w * qk[2][2],
+            ];
+            for (&i, &cki) in idx.iter().zip(wts) {
+                if i as usize <= j {
+                    let a = &mut acc[pos[i as usize] as usize];
+                    for (a, &v) in a.iter_mut().zip(&wq) {
+                        *a += cki * v;
+                    }
                 }
-            },
-        );
+            }
+        }
+        if w_s != 0.0 {
+            let (rs, lrj) = self.lap_t.row(j);
+            for (&r, &lrj) in rs.iter().zip(lrj) {
+                let (idx, wts) = self.lap.row(r as usize);
+                for (&i, &lri) in idx.iter().zip(wts) {
+                    if i as usize <= j {
+                        let a = &mut acc[pos[i as usize] as usize];
+                        let v = w_s * lri * lrj;
+                        a[0] += v;
+                        a[3] += v;
+                        a[5] += v;
+                    }
+                }
+            }
+        }
+        // Scatter: column 3j + c holds rows 3p + a of each off-diagonal block row p, then the
+        // diagonal rows a ≤ c.
+        const SYM: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
+        let base = self.col_ptr[3 * j];
+        for c in 0..3 {
+            let col =
+                &mut chunk[self.col_ptr[3 * j + c] - base..self.col_ptr[3 * j + c + 1] - base];
+            for (p, a6) in acc[..nb - 1].iter().enumerate() {
+                for a in 0..3 {
+                    col[3 * p + a] = a6[SYM[a][c]];
+                }
+            }
+            let d = &acc[nb - 1];
+            for a in 0..=c {
+                col[3 * (nb - 1) + a] = d[SYM[a][c]];
+            }
+        }
+        for &i in rows {
+            pos[i as usize] = u32::MAX;
+        }
     }
 
     /// The half-gradient `g = w_e Σ_k c_k ⊗ r_k + w_s (LᵀL ⊗ I) P` (`n by 3`), where

@@ -75,12 +75,22 @@ impl<'t> Fitter<'t> {
             &Options::new(options.scheme),
             options.sample_level,
         )?;
+        use crate::options::LinearSolver;
         let lap = Laplacian::umbrella(faces, num_vertices);
         let block = if options.method == Method::Pdm { 1 } else { 3 };
         let pattern = Pattern::new(&op.position, &lap, block);
         let values = vec![0.0; pattern.nnz()];
         let bbox_diagonal = bbox_diagonal(target.points());
-        let mut solver = CholeskySolver::new();
+        let pcg = match options.linear_solver {
+            LinearSolver::Auto => num_vertices >= options.pcg_min_points && block == 3,
+            LinearSolver::Cholesky => false,
+            LinearSolver::Pcg => true,
+        };
+        let mut solver = if pcg {
+            CholeskySolver::with_pcg(options.pcg_tolerance, options.pcg_max_iterations)
+        } else {
+            CholeskySolver::with_ordering(options.fill_ordering)
+        };
         solver
             .analyse(&pattern)
             .map_err(|e| FitError::Solver(format!("symbolic analysis: {e:?}")))?;

@@ -8,7 +8,8 @@
 //! * [`terms`]: the per-sample 3×3 error matrices `Q_k`;
 //! * [`smooth`]: the umbrella Laplacian;
 //! * [`assemble`]: the pattern of `H`, built once per topology, filled in place in parallel;
-//! * [`solve`]: `faer` supernodal Cholesky with the symbolic analysis reused;
+//! * [`solve`]: `faer` supernodal Cholesky with the symbolic analysis reused, or PCG for large
+//!   systems ([`pcg`]); [`ordering`]: fill-reducing orderings on the block graph;
 //! * [`Fitter`] / [`fit`]: the loop with step control; [`FitReport`] logs every iteration.
 //!
 //! Everything is in the target's normalized units (unit cube). The library prints nothing;
@@ -46,6 +47,8 @@ pub mod assemble;
 mod error;
 mod fitter;
 mod options;
+pub mod ordering;
+pub mod pcg;
 mod report;
 pub mod smooth;
 pub mod solve;
@@ -53,5 +56,5 @@ pub mod terms;
 
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
-pub use options::{FitOptions, Method, StepControl, Variant};
+pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};

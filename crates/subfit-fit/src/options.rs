@@ -2,7 +2,22 @@
 
 use subfit_subdiv::Scheme;
 
+pub use crate::ordering::FillOrdering;
 pub use crate::terms::Method;
+
+/// How the damped normal equations are solved each iteration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum LinearSolver {
+    /// Sparse Cholesky below [`FitOptions::pcg_min_points`] control points, preconditioned
+    /// conjugate gradients at and above it. The default.
+    #[default]
+    Auto,
+    /// Always the sparse Cholesky factorization (exact up to rounding).
+    Cholesky,
+    /// Always preconditioned conjugate gradients (inexact: stops at
+    /// [`FitOptions::pcg_tolerance`]).
+    Pcg,
+}
 
 /// Step control on the true (re-projected) objective (Cheng 2007 §III-C).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -121,6 +136,17 @@ pub struct FitOptions {
     pub armijo_beta: f64,
     /// Armijo: maximum number of halvings per iteration. Default 12.
     pub armijo_max_backtracks: usize,
+    /// Linear solver for the normal equations. Default [`LinearSolver::Auto`].
+    pub linear_solver: LinearSolver,
+    /// Fill-reducing ordering of the sparse Cholesky. Default [`FillOrdering::BlockAmd`].
+    pub fill_ordering: FillOrdering,
+    /// [`LinearSolver::Auto`] switches to PCG at this many control points. Default 4000.
+    pub pcg_min_points: usize,
+    /// PCG stops when `‖r‖ ≤ pcg_tolerance · ‖g‖` (relative residual, dimensionless).
+    /// Default `1e-3`.
+    pub pcg_tolerance: f64,
+    /// PCG iteration cap per solve. Default 500.
+    pub pcg_max_iterations: usize,
 }
 
 impl Default for FitOptions {
@@ -140,6 +166,11 @@ impl Default for FitOptions {
             armijo_c1: 1e-4,
             armijo_beta: 0.5,
             armijo_max_backtracks: 12,
+            linear_solver: LinearSolver::Auto,
+            fill_ordering: FillOrdering::BlockAmd,
+            pcg_min_points: 4000,
+            pcg_tolerance: 1e-3,
+            pcg_max_iterations: 500,
         }
     }
 }
@@ -187,7 +218,7 @@ impl FitOptions {
 
     /// Checks value ranges; returns the offending field's name and value.
     pub(crate) fn validate(&self) -> Result<(), (&'static str, f64)> {
-        let checks: [(&'static str, f64, bool); 7] = [
+        let checks: [(&'static str, f64, bool); 9] = [
             ("lambda", self.lambda, self.lambda >= 0.0),
             (
                 "tolerance_rms",
@@ -210,6 +241,16 @@ impl FitOptions {
                 "armijo_beta",
                 self.armijo_beta,
                 self.armijo_beta > 0.0 && self.armijo_beta < 1.0,
+            ),
+            (
+                "pcg_tolerance",
+                self.pcg_tolerance,
+                self.pcg_tolerance > 0.0 && self.pcg_tolerance < 1.0,
+            ),
+            (
+                "pcg_max_iterations",
+                self.pcg_max_iterations as f64,
+                self.pcg_max_iterations > 0,
             ),
         ];
         for (name, v, ok) in checks {

@@ -1,15 +1,24 @@
-//! Sparse Cholesky solve of the (damped) normal equations with `faer` (DESIGN.md §3.3, §6):
-//! the symbolic analysis (AMD fill-reducing ordering, supernodal structure) is done once per
-//! [`Pattern`] and reused by every numeric factorization; the factor's value buffer and the
-//! workspace are reused too.
+//! Solve of the (damped) normal equations (DESIGN.md §3.3, §6): a sparse Cholesky with `faer`
+//! — the symbolic analysis (fill-reducing ordering on the block graph, see [`crate::ordering`];
+//! supernodal structure) done once per [`Pattern`] and reused by every numeric factorization,
+//! the factor's value buffer and the workspace reused too — or, for large systems,
+//! preconditioned conjugate gradients ([`crate::pcg`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError as DenseLltError;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{get_global_parallelism, Conj, MatMut, Side};
 
 use crate::assemble::Pattern;
+use crate::ordering::{block_amd, expand, inverse, nested_dissection, BlockGraph, FillOrdering};
+use crate::pcg::{PcgFailure, PcgSolver, PcgStats};
+
+/// Nested dissection stops splitting parts of at most this many control points.
+const ND_LEAF: usize = 64;
 
 /// Why a factorization failed.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,24 +33,85 @@ pub enum SolveFailure {
     Other(String),
 }
 
-/// A sparse `LLᵀ` solver that keeps the symbolic factorization of one [`Pattern`], the factor's
-/// values and the workspace between calls.
+/// The name the fitter uses for [`NormalSolver`] (a sparse Cholesky unless built with
+/// [`NormalSolver::with_pcg`]).
+pub type CholeskySolver = NormalSolver;
+
+/// A solver of the normal equations for one [`Pattern`]: a sparse `LLᵀ` factorization that keeps
+/// the symbolic analysis, the factor's values and the workspace between calls, or (built with
+/// [`Self::with_pcg`]) block-Jacobi PCG that keeps its block-CSR index.
 #[derive(Debug, Default)]
-pub struct CholeskySolver {
+pub struct NormalSolver {
     symbolic: Option<SymbolicCholesky<usize>>,
     factor: Vec<f64>,
+    ordering: FillOrdering,
+    pcg: Option<PcgMode>,
 }
 
-impl CholeskySolver {
-    /// A solver without analysis yet (done at the first [`Self::solve`]).
+/// Settings and state of the PCG path.
+#[derive(Debug)]
+struct PcgMode {
+    tol: f64,
+    max_iter: usize,
+    solver: Option<PcgSolver>,
+    last: Option<PcgStats>,
+}
+
+impl NormalSolver {
+    /// A Cholesky solver without analysis yet (done at the first [`Self::solve`]), with the
+    /// default [`FillOrdering`].
     pub fn new() -> Self {
         Self::default()
     }
 
-    /// Forgets the symbolic analysis (call when the pattern changes).
+    /// A PCG solver stopping each solve at relative residual `tol` or after `max_iter`
+    /// iterations (see [`PcgSolver::solve`]).
+    pub fn with_pcg(tol: f64, max_iter: usize) -> Self {
+        Self {
+            pcg: Some(PcgMode {
+                tol,
+                max_iter,
+                solver: None,
+                last: None,
+            }),
+            ..Self::default()
+        }
+    }
+
+    /// True for the PCG path.
+    pub fn is_pcg(&self) -> bool {
+        self.pcg.is_some()
+    }
+
+    /// Iterations and residual of the last PCG solve (`None` for Cholesky or before a solve).
+    pub fn last_pcg(&self) -> Option<PcgStats> {
+        self.pcg.as_ref().and_then(|p| p.last)
+    }
+
+    /// A solver that will analyse with `ordering`.
+    pub fn with_ordering(ordering: FillOrdering) -> Self {
+        Self {
+            ordering,
+            ..Self::default()
+        }
+    }
+
+    /// Whether the analysis chose `faer`'s supernodal (blocked) factorization rather than the
+    /// simplicial one (`None` before the analysis).
+    pub fn is_supernodal(&self) -> Option<bool> {
+        self.symbolic
+            .as_ref()
+            .map(|s| matches!(s.raw(), SymbolicCholeskyRaw::Supernodal(_)))
+    }
+
+    /// Forgets the symbolic analysis / PCG index (call when the pattern changes).
     pub fn reset(&mut self) {
         self.symbolic = None;
         self.factor = Vec::new();
+        if let Some(p) = &mut self.pcg {
+            p.solver = None;
+            p.last = None;
+        }
     }
 
     /// Number of stored values of the Cholesky factor (after the first solve), a measure of
@@ -51,13 +121,36 @@ impl CholeskySolver {
     }
 
     /// The symbolic analysis (fill-reducing ordering, elimination tree, supernodes) of
-    /// `pattern`, unless already done. Cost: roughly one numeric factorization or less.
+    /// `pattern`, unless already done; for PCG, its block-CSR index. Cost: roughly one numeric
+    /// factorization or less (PCG: O(nnz)).
     pub fn analyse(&mut self, pattern: &Pattern) -> Result<(), SolveFailure> {
+        if let Some(p) = &mut self.pcg {
+            if p.solver.is_none() {
+                p.solver = Some(PcgSolver::new(pattern));
+            }
+            return Ok(());
+        }
         if self.symbolic.is_none() {
+            let order = match self.ordering {
+                FillOrdering::ScalarAmd => None,
+                FillOrdering::BlockAmd => Some(block_amd(pattern).map_err(SolveFailure::Other)?),
+                FillOrdering::NestedDissection => Some(nested_dissection(
+                    &BlockGraph::from_pattern(pattern),
+                    ND_LEAF,
+                )),
+            };
+            let fwd = order.map(|o| expand(&o, pattern.block()));
+            let inv = fwd.as_deref().map(inverse);
+            let ord = match (&fwd, &inv) {
+                (Some(f), Some(i)) => {
+                    SymmetricOrdering::Custom(PermRef::new_checked(f, i, pattern.dim()))
+                }
+                _ => SymmetricOrdering::Amd,
+            };
             let s = factorize_symbolic_cholesky(
                 symbolic_ref(pattern),
                 Side::Upper,
-                Default::default(),
+                ord,
                 Default::default(),
             )
             .map_err(|e| SolveFailure::Other(format!("{e:?}")))?;
@@ -68,10 +161,12 @@ impl CholeskySolver {
     }
 
     /// Factors `A` (upper triangle in `values`, pattern `pattern`) and solves `A X = B` in
-    /// place. `rhs` is column-major `dim × nrhs`.
+    /// place (PCG: solves approximately, see [`PcgSolver::solve`]). `rhs` is column-major
+    /// `dim × nrhs`.
     ///
     /// Cost: one numeric supernodal Cholesky (the first call also the symbolic analysis) plus
-    /// `nrhs` triangular solve pairs; parallel per `faer`'s global parallelism (rayon).
+    /// `nrhs` triangular solve pairs; parallel per `faer`'s global parallelism (rayon). PCG:
+    /// O(nnz) per iteration.
     ///
     /// # Panics
     /// If `values.len() != pattern.nnz()` or `rhs.len() != dim · nrhs`.
@@ -86,6 +181,16 @@ impl CholeskySolver {
         let dim = pattern.dim();
         assert_eq!(rhs.len(), dim * nrhs, "rhs length");
         self.analyse(pattern)?;
+        if let Some(p) = &mut self.pcg {
+            let solver = p.solver.as_mut().expect("analysed above");
+            let stats = solver
+                .solve(pattern, values, rhs, nrhs, p.tol, p.max_iter)
+                .map_err(|PcgFailure::NotPositiveDefinite { index }| {
+                    SolveFailure::NotPositiveDefinite { index }
+                })?;
+            p.last = Some(stats);
+            return Ok(());
+        }
         let sym = symbolic_ref(pattern);
         let symbolic = self.symbolic.as_ref().expect("analysed above");
         let par = get_global_parallelism();

@@ -1,0 +1,196 @@
+//! Time per SDMLM iteration (level-3 sampling), with the phase breakdown, the sample count and
+//! the factor size, for control meshes of about 1k and 10k vertices fitted to Igea
+//! (`igea.ply`, 134k points, closed genus 0). The target is built from the file's points; the
+//! control meshes are the Igea mesh simplified by our QEM (`subfit_init::simplify`, each size
+//! from the full mesh), mapped into the target's normalized coordinates.
+//!
+//! ```text
+//! SUBFIT_DATA=/work/shared/data RAYON_NUM_THREADS=2 \
+//!     cargo run --release -p subfit-fit --example iteration_igea
+//! SUBFIT_DATA=/work/shared/data SUBFIT_SIZES=10000 SUBFIT_ITERS=5 SUBFIT_SOLVER=pcg \
+//!     RAYON_NUM_THREADS=2 cargo run --release -p subfit-fit --example iteration_igea
+//! ```
+//!
+//! Environment: `SUBFIT_DATA` (directory holding `igea.ply`; required), `SUBFIT_SIZES`
+//! (comma-separated control-point counts, default `1000,10000`), `SUBFIT_ITERS` (default 3),
+//! `SUBFIT_SAMPLE_LEVEL` (default 3), `SUBFIT_LAMBDA` (default 1e-3), `SUBFIT_SOLVER`
+//! (`auto`, `cholesky` or `pcg`; default `auto`), `SUBFIT_ORDERING` (`scalar-amd`,
+//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-3). CPU time is the process's user + system time
+//! from `/proc/self/stat` (Linux only; 0 elsewhere).
+#![allow(clippy::print_stdout)]
+
+use std::time::{Duration, Instant};
+
+use subfit_fit::{FillOrdering, FitOptions, Fitter, LinearSolver, Variant};
+use subfit_init::{simplify, SimplifyOptions};
+use subfit_mesh::{PolyMesh, Tags};
+use subfit_target::{Target, TargetOptions};
+
+fn env<T: std::str::FromStr>(name: &str, default: T) -> T {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// User + system CPU time of this process (all threads), from `/proc/self/stat`.
+fn cpu_time() -> Duration {
+    let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {
+        return Duration::ZERO;
+    };
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = s.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<u64> = rest
+        .split_whitespace()
+        .skip(11)
+        .take(2)
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    // Linux reports clock ticks of 1/100 s (USER_HZ).
+    Duration::from_millis(10 * f.iter().sum::<u64>())
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn main() {
+    let Some(dir) = std::env::var_os("SUBFIT_DATA") else {
+        println!("SUBFIT_DATA not set (the directory holding igea.ply): nothing to measure");
+        return;
+    };
+    let sizes: Vec<usize> = std::env::var("SUBFIT_SIZES")
+        .unwrap_or_else(|_| "1000,10000".into())
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    let iters = env("SUBFIT_ITERS", 3usize);
+    let level = env("SUBFIT_SAMPLE_LEVEL", 3usize);
+    let lambda = env("SUBFIT_LAMBDA", 1e-3f64);
+    let pcg_tol = env("SUBFIT_PCG_TOL", 1e-3f64);
+    let solver = match std::env::var("SUBFIT_SOLVER").as_deref() {
+        Ok("cholesky") => LinearSolver::Cholesky,
+        Ok("pcg") => LinearSolver::Pcg,
+        _ => LinearSolver::Auto,
+    };
+    let ordering = match std::env::var("SUBFIT_ORDERING").as_deref() {
+        Ok("scalar-amd") => FillOrdering::ScalarAmd,
+        Ok("nd") => FillOrdering::NestedDissection,
+        _ => FillOrdering::BlockAmd,
+    };
+
+    let path = std::path::Path::new(&dir).join("igea.ply");
+    let (mesh, _) =
+        subfit_io::read_file(&path, &subfit_io::ReadOptions::default()).expect("read igea.ply");
+    let t0 = Instant::now();
+    let target = Target::from_points(
+        &mesh.positions,
+        mesh.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .expect("target");
+    println!(
+        "target: {} points, built in {:.2?}; rayon threads: {}",
+        target.len(),
+        t0.elapsed(),
+        rayon::current_num_threads()
+    );
+
+    // Each size simplified from the full mesh (simplifying the 10k cage further gets stuck
+    // early on its quality checks).
+    let mut cages: Vec<(usize, PolyMesh)> = Vec::new();
+    for &n in &sizes {
+        let t = Instant::now();
+        let opts = SimplifyOptions {
+            target_vertices: n,
+            ..SimplifyOptions::default()
+        };
+        let (cage, rep) = simplify(&mesh, &opts).expect("simplify");
+        println!(
+            "QEM: {} → {} vertices in {:.2?}",
+            rep.vertices_before,
+            rep.vertices_after,
+            t.elapsed()
+        );
+        cages.push((n, cage));
+    }
+
+    for &n in &sizes {
+        let cage = &cages.iter().find(|(k, _)| *k == n).expect("simplified").1;
+        let positions: Vec<[f64; 3]> = cage
+            .positions
+            .iter()
+            .map(|&p| target.to_normalized(p))
+            .collect();
+        let opts = FitOptions {
+            linear_solver: solver,
+            fill_ordering: ordering,
+            pcg_tolerance: pcg_tol,
+            ..FitOptions::variant(Variant::SdmLm)
+                .with_lambda(lambda)
+                .with_sample_level(level)
+                .with_max_iterations(iters)
+        };
+        let (c0, t) = (cpu_time(), Instant::now());
+        let mut fitter = Fitter::new(
+            &target,
+            &cage.faces,
+            cage.num_vertices(),
+            &Tags::new(),
+            &opts,
+        )
+        .expect("fitter");
+        let (setup, setup_cpu) = (t.elapsed(), cpu_time() - c0);
+        println!(
+            "\n{} control points, {} samples (level {level}), H: {} scalar nonzeros (upper), \
+             setup {:.0} ms (CPU {:.0} ms)",
+            positions.len(),
+            fitter.num_samples(),
+            fitter.pattern().nnz(),
+            ms(setup),
+            ms(setup_cpu)
+        );
+        let mut p = positions.clone();
+        let (c0, t) = (cpu_time(), Instant::now());
+        let report = fitter.run(&mut p, None).expect("fit");
+        let (wall, cpu) = (t.elapsed(), cpu_time() - c0);
+        println!(
+            "solver: {solver:?}, ordering {ordering:?}; factor: {}; initial E_rms {:.6} E_max {:.6}",
+            match fitter.factor_len() {
+                Some(f) => format!(
+                    "{f} values ({:.1}× nnz(H))",
+                    f as f64 / fitter.pattern().nnz() as f64
+                ),
+                None => "none (PCG)".into(),
+            },
+            report.initial.e_rms,
+            report.initial.e_max
+        );
+        println!("iter acc  E_rms     E_max     total_ms sample project assemble  solve evaluate");
+        for row in &report.iterations {
+            let t = row.timings;
+            println!(
+                "{:>4} {:>3} {:.6} {:.6} {:>8.1} {:>6.1} {:>7.1} {:>8.1} {:>6.1} {:>8.1}",
+                row.iteration,
+                if row.accepted { "y" } else { "n" },
+                row.errors.e_rms,
+                row.errors.e_max,
+                ms(t.total()),
+                ms(t.sample),
+                ms(t.project),
+                ms(t.assemble),
+                ms(t.solve),
+                ms(t.evaluate)
+            );
+        }
+        let k = report.iterations.len().max(1) as f64;
+        println!(
+            "mean per iteration: {:.1} ms wall, {:.1} ms CPU (whole run incl. initial evaluation: \
+             {:.0} ms wall, {:.0} ms CPU)",
+            ms(report.iterations.iter().map(|r| r.timings.total()).sum()) / k,
+            ms(cpu) / k,
+            ms(wall),
+            ms(cpu)
+        );
+    }
+}
