@@ -239,7 +239,7 @@ pub fn contour(
     Ok((mesh, report))
 }
 
-fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+pub(crate) fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in pts {
@@ -251,30 +251,30 @@ fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     (lo, hi)
 }
 
-struct Grid {
-    dims: [usize; 3],
-    origin: [f64; 3],
-    cell: f64,
+pub(crate) struct Grid {
+    pub(crate) dims: [usize; 3],
+    pub(crate) origin: [f64; 3],
+    pub(crate) cell: f64,
 }
 
 impl Grid {
-    fn id(&self, x: isize, y: isize, z: isize) -> usize {
+    pub(crate) fn id(&self, x: isize, y: isize, z: isize) -> usize {
         x as usize + self.dims[0] * (y as usize + self.dims[1] * z as usize)
     }
-    fn coords(&self, i: usize) -> [usize; 3] {
+    pub(crate) fn coords(&self, i: usize) -> [usize; 3] {
         let x = i % self.dims[0];
         let y = (i / self.dims[0]) % self.dims[1];
         [x, y, i / (self.dims[0] * self.dims[1])]
     }
-    fn pos(&self, i: usize) -> [f64; 3] {
+    pub(crate) fn pos(&self, i: usize) -> [f64; 3] {
         let c = self.coords(i);
         [0, 1, 2].map(|k| self.origin[k] + c[k] as f64 * self.cell)
     }
-    fn on_boundary(&self, i: usize) -> bool {
+    pub(crate) fn on_boundary(&self, i: usize) -> bool {
         let c = self.coords(i);
         (0..3).any(|k| c[k] == 0 || c[k] + 1 == self.dims[k])
     }
-    fn neighbors6(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+    pub(crate) fn neighbors6(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
         let c = self.coords(i);
         let strides = [1, self.dims[0], self.dims[0] * self.dims[1]];
         (0..3).flat_map(move |k| {
@@ -287,7 +287,7 @@ impl Grid {
 
 /// Marching tetrahedra over every cell with a sign change; vertices welded by grid-edge keys.
 /// Triangles are oriented so that their normals point to positive values (outside).
-fn march(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+pub(crate) fn march(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let [nx, ny, nz] = grid.dims;
     let corner_off: [usize; 8] =
         std::array::from_fn(|c| (c & 1) + nx * (((c >> 1) & 1) + ny * ((c >> 2) & 1)));
@@ -366,7 +366,7 @@ fn march(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 
 /// Keeps the components with at least `fraction` × (largest face count) faces; re-indexes.
 /// Returns the mesh, the number of components found and kept.
-fn keep_components(
+pub(crate) fn keep_components(
     positions: Vec<[f64; 3]>,
     tris: &[[u32; 3]],
     fraction: f64,

@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use subfit_mesh::{HalfEdgeMesh, PolyMesh, TopologyError};
 use subfit_target::Target;
 
+use crate::carve::carve;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
 use crate::simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
 
@@ -21,8 +22,10 @@ pub struct InitOptions {
     pub simplify: SimplifyOptions,
     /// Contouring options (point clouds only).
     pub contour: ContourOptions,
-    /// Genus the caller expects for a point cloud (compared in the report). Default `None`: the
-    /// contour's genus is reported as the target's. Ignored for mesh targets (their genus is
+    /// Genus the caller expects for a point cloud (compared in the report). When the IMLS
+    /// contour has another genus, the space-carving fallback ([`crate::carve`], which ignores
+    /// the normals) is tried and used if it matches. Default `None`: the contour's genus is
+    /// reported as the target's. Ignored for mesh targets (their genus is
     /// computed).
     pub expected_genus: Option<u32>,
     /// Fail with [`InitError::GenusMismatch`] when the result's genus differs from the target's.
@@ -119,6 +122,10 @@ pub struct InitReport {
     pub simplify: SimplifyReport,
     /// Contouring details (point clouds only).
     pub contour: Option<ContourReport>,
+    /// Point clouds: the carving radius (normalized units) when the IMLS contour missed
+    /// [`InitOptions::expected_genus`] and the space-carving fallback ([`crate::carve`]) was
+    /// used; `None` otherwise.
+    pub carve_radius: Option<f64>,
     /// Step times.
     pub timings: InitTimings,
 }
@@ -203,6 +210,16 @@ pub fn initial_control_mesh(
             report.source = InitSource::Contour;
             let t = Instant::now();
             let (m, c) = contour_for(target, n_vertices, options)?;
+            let (m, c) = match options.expected_genus {
+                Some(g) if c.genus != g => match carve_for(target, &c, g) {
+                    Some((cm, cc, r)) => {
+                        report.carve_radius = Some(r);
+                        (cm, cc)
+                    }
+                    None => (m, c),
+                },
+                _ => (m, c),
+            };
             report.timings.contour = t.elapsed();
             report.contour = Some(c);
             m
@@ -303,6 +320,23 @@ fn contour_for(
         }
         _ => Ok((m, c)),
     }
+}
+
+/// The space-carving fallback: carving radii of 1, 1.5, 2 and 3 IMLS-contour cells on a grid
+/// twice as fine; the first result of genus `genus` with one component, if any, with its radius.
+fn carve_for(
+    target: &Target,
+    imls: &ContourReport,
+    genus: u32,
+) -> Option<(PolyMesh, ContourReport, f64)> {
+    let res = (2 * imls.resolution).max(32);
+    [1.0, 1.5, 2.0, 3.0].into_iter().find_map(|k| {
+        let r = k * imls.cell_size;
+        match carve(target, res, r, 1.0) {
+            Ok((m, c)) if c.genus == genus && c.components_kept == 1 => Some((m, c, r)),
+            _ => None,
+        }
+    })
 }
 
 /// [`InitError::TooFewForTopology`] when `n_vertices` is below the sum over the components of

@@ -14,10 +14,12 @@
 // `!(x > t)` is used deliberately: it is true for NaN, which must take the fallback branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod carve;
 pub mod contour;
 pub mod init;
 pub mod simplify;
 
+pub use carve::carve;
 pub use contour::{contour, ContourError, ContourOptions, ContourReport};
 pub use init::{
     default_control_points, initial_control_mesh, min_vertices_for_topology, InitError,

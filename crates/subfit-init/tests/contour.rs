@@ -183,3 +183,52 @@ fn real_point_clouds_and_meshes_keep_their_genus() {
         assert_eq!(out.num_vertices(), 900, "{file}: {rep:?}");
     }
 }
+
+/// Carving ignores the normals: a genus-2 cloud gives a closed genus-2 wrap about `r` outside.
+#[test]
+fn carving_wraps_a_genus2_cloud_without_normals() {
+    let shape = Shape::DEFAULT_GENUS2;
+    let t = target_of(&shape, 8000);
+    let r = 0.02;
+    let (m, rep) = subfit_init::carve(&t, 80, r, 0.05).unwrap();
+    assert_eq!(topology(&m), (2, 0, 1), "{rep:?}");
+    assert_eq!(rep.genus, 2);
+    for &p in &m.positions {
+        let d = distance(&shape, &t, p);
+        assert!(d < r + 1.5 * rep.cell_size, "{d} vs r {r}: {rep:?}");
+    }
+    assert!(subfit_init::carve(&t, 80, 0.0, 0.05).is_err());
+}
+
+/// With a third of the normals flipped the IMLS contour gets the genus wrong; given the expected
+/// genus, `initial_control_mesh` falls back to carving and gets it right.
+#[test]
+fn wrong_normals_fall_back_to_carving_when_the_genus_is_known() {
+    let shape = Shape::DEFAULT_TORUS;
+    let cloud = shape.sample(8000, 0.0, 5);
+    let normals: Vec<[f64; 3]> = cloud
+        .normals
+        .as_ref()
+        .unwrap()
+        .iter()
+        .enumerate()
+        .map(|(i, n)| if i % 3 == 0 { n.map(|c| -c) } else { *n })
+        .collect();
+    let t =
+        Target::from_points(&cloud.positions, Some(&normals), &TargetOptions::default()).unwrap();
+    let (_, plain) = initial_control_mesh(&t, None, 200, &InitOptions::default()).unwrap();
+    assert!(plain.carve_radius.is_none());
+    assert_ne!(
+        plain.genus_after, 1,
+        "the corrupted normals should mislead IMLS: {plain:?}"
+    );
+    let opts = InitOptions {
+        expected_genus: Some(1),
+        require_genus: true,
+        ..InitOptions::default()
+    };
+    let (m, rep) = initial_control_mesh(&t, None, 200, &opts).unwrap();
+    assert!(rep.carve_radius.is_some(), "{rep:?}");
+    assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
+    assert!(m.num_vertices() <= 200);
+}
