@@ -54,8 +54,9 @@ pub(crate) const MIN_NEIGHBORS: usize = 10;
 ///
 /// `prescribed`: a unit normal to use as the frame normal instead of the PCA one.
 /// `ambiguity_ratio`: the point is flagged ambiguous when `λ0 ≥ ratio · λ1` (smallest two
-/// covariance eigenvalues nearly equal). `graph_row` (`graph_k` entries) receives the nearest
-/// neighbours kept for orientation, padded with `u32::MAX`. `scratch` is reused between calls.
+/// covariance eigenvalues nearly equal). `graph_row` (any length, see [`graph_stride`]) receives
+/// the nearest neighbours in increasing distance (the point itself excluded), padded with
+/// `u32::MAX`. `scratch` is reused between calls.
 pub(crate) fn estimate_point(
     points: &[[f64; 3]],
     index: &PointIndex,
@@ -182,9 +183,21 @@ pub(crate) struct Scratch {
     w: Vec<f64>,
 }
 
+/// Neighbours kept per point by [`estimate_all`] for the nearest-point descent graph
+/// ([`crate::neighbors::NeighborGraph`]).
+pub(crate) const DESCENT_K: usize = 16;
+
+/// Row length of the graph returned by [`estimate_all`]: `max(graph_k, DESCENT_K)`. The
+/// orientation graph is the first `graph_k` entries of each row, the descent graph the first
+/// [`DESCENT_K`].
+pub(crate) fn graph_stride(params: &EstimateParams) -> usize {
+    params.graph_k.max(DESCENT_K)
+}
+
 /// [`estimate_point`] for all points in parallel, in chunks, calling `tick(done)` after each.
 /// Points are visited in Morton order (kd-tree locality); results are in point order, with the
-/// orientation graph as rows of `params.graph_k` entries (padded with `u32::MAX`).
+/// nearest-neighbour graph as rows of [`graph_stride`] entries (sorted by distance, padded with
+/// `u32::MAX`).
 pub(crate) fn estimate_all(
     points: &[[f64; 3]],
     index: &PointIndex,
@@ -194,7 +207,7 @@ pub(crate) fn estimate_all(
 ) -> (Vec<PointEstimate>, Vec<u32>) {
     const CHUNK: usize = 1 << 15;
     let n = points.len();
-    let k = params.graph_k.max(1);
+    let k = graph_stride(params);
     let order = morton_order(points);
     let mut sorted = Vec::with_capacity(n);
     let mut graph_sorted = vec![u32::MAX; n * k];

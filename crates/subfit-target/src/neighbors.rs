@@ -150,6 +150,96 @@ impl PointIndex {
     }
 }
 
+/// A k-nearest-neighbour graph over a point set, with per-row radii, for warm-started nearest
+/// queries by greedy descent ([`NeighborGraph::descend`]).
+///
+/// Row `i` holds the (up to) `stride` points nearest to point `i` (itself excluded), padded with
+/// `u32::MAX`. `radius2[i]` is the squared distance of the last entry of row `i`; since a row
+/// holds the nearest points, every point strictly closer to point `i` than that is in the row.
+/// Memory: `#P · (4 · stride + 8)` bytes.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct NeighborGraph {
+    stride: usize,
+    targets: Vec<u32>,
+    radius2: Vec<f64>,
+}
+
+/// Descent steps after which [`NeighborGraph::descend`] gives up (the caller falls back to the
+/// kd-tree). Descents from a nearby start take a handful.
+const MAX_DESCENT_STEPS: usize = 48;
+
+#[inline]
+fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+}
+
+impl NeighborGraph {
+    /// Builds the graph from rows of nearest neighbours (`#P · stride`, each row sorted by
+    /// increasing distance, padded with `u32::MAX`) over `points` (`#P by 3`). O(#P · stride).
+    pub(crate) fn new(points: &[[f64; 3]], targets: Vec<u32>, stride: usize) -> Self {
+        let stride = stride.max(1);
+        debug_assert_eq!(targets.len(), points.len() * stride);
+        let radius2 = targets
+            .par_chunks(stride)
+            .zip(points.par_iter())
+            .map(|(row, p)| {
+                row.iter()
+                    .take_while(|&&j| j != u32::MAX)
+                    .map(|&j| dist2(p, &points[j as usize]))
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        Self {
+            stride,
+            targets,
+            radius2,
+        }
+    }
+
+    /// The certified nearest point of `points` (the slice the graph was built over) to `q`, by
+    /// greedy descent from point `start`: move to the row entry nearest to `q` while it is
+    /// strictly nearer than the current point. At a local minimum `c` at distance `d`, the result
+    /// is exact when `2 d < R_c` (`R_c` the row radius): a point `p` nearer to `q` than `c` has
+    /// `|p − c| ≤ |p − q| + |q − c| < 2 d < R_c`, so it is in the row and the descent would
+    /// have moved to it. Returns `None` when that condition fails (typically `q` farther from
+    /// the points than about the neighbour spacing), after [`MAX_DESCENT_STEPS`] steps, or for
+    /// an out-of-range `start`. Exact up to rounding of the squared distances (ties may resolve
+    /// to either point). Cost: O(steps · stride).
+    #[inline]
+    pub(crate) fn descend(
+        &self,
+        points: &[[f64; 3]],
+        q: &[f64; 3],
+        start: u32,
+    ) -> Option<Neighbor> {
+        let mut c = start as usize;
+        let mut dc = dist2(q, points.get(c)?);
+        for _ in 0..MAX_DESCENT_STEPS {
+            let row = &self.targets[c * self.stride..(c + 1) * self.stride];
+            let (mut best, mut bd) = (c, dc);
+            for &j in row {
+                if j == u32::MAX {
+                    break;
+                }
+                let d = dist2(q, &points[j as usize]);
+                if d < bd {
+                    (best, bd) = (j as usize, d);
+                }
+            }
+            if best == c {
+                // 2d < R ⇔ 4d² < R², with a margin for rounding.
+                return (4.0 * dc * (1.0 + 1e-12) < self.radius2[c]).then(|| Neighbor {
+                    index: c as u32,
+                    distance: dc.sqrt(),
+                });
+            }
+            (c, dc) = (best, bd);
+        }
+        None
+    }
+}
+
 /// Spreads the low 21 bits of `x` to every third bit.
 #[inline]
 fn spread3(x: u64) -> u64 {

@@ -2,8 +2,10 @@
 //! signed distance and curvature data of the SD error term (Cheng 2007 §II-D3, eq. 5–6;
 //! DESIGN.md §3.2).
 //!
-//! Method: the nearest data point by kd-tree, then the closest point on that point's local
-//! quadric (Newton on the height function, [`LocalQuadric::project_local`]).
+//! Method: the nearest data point by kd-tree (or, in batches and for warm-started queries, by
+//! certified greedy descent over the 16-nearest-neighbour graph from a nearby point, with the
+//! kd-tree as fallback: same result, fewer tree traversals), then the closest point on that
+//! point's local quadric (Newton on the height function, [`LocalQuadric::project_local`]).
 //!
 //! Signs, quoting Cheng 2007 §II-D3: "If the sample point S_k is on the side of Γ_T pointed to by
 //! N, i.e., N·(S_k⁰ − V_k⁰) > 0, then d > 0; otherwise, d ≤ 0. Similarly, if the curvature center
@@ -26,6 +28,10 @@ const TOL: f64 = 1e-14;
 
 /// Batches at least this large are processed in Morton order.
 const SPATIAL_SORT_MIN: usize = 4096;
+
+/// Queries per run in batches: within a run, each nearest-point search starts from the previous
+/// query's nearest point; runs are processed in parallel.
+const CHAIN: usize = 256;
 
 /// The foot point of a query point on the target, with everything the PD/TD/SD terms need.
 /// All in normalized units.
@@ -70,6 +76,14 @@ pub fn alpha_plus(d: f64, kappa: f64) -> f64 {
     }
 }
 
+/// A quadric foot point may be at most this factor farther from the query than the data
+/// point it was fitted at; beyond, the data point's tangent plane is used.
+const FALLBACK_SLACK: f64 = 1.1;
+
+fn norm2(a: [f64; 3]) -> f64 {
+    dot(a, a)
+}
+
 /// The foot point of `x` (normalized coordinates) on one quadric with origin `origin`.
 pub fn foot_point_on(
     quadric: &LocalQuadric,
@@ -79,8 +93,19 @@ pub fn foot_point_on(
 ) -> FootPoint {
     let loc = quadric.local(sub(x, origin));
     let (u, v) = quadric.project_local(loc, MAX_ITER, TOL);
-    let f = quadric.frame_at(u, v);
-    let point = add(origin, f.offset);
+    let mut f = quadric.frame_at(u, v);
+    let mut point = add(origin, f.offset);
+    // The data point itself lies on the surface, so the true foot point is no farther from `x`
+    // than it. A quadric projection that lands farther (the jet extrapolated far outside its
+    // support, for queries far from the data or in thin parts) is replaced by the projection
+    // onto the tangent plane of the data point's own frame.
+    let (dq, dp) = (norm2(sub(x, point)), norm2(sub(x, origin)));
+    if !(dq.is_finite() && dq <= FALLBACK_SLACK * FALLBACK_SLACK * dp) {
+        f = quadric.frame_at(0.0, 0.0);
+        let base = add(origin, f.offset);
+        let h = dot(sub(x, base), f.normal);
+        point = std::array::from_fn(|k| x[k] - h * f.normal[k]);
+    }
     let distance = dot(sub(x, point), f.normal);
     FootPoint {
         point,
@@ -110,28 +135,51 @@ impl Target {
     /// point (then no other data point can be nearer to it: triangle inequality), so the result
     /// is the same as with the second query.
     pub fn foot_point(&self, x: [f64; 3]) -> FootPoint {
-        let i = self.index().nearest(&x).index;
+        self.foot_point_from(x, None).0
+    }
+
+    /// The data point nearest to `x`: by certified greedy descent over the neighbour graph from
+    /// `start` when given (see `NeighborGraph::descend`), else, or when the descent cannot
+    /// certify its result, by the kd-tree. Exact either way (up to ties).
+    #[inline]
+    fn nearest_from(&self, x: &[f64; 3], start: Option<u32>) -> u32 {
+        start
+            .and_then(|s| self.descent_graph().descend(self.points(), x, s))
+            .unwrap_or_else(|| self.index().nearest(x))
+            .index
+    }
+
+    /// [`Self::foot_point`] with the nearest-point search started at `start`; also returns the
+    /// data point nearest to `x`. Same result as [`Self::foot_point`] (up to distance ties).
+    #[inline]
+    fn foot_point_from(&self, x: [f64; 3], start: Option<u32>) -> (FootPoint, u32) {
+        let i = self.nearest_from(&x, start);
         let pi = self.points()[i as usize];
         let f = foot_point_on(&self.quadrics()[i as usize], pi, x, i);
         let d = sub(f.point, pi);
         let h = 0.5 * self.foot_shortcut_diameters()[i as usize];
         if dot(d, d) < h * h {
-            return f;
+            return (f, i);
         }
-        let j = self.index().nearest(&f.point).index;
+        // The foot point is on the surface near point i: the descent from i almost always
+        // certifies, sparing the second kd-tree query.
+        let j = self.nearest_from(&f.point, Some(i));
         if j == i {
-            return f;
+            return (f, i);
         }
-        foot_point_on(
+        let g = foot_point_on(
             &self.quadrics()[j as usize],
             self.points()[j as usize],
             x,
             j,
-        )
+        );
+        (g, i)
     }
 
     /// [`Self::foot_point`] for many points, in parallel (rayon); `#Q` results in order.
-    /// Large batches are processed in Morton (Z-curve) order of the queries for cache locality.
+    /// Large batches are processed in Morton (Z-curve) order of the queries; within a run of
+    /// consecutive queries the nearest-point search starts from the previous query's result
+    /// (certified greedy descent, kd-tree fallback), so results equal [`Self::foot_point`]'s.
     pub fn foot_points(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
         let mut out = vec![FootPoint::default(); xs.len()];
         self.foot_points_into(xs, &mut out);
@@ -146,16 +194,29 @@ impl Target {
     pub fn foot_points_into(&self, xs: &[[f64; 3]], out: &mut [FootPoint]) {
         assert_eq!(xs.len(), out.len(), "foot_points_into: length mismatch");
         if xs.len() < SPATIAL_SORT_MIN {
-            out.par_iter_mut()
-                .zip(xs.par_iter())
-                .for_each(|(o, &x)| *o = self.foot_point(x));
+            out.par_chunks_mut(CHAIN)
+                .zip(xs.par_chunks(CHAIN))
+                .for_each(|(o, x)| {
+                    let mut prev = None;
+                    for (o, &x) in o.iter_mut().zip(x) {
+                        let (f, i) = self.foot_point_from(x, prev);
+                        (*o, prev) = (f, Some(i));
+                    }
+                });
             return;
         }
         let order = crate::neighbors::morton_order(xs);
-        let sorted: Vec<FootPoint> = order
-            .par_iter()
-            .map(|&q| self.foot_point(xs[q as usize]))
-            .collect();
+        let mut sorted = vec![FootPoint::default(); xs.len()];
+        sorted
+            .par_chunks_mut(CHAIN)
+            .zip(order.par_chunks(CHAIN))
+            .for_each(|(o, q)| {
+                let mut prev = None;
+                for (o, &q) in o.iter_mut().zip(q) {
+                    let (f, i) = self.foot_point_from(xs[q as usize], prev);
+                    (*o, prev) = (f, Some(i));
+                }
+            });
         let mut rank = vec![0u32; xs.len()];
         for (r, &q) in order.iter().enumerate() {
             rank[q as usize] = r as u32;
@@ -163,6 +224,44 @@ impl Target {
         out.par_iter_mut()
             .zip(rank.par_iter())
             .for_each(|(o, &r)| *o = sorted[r as usize]);
+    }
+
+    /// Warm-started [`Self::foot_points`] for queries that move little between calls (e.g. the
+    /// fitter's samples between iterations). `hints[q]` is a data-point index near query `q`
+    /// (typically the value this function stored there on the previous call); `u32::MAX` or any
+    /// out-of-range value means none, and the previous query of the batch, or the kd-tree, is
+    /// used instead. On return `hints[q]` holds the data point nearest to `xs[q]`.
+    ///
+    /// The nearest data point is found by greedy descent over a 16-nearest-neighbour graph from
+    /// the hint. Greedy descent alone is not exact (it can stop at a local minimum); its result
+    /// is accepted only when certified — at the local minimum `c`, at distance `d` from the
+    /// query, `2d` is less than the distance from `c` to its 16th neighbour, which proves no
+    /// other point is nearer — and otherwise the kd-tree is queried. So the results equal
+    /// [`Self::foot_points`]' (up to exact distance ties); the hints only save time. Queries
+    /// farther from the data than about the neighbour spacing usually fall back to the kd-tree.
+    /// Parallel over chunks of consecutive queries, no reordering: cost O(#Q · steps · 16)
+    /// when the hints are good.
+    ///
+    /// # Panics
+    /// If `hints.len() != xs.len()` (a caller bug, like a length mismatch in
+    /// [`Self::foot_points_into`]).
+    #[track_caller]
+    pub fn foot_points_hinted(&self, xs: &[[f64; 3]], hints: &mut [u32]) -> Vec<FootPoint> {
+        assert_eq!(xs.len(), hints.len(), "foot_points_hinted: length mismatch");
+        let n = self.len() as u32;
+        let mut out = vec![FootPoint::default(); xs.len()];
+        out.par_chunks_mut(CHAIN)
+            .zip(xs.par_chunks(CHAIN))
+            .zip(hints.par_chunks_mut(CHAIN))
+            .for_each(|((o, x), h)| {
+                let mut prev = None;
+                for ((o, &x), h) in o.iter_mut().zip(x).zip(h.iter_mut()) {
+                    let start = if *h < n { Some(*h) } else { prev };
+                    let (f, i) = self.foot_point_from(x, start);
+                    (*o, *h, prev) = (f, i, Some(i));
+                }
+            });
+        out
     }
 
     /// Exact closest point on the target's triangles (mesh targets only; `None` for point

@@ -9,8 +9,10 @@ use subfit_mesh::PolyMesh;
 
 use crate::closest::TriangleBvh;
 use crate::error::TargetError;
-use crate::estimate::{estimate_all, EstimateParams, Neighborhood, PointEstimate};
-use crate::neighbors::PointIndex;
+use crate::estimate::{
+    estimate_all, graph_stride, EstimateParams, Neighborhood, PointEstimate, DESCENT_K,
+};
+use crate::neighbors::{NeighborGraph, PointIndex};
 use crate::normalize::Normalization;
 use crate::options::{
     NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
@@ -41,6 +43,8 @@ pub struct Target {
     normals: Vec<[f64; 3]>,
     quadrics: Vec<LocalQuadric>,
     index: PointIndex,
+    /// The 16-nearest-neighbour graph for warm-started nearest queries.
+    descent: NeighborGraph,
     bvh: Option<TriangleBvh>,
     input_to_point: Vec<u32>,
     /// Per point: the larger of the distance to the nearest other point and
@@ -209,16 +213,18 @@ impl Target {
             (o, f) if f == np => o,
             _ => NormalOrigin::Mixed,
         };
+        let stride = graph_stride(&params);
         if n_fixed < np {
-            let stride = options.orientation_k;
+            let k = options.orientation_k;
+            let orient_graph = prefix_rows(&graph, stride, k);
             let ambiguous: Vec<bool> = estimates.iter().map(|e| e.ambiguous).collect();
             let area: Vec<f64> = estimates.iter().map(|e| e.radius * e.radius).collect();
             let o = orient_normals(
                 &points,
                 &mut normals,
                 KnnGraph {
-                    targets: &graph,
-                    stride,
+                    targets: &orient_graph,
+                    stride: k,
                 },
                 &OrientInput {
                     ambiguous: &ambiguous,
@@ -235,6 +241,9 @@ impl Target {
             stats.flipped_normals = o.flipped.iter().filter(|&&f| f).count();
             stats.orientation_components = o.components;
         }
+        let descent =
+            NeighborGraph::new(&points, prefix_rows(&graph, stride, DESCENT_K), DESCENT_K);
+        drop(graph);
         stats.timings.orient = t.elapsed();
         report(Phase::Orient, np, np);
 
@@ -269,6 +278,7 @@ impl Target {
             normals,
             quadrics,
             index,
+            descent,
             bvh,
             input_to_point,
             nn_dist,
@@ -334,6 +344,11 @@ impl Target {
         &self.index
     }
 
+    /// The nearest-neighbour graph used for warm-started nearest queries.
+    pub(crate) fn descent_graph(&self) -> &NeighborGraph {
+        &self.descent
+    }
+
     /// The triangle BVH (normalized coordinates, distinct-point indices) for mesh targets.
     pub fn mesh(&self) -> Option<&TriangleBvh> {
         self.bvh.as_ref()
@@ -380,6 +395,18 @@ impl Target {
             t2: frames.iter().map(|f| f.3).collect(),
         }
     }
+}
+
+/// The first `k` entries of each row of a graph with rows of `stride` entries (`k ≤ stride`);
+/// the graph itself when `k == stride`.
+fn prefix_rows(graph: &[u32], stride: usize, k: usize) -> Vec<u32> {
+    if k == stride {
+        return graph.to_vec();
+    }
+    graph
+        .par_chunks(stride)
+        .flat_map_iter(|row| row[..k].iter().copied())
+        .collect()
 }
 
 fn validate_options(o: &TargetOptions) -> Result<(), TargetError> {

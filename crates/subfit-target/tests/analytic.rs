@@ -65,6 +65,58 @@ fn check_estimates(
     }
 }
 
+/// `foot_points_hinted` agrees with `foot_points` (the certified descent is exact; only exact
+/// distance ties may resolve differently, so at most 0.1 % may differ, and then within the
+/// foot-point accuracy), cold and after moving the queries slightly; the hints returned are the
+/// nearest data points; out-of-range hints are ignored.
+fn check_hinted(
+    name: &str,
+    t: &Target,
+    queries: &[[f64; 3]],
+    feet: &[subfit_target::FootPoint],
+    seed: u64,
+) {
+    let compare = |what: &str, a: &[subfit_target::FootPoint], b: &[subfit_target::FootPoint]| {
+        let differ = a.iter().zip(b).filter(|(a, b)| a != b).count();
+        assert!(
+            differ * 1000 <= a.len(),
+            "{name} {what}: {differ} of {} differ",
+            a.len()
+        );
+        for (a, b) in a.iter().zip(b) {
+            assert!(norm(sub(a.point, b.point)) <= 1e-4, "{name} {what}");
+        }
+        differ
+    };
+    let mut hints = vec![u32::MAX; queries.len()];
+    // Some hints out of range: treated as none.
+    for (q, h) in hints.iter_mut().enumerate().step_by(5) {
+        *h = (t.len() + q) as u32;
+    }
+    let cold = t.foot_points_hinted(queries, &mut hints);
+    let d0 = compare("cold", &cold, feet);
+    for (q, &h) in queries.iter().zip(&hints) {
+        let nn = t.index().nearest(q);
+        let dh = norm(sub(t.points()[h as usize], *q));
+        assert!(
+            dh <= nn.distance * (1.0 + 1e-12),
+            "{name}: hint not nearest"
+        );
+    }
+    // The fitter's case: queries moved by up to 1e-3, hints from the previous call.
+    let mut r = rng(seed + 1);
+    let moved: Vec<[f64; 3]> = queries
+        .iter()
+        .map(|q| q.map(|c| c + 1e-3 * (rand::Rng::random::<f64>(&mut r) * 2.0 - 1.0)))
+        .collect();
+    let warm = t.foot_points_hinted(&moved, &mut hints);
+    let d1 = compare("warm", &warm, &t.foot_points(&moved));
+    println!(
+        "{name}: hinted foot points differ from the kd-tree's at {d0} (cold) and {d1} (warm) of {}",
+        queries.len()
+    );
+}
+
 /// Foot points of queries `x = q + d n(q)`, `|d| ≤ 0.05` normalized (inside: also
 /// `|d| ≤ 0.5 min|ρ(q)|`), against the exact closest point.
 fn check_foot_points(name: &str, shape: &dyn Shape, pts: &[[f64; 3]], nq: usize, seed: u64) {
@@ -86,6 +138,7 @@ fn check_foot_points(name: &str, shape: &dyn Shape, pts: &[[f64; 3]], nq: usize,
         truths.push((shape.at(v), d));
     }
     let feet = t.foot_points(&queries);
+    check_hinted(name, &t, &queries, &feet, seed);
     let mut worst: f64 = 0.0;
     for (i, (f, (tr, d_true))) in feet.iter().zip(&truths).enumerate() {
         let v_true = t.to_normalized(tr.p);
