@@ -395,9 +395,10 @@ impl<'t> Fitter<'t> {
         }
     }
 
+    /// Whether every tolerance that is set holds (false when none is set).
     fn reached(&self, s: &ErrorStats) -> bool {
-        (self.options.tolerance_rms > 0.0 && s.e_rms <= self.options.tolerance_rms)
-            || (self.options.tolerance_max > 0.0 && s.e_max <= self.options.tolerance_max)
+        let (rms, max) = (self.options.tolerance_rms, self.options.tolerance_max);
+        (rms > 0.0 || max > 0.0) && (rms <= 0.0 || s.e_rms <= rms) && (max <= 0.0 || s.e_max <= max)
     }
 
     /// Fills `H` (values and its diagonal copy) at the current state; returns `g`.

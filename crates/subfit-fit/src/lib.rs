@@ -10,7 +10,9 @@
 //! * [`assemble`]: the pattern of `H`, built once per topology, filled in place in parallel;
 //! * [`solve`]: `faer` supernodal Cholesky with the symbolic analysis reused, or PCG for large
 //!   systems ([`pcg`]); [`ordering`]: fill-reducing orderings on the block graph;
-//! * [`Fitter`] / [`fit`]: the loop with step control; [`FitReport`] logs every iteration.
+//! * [`Fitter`] / [`fit`]: the loop with step control; [`FitReport`] logs every iteration;
+//! * [`fit_stages`]: multi-stage fitting — `λ` schedule, edge flips and red-green local
+//!   refinement ([`adapt`]) until a tolerance or a control-point budget.
 //!
 //! Everything is in the target's normalized units (unit cube). The library prints nothing;
 //! progress goes to an optional callback.
@@ -43,6 +45,7 @@
 //! assert_eq!(original.len(), 6);
 //! ```
 
+pub mod adapt;
 pub mod assemble;
 mod error;
 mod fitter;
@@ -52,9 +55,13 @@ pub mod pcg;
 mod report;
 pub mod smooth;
 pub mod solve;
+mod stages;
 pub mod terms;
 
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
+pub use stages::{
+    fit_stages, StageEvent, StageOptions, StageReport, StageStop, StagesReport, StagesResult,
+};

@@ -75,7 +75,7 @@ pub struct IterationRow {
 /// Why the loop stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopReason {
-    /// `E_rms ≤ tolerance_rms` or `E_max ≤ tolerance_max`.
+    /// Every tolerance set holds: `E_rms ≤ tolerance_rms` and `E_max ≤ tolerance_max`.
     Tolerance,
     /// `max_iterations` reached.
     MaxIterations,

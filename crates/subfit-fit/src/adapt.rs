@@ -1,0 +1,458 @@
+//! Adaptive changes of the control mesh between fitting stages (Cheng et al. 2004 §4.5–4.6,
+//! Cheng et al. 2007 §II-F): per-face fitting errors, local 1-to-4 refinement of the faces with
+//! large errors with red-green closure (Bank, Sherman & Weiser 1983) so that no T-vertex
+//! appears, and edge flips in high-error regions.
+//!
+//! Everything here works on triangle control meshes (Loop); the stage driver in
+//! [`crate::stages`] does not refine Catmull-Clark cages.
+
+use std::collections::HashMap;
+
+use subfit_mesh::{PolyMesh, Polygons};
+use subfit_subdiv::mask::loop_beta;
+use subfit_subdiv::SamplingOperator;
+
+/// Fitting error gathered per control face from the samples of its limit patch.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FaceError {
+    /// Sum over the face's level-`l` sub-faces of the mean squared sample error of their
+    /// corners (normalized units²).
+    pub sum_sq: f64,
+    /// Number of level-`l` sub-faces (the weight of `sum_sq`).
+    pub count: u32,
+    /// Largest sample error at a corner of one of the face's sub-faces.
+    pub max: f64,
+}
+
+impl FaceError {
+    /// Root-mean-square error over the face's sub-faces.
+    pub fn rms(&self) -> f64 {
+        if self.count == 0 {
+            0.0
+        } else {
+            (self.sum_sq / self.count as f64).sqrt()
+        }
+    }
+}
+
+/// For each face of the level-`l` mesh of `op`, the control face it descends from. Relies on
+/// the documented child order of the refinement (children of a face are consecutive; a Loop
+/// triangle has 4 children, a Catmull-Clark `n`-gon `n` at the first level and 4 after).
+pub fn face_owners(control_faces: &Polygons, op: &SamplingOperator) -> Vec<u32> {
+    let mut owners: Vec<u32> = (0..control_faces.len() as u32).collect();
+    let mut sizes: Vec<usize> = control_faces.iter().map(<[u32]>::len).collect();
+    let tri = control_faces.is_triangles();
+    for _ in 0..op.level {
+        let mut next = Vec::with_capacity(owners.len() * 4);
+        let mut next_sizes = Vec::with_capacity(owners.len() * 4);
+        for (&o, &s) in owners.iter().zip(&sizes) {
+            let children = if tri { 4 } else { s };
+            let child_size = if tri { 3 } else { 4 };
+            for _ in 0..children {
+                next.push(o);
+                next_sizes.push(child_size);
+            }
+        }
+        owners = next;
+        sizes = next_sizes;
+    }
+    debug_assert_eq!(owners.len(), op.faces.len());
+    owners
+}
+
+/// Per-control-face errors from per-sample squared errors `err2` (one per row of `op`).
+pub fn face_errors(
+    control_faces: &Polygons,
+    op: &SamplingOperator,
+    err2: &[f64],
+) -> Vec<FaceError> {
+    let owners = face_owners(control_faces, op);
+    let mut out = vec![FaceError::default(); control_faces.len()];
+    for (f, &o) in op.faces.iter().zip(&owners) {
+        let e = &mut out[o as usize];
+        let mut s = 0.0;
+        for &v in f {
+            let d2 = err2[v as usize];
+            s += d2;
+            e.max = e.max.max(d2.sqrt());
+        }
+        e.sum_sq += s / f.len() as f64;
+        e.count += 1;
+    }
+    out
+}
+
+/// What [`refine_red_green`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RefineStats {
+    /// Faces asked for (marked) and split 1-to-4.
+    pub marked: usize,
+    /// Faces split 1-to-4 in total (marked plus red closure).
+    pub red: usize,
+    /// Faces bisected to close the refinement (green).
+    pub green: usize,
+    /// Control points added (one per split edge).
+    pub new_points: usize,
+}
+
+fn key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// Splits the marked triangles 1-to-4 (Loop's split); a neighbour with two or three split
+/// edges is split 1-to-4 as well (red), one with a single split edge is bisected (green), so
+/// the result has no T-vertices (red-green refinement, Bank et al. 1983; Cheng 2004 §4.5).
+///
+/// New control points sit at Loop's edge points of the current cage (3/8, 3/8, 1/8, 1/8;
+/// midpoints on boundary edges); an interior old control point whose faces are all split moves
+/// to Loop's vertex point, so that the limit surface is unchanged where the refinement is
+/// uniform; other old points stay. Old points keep their ids, new ones are appended. Winding
+/// is preserved. Returns `None` when the cage is not all triangles.
+pub fn refine_red_green(mesh: &PolyMesh, marked: &[bool]) -> Option<(PolyMesh, RefineStats)> {
+    if !mesh.faces.is_triangles() {
+        return None;
+    }
+    let tris: Vec<[u32; 3]> = mesh.faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    // Opposite vertices of each edge (for the edge-point mask).
+    let mut opposite: HashMap<(u32, u32), Vec<u32>> = HashMap::with_capacity(tris.len() * 2);
+    for t in &tris {
+        for i in 0..3 {
+            opposite
+                .entry(key(t[i], t[(i + 1) % 3]))
+                .or_default()
+                .push(t[(i + 2) % 3]);
+        }
+    }
+    let mut red: Vec<bool> = marked.to_vec();
+    red.resize(tris.len(), false);
+    let mut split: HashMap<(u32, u32), u32> = HashMap::new();
+    // Closure: mark edges of red faces; faces with ≥ 2 split edges turn red.
+    loop {
+        for (t, _) in tris.iter().zip(&red).filter(|(_, &r)| r) {
+            for i in 0..3 {
+                split.entry(key(t[i], t[(i + 1) % 3])).or_insert(u32::MAX);
+            }
+        }
+        let mut changed = false;
+        for (t, r) in tris.iter().zip(red.iter_mut()) {
+            if *r {
+                continue;
+            }
+            let k = (0..3)
+                .filter(|&i| split.contains_key(&key(t[i], t[(i + 1) % 3])))
+                .count();
+            if k >= 2 {
+                *r = true;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    // Old points whose faces are all split 1-to-4 take Loop's vertex point, so that where the
+    // refinement is uniform the limit surface does not change at all; elsewhere they stay.
+    let nv = mesh.num_vertices();
+    let mut all_red = vec![true; nv];
+    let mut on_boundary = vec![false; nv];
+    let mut ring: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    for (t, &r) in tris.iter().zip(&red) {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            all_red[a as usize] &= r;
+            if !ring[a as usize].contains(&b) {
+                ring[a as usize].push(b);
+            }
+            if !ring[b as usize].contains(&a) {
+                ring[b as usize].push(a);
+            }
+            if opposite[&key(a, b)].len() != 2 {
+                on_boundary[a as usize] = true;
+                on_boundary[b as usize] = true;
+            }
+        }
+    }
+    let mut positions = mesh.positions.clone();
+    for v in 0..nv {
+        let n = ring[v].len();
+        if !all_red[v] || on_boundary[v] || n < 3 {
+            continue;
+        }
+        let beta = loop_beta(n);
+        let p = mesh.positions[v];
+        positions[v] = std::array::from_fn(|k| {
+            (1.0 - n as f64 * beta) * p[k]
+                + beta
+                    * ring[v]
+                        .iter()
+                        .map(|&w| mesh.positions[w as usize][k])
+                        .sum::<f64>()
+        });
+    }
+    // New points, in a deterministic order: by first appearance over faces and corners.
+    for t in &tris {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            if let Some(id) = split.get_mut(&key(a, b)) {
+                if *id == u32::MAX {
+                    *id = positions.len() as u32;
+                    let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+                    let opp = &opposite[&key(a, b)];
+                    let p = if opp.len() == 2 {
+                        let (pc, pd) = (
+                            mesh.positions[opp[0] as usize],
+                            mesh.positions[opp[1] as usize],
+                        );
+                        std::array::from_fn(|k| 0.375 * (pa[k] + pb[k]) + 0.125 * (pc[k] + pd[k]))
+                    } else {
+                        std::array::from_fn(|k| 0.5 * (pa[k] + pb[k]))
+                    };
+                    positions.push(p);
+                }
+            }
+        }
+    }
+    let mut stats = RefineStats {
+        marked: marked.iter().filter(|&&m| m).count(),
+        new_points: split.len(),
+        ..RefineStats::default()
+    };
+    let mut out = Vec::with_capacity(tris.len() + 3 * split.len());
+    for (t, &r) in tris.iter().zip(&red) {
+        let mid = |i: usize| split.get(&key(t[i], t[(i + 1) % 3])).copied();
+        if r {
+            stats.red += 1;
+            let (ab, bc, ca) = (mid(0).unwrap(), mid(1).unwrap(), mid(2).unwrap());
+            let [a, b, c] = *t;
+            out.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        } else if let Some(i) = (0..3).find(|&i| mid(i).is_some()) {
+            stats.green += 1;
+            let m = mid(i).unwrap();
+            let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
+            out.extend_from_slice(&[[a, m, c], [m, b, c]]);
+        } else {
+            out.push(*t);
+        }
+    }
+    Some((
+        PolyMesh::new(positions, Polygons::from_triangles(&out)),
+        stats,
+    ))
+}
+
+/// An interior edge `(a, b)` shared by triangles `(a, b, c)` and `(b, a, d)` that may be
+/// flipped to `(c, d)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Flip {
+    /// Index of the triangle `(a, b, c)`.
+    pub face0: u32,
+    /// Index of the triangle `(b, a, d)`.
+    pub face1: u32,
+    /// Edge ends.
+    pub a: u32,
+    /// Edge ends.
+    pub b: u32,
+    /// Opposite vertex in `face0`.
+    pub c: u32,
+    /// Opposite vertex in `face1`.
+    pub d: u32,
+}
+
+/// Interior edges of a triangle cage whose flip keeps the mesh manifold (no existing edge
+/// `(c, d)`, valences of `a` and `b` stay ≥ 4), whose two faces both score `≥ threshold`,
+/// ordered by decreasing score and chosen so that no two flips change the limit surface on a
+/// common face: a flip changes the limit only on faces incident to `a, b, c, d`, so the vertex
+/// sets are kept at least two rings apart. Then each flip can be judged on its own faces.
+pub fn independent_flips(
+    faces: &Polygons,
+    num_vertices: usize,
+    score: &[f64],
+    threshold: f64,
+) -> Vec<Flip> {
+    if !faces.is_triangles() {
+        return Vec::new();
+    }
+    let tris: Vec<[u32; 3]> = faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let mut edge_face: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3);
+    let mut valence = vec![0u32; num_vertices];
+    let mut neighbors: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
+    for (f, t) in tris.iter().enumerate() {
+        for i in 0..3 {
+            edge_face.insert((t[i], t[(i + 1) % 3]), f as u32);
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            if !neighbors[a as usize].contains(&b) {
+                neighbors[a as usize].push(b);
+                neighbors[b as usize].push(a);
+                valence[a as usize] += 1;
+                valence[b as usize] += 1;
+            }
+        }
+    }
+    let mut cands: Vec<(f64, Flip)> = Vec::new();
+    for (f, t) in tris.iter().enumerate() {
+        for i in 0..3 {
+            let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
+            if a > b {
+                continue; // each interior edge once
+            }
+            let Some(&g) = edge_face.get(&(b, a)) else {
+                continue;
+            };
+            let tg = tris[g as usize];
+            let j = (0..3).find(|&j| tg[j] == b).unwrap_or(0);
+            let d = tg[(j + 2) % 3];
+            let s = score[f].min(score[g as usize]);
+            if !(s >= threshold) || c == d || neighbors[c as usize].contains(&d) {
+                continue;
+            }
+            if valence[a as usize] <= 3 || valence[b as usize] <= 3 {
+                continue;
+            }
+            cands.push((
+                s,
+                Flip {
+                    face0: f as u32,
+                    face1: g,
+                    a,
+                    b,
+                    c,
+                    d,
+                },
+            ));
+        }
+    }
+    cands.sort_by(|x, y| y.0.total_cmp(&x.0));
+    let mut locked = vec![false; num_vertices];
+    let mut chosen = Vec::new();
+    for (_, fl) in cands {
+        let vs = [fl.a, fl.b, fl.c, fl.d];
+        if vs.iter().any(|&v| locked[v as usize]) {
+            continue;
+        }
+        for &v in &vs {
+            locked[v as usize] = true;
+            for &w in &neighbors[v as usize] {
+                locked[w as usize] = true;
+            }
+        }
+        chosen.push(fl);
+    }
+    chosen
+}
+
+/// The faces with the given flips applied: `face0` becomes `(a, d, c)` and `face1` becomes
+/// `(b, c, d)` (face ids and winding kept).
+pub fn apply_flips(faces: &Polygons, flips: &[Flip]) -> Polygons {
+    let mut tris: Vec<[u32; 3]> = faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    for fl in flips {
+        tris[fl.face0 as usize] = [fl.a, fl.d, fl.c];
+        tris[fl.face1 as usize] = [fl.b, fl.c, fl.d];
+    }
+    Polygons::from_triangles(&tris)
+}
+
+/// Faces incident to any of `vertices` (sorted, unique).
+pub fn incident_faces(faces: &Polygons, vertices: &[u32]) -> Vec<u32> {
+    faces
+        .iter()
+        .enumerate()
+        .filter(|(_, f)| f.iter().any(|v| vertices.contains(v)))
+        .map(|(i, _)| i as u32)
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subfit_mesh::shapes::octahedron_mesh;
+    use subfit_mesh::{HalfEdgeMesh, Tags};
+    use subfit_subdiv::{sampling_operator, Options, Scheme};
+
+    fn edges_unique(m: &PolyMesh) -> bool {
+        HalfEdgeMesh::from_mesh(m).is_ok()
+    }
+
+    #[test]
+    fn one_marked_face_gives_red_plus_three_green() {
+        let m = octahedron_mesh(1.0, 1.0, 1.0);
+        let mut marked = vec![false; m.faces.len()];
+        marked[0] = true;
+        let (r, s) = refine_red_green(&m, &marked).unwrap();
+        assert_eq!(s.red, 1);
+        assert_eq!(s.green, 3);
+        assert_eq!(s.new_points, 3);
+        assert_eq!(r.num_vertices(), 9);
+        assert_eq!(r.faces.len(), 8 - 4 + 4 + 6);
+        assert!(edges_unique(&r));
+        let h = HalfEdgeMesh::from_mesh(&r).unwrap();
+        assert_eq!(h.genus(), 0);
+        assert!(h.boundary_loops().is_empty());
+    }
+
+    #[test]
+    fn closure_turns_doubly_split_faces_red() {
+        let m = octahedron_mesh(1.0, 1.0, 1.0);
+        // Two faces sharing only a vertex: their common neighbours get two split edges.
+        let marked: Vec<bool> = (0..8).map(|f| f == 0 || f == 2).collect();
+        let (r, s) = refine_red_green(&m, &marked).unwrap();
+        assert!(s.red > 2, "{s:?}");
+        assert!(edges_unique(&r));
+        // Every edge of the result is shared by exactly two faces (no T-vertex).
+        assert!(HalfEdgeMesh::from_mesh(&r)
+            .unwrap()
+            .boundary_loops()
+            .is_empty());
+    }
+
+    #[test]
+    fn all_marked_is_uniform_loop_topology() {
+        let m = octahedron_mesh(1.0, 2.0, 3.0);
+        let (r, s) = refine_red_green(&m, &[true; 8]).unwrap();
+        assert_eq!((s.red, s.green, s.new_points), (8, 0, 12));
+        assert_eq!(r.faces.len(), 32);
+        // Edge points use Loop's mask: on the octahedron with axes (1, 2, 3) the point of edge
+        // (+x, +y) is 3/8 (x + y) + 1/8 (+z + −z) = 3/8 (x + y).
+        let has = r
+            .positions
+            .iter()
+            .any(|p| (p[0] - 0.375).abs() < 1e-15 && (p[1] - 0.75).abs() < 1e-15 && p[2] == 0.0);
+        assert!(has);
+        // Refining everything is one uniform Loop step: the same limit surface, exactly.
+        let opts = Options::new(Scheme::Loop);
+        let a = sampling_operator(&m.faces, 6, &Tags::new(), &opts, 2).unwrap();
+        let b = sampling_operator(&r.faces, r.num_vertices(), &Tags::new(), &opts, 1).unwrap();
+        let (pa, pb) = (
+            a.position.apply(&m.positions),
+            b.position.apply(&r.positions),
+        );
+        // The old vertices keep their ids at every level; compare their limit points.
+        for v in 0..6 {
+            for k in 0..3 {
+                assert!((pa[v][k] - pb[v][k]).abs() < 1e-12, "{v}");
+            }
+        }
+    }
+
+    #[test]
+    fn independent_flips_are_two_rings_apart_and_keep_manifold() {
+        let m = octahedron_mesh(1.0, 1.0, 1.0);
+        let (r, _) = refine_red_green(&m, &[true; 8]).unwrap();
+        let (r, _) = refine_red_green(&r, &vec![true; r.faces.len()]).unwrap();
+        let score = vec![1.0; r.faces.len()];
+        let flips = independent_flips(&r.faces, r.num_vertices(), &score, 0.5);
+        assert!(!flips.is_empty());
+        for (i, x) in flips.iter().enumerate() {
+            for y in &flips[i + 1..] {
+                let fx = incident_faces(&r.faces, &[x.a, x.b, x.c, x.d]);
+                let fy = incident_faces(&r.faces, &[y.a, y.b, y.c, y.d]);
+                assert!(fx.iter().all(|f| !fy.contains(f)));
+            }
+        }
+        let flipped = PolyMesh::new(r.positions.clone(), apply_flips(&r.faces, &flips));
+        let h = HalfEdgeMesh::from_mesh(&flipped).unwrap();
+        assert_eq!(h.genus(), 0);
+        assert!(h.boundary_loops().is_empty());
+        // Nothing scores above the threshold: no flip.
+        assert!(independent_flips(&r.faces, r.num_vertices(), &score, 2.0).is_empty());
+    }
+}
