@@ -114,34 +114,62 @@ pub struct ConvergenceArgs {
 pub struct FitArgs {
     /// The target: a point cloud or a mesh (any supported format).
     pub target: PathBuf,
-    /// Initial control mesh, in the target's coordinates (any mesh format).
+    /// Initial control mesh in the target's coordinates (any mesh format), or `auto` to build
+    /// one with the target's topology (QEM simplification of a mesh target, contouring of an
+    /// implicit surface for a point cloud).
+    #[arg(long, default_value = "auto")]
+    pub init: String,
+    /// Use only the target's points (and normals): ignore its faces, as for a scan.
     #[arg(long)]
-    pub init: PathBuf,
+    pub as_points: bool,
+    /// Control points of the automatic initial mesh [default: from the target's size,
+    /// clamp(1.5·√points, 200, 2000)].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(4..=1_000_000))]
+    pub control_points: Option<u32>,
     /// Error term: point (PDM), tangent (TDM) or squared distance (SDM), Cheng et al. 2007.
     #[arg(long, value_enum, default_value_t = MethodArg::Sdm)]
     pub method: MethodArg,
     /// Step control: none, Levenberg-Marquardt, or Armijo backtracking.
     #[arg(long, value_enum, default_value_t = StepArg::Lm)]
     pub step: StepArg,
-    /// Smoothing weight λ (dimensionless; 0 disables smoothing).
+    /// Smoothing weight λ of the first stage (dimensionless; 0 disables smoothing).
     #[arg(long, default_value_t = 1e-3)]
     pub lambda: f64,
+    /// Smallest λ: each stage multiplies λ by 0.1 down to this [default: min(1e-5, --lambda)].
+    #[arg(long)]
+    pub lambda_end: Option<f64>,
     /// Refinement level at which the limit surface is sampled.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(0..=6))]
     pub sample_level: u32,
-    /// Maximum number of iterations.
-    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    /// Iterations over all stages at most.
+    #[arg(long, default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub max_iterations: u32,
+    /// Iterations of one stage at most (a stage also ends when the error stalls).
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub stage_iterations: u32,
     /// Stop when E_rms (unit-cube units) is at most this; exit code 1 if it is not reached.
-    #[arg(long)]
-    pub tolerance: Option<f64>,
-    /// Stop when E_max (unit-cube units) is at most this; exit code 1 if it is not reached.
+    #[arg(long, default_value_t = 5e-4)]
+    pub tolerance: f64,
+    /// Also require E_max (unit-cube units) to be at most this; exit code 1 if it is not.
     #[arg(long)]
     pub max_error: Option<f64>,
+    /// Never refine the cage beyond this many control points.
+    #[arg(long, default_value_t = 5_000, value_parser = clap::value_parser!(u32).range(4..=10_000_000))]
+    pub max_control_points: u32,
+    /// Keep the initial cage's connectivity: no local refinement, no edge flips.
+    #[arg(long)]
+    pub no_refine: bool,
+    /// No edge flips between stages.
+    #[arg(long)]
+    pub no_flips: bool,
+    /// Error that maps to red in error.ply (unit-cube units) [default: the final E_max].
+    #[arg(long)]
+    pub error_scale: Option<f64>,
     /// Subdivision scheme; `auto` picks Loop for all-triangle meshes, Catmull-Clark otherwise.
     #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
     pub scheme: SchemeArg,
-    /// Output directory (control.obj, limit.ply, log.csv, report.json).
+    /// Output directory (control.obj, control.usda, limit.ply, error.ply, log.csv,
+    /// report.json).
     #[arg(short, long, default_value = "subfit-fit")]
     pub output: PathBuf,
 }

@@ -424,8 +424,16 @@ fn fit_writes_cage_limit_log_and_report() {
         let a = args(extra);
         subfit(&a.iter().map(String::as_str).collect::<Vec<_>>())
     };
-    // No tolerance asked: success.
-    let r = run(&["--lambda", "0"]);
+    // A single stage on the given cage (no refinement), a tolerance it reaches: success.
+    let r = run(&[
+        "--lambda",
+        "0",
+        "--no-refine",
+        "--tolerance",
+        "0.05",
+        "--stage-iterations",
+        "8",
+    ]);
     assert_eq!(
         r.status.code(),
         Some(0),
@@ -466,9 +474,18 @@ fn fit_writes_cage_limit_log_and_report() {
 
     // An unreachable tolerance: exit code 1, outputs still written.
     std::fs::remove_dir_all(&out).unwrap();
-    let r = run(&["--tolerance", "1e-9"]);
+    let r = run(&["--tolerance", "1e-9", "--no-refine"]);
     assert_eq!(r.status.code(), Some(1));
-    assert!(out.join("report.json").exists() && out.join("control.obj").exists());
+    for f in [
+        "report.json",
+        "control.obj",
+        "control.usda",
+        "limit.ply",
+        "error.ply",
+        "log.csv",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
 
     // Bad options: exit code 2 before any work.
     for bad in [

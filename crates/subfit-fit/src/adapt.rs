@@ -302,7 +302,7 @@ pub fn independent_flips(
             let j = (0..3).find(|&j| tg[j] == b).unwrap_or(0);
             let d = tg[(j + 2) % 3];
             let s = score[f].min(score[g as usize]);
-            if !(s >= threshold) || c == d || neighbors[c as usize].contains(&d) {
+            if s.is_nan() || s < threshold || c == d || neighbors[c as usize].contains(&d) {
                 continue;
             }
             if valence[a as usize] <= 3 || valence[b as usize] <= 3 {

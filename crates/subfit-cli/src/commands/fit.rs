@@ -9,9 +9,17 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 use serde_json::json;
-use subfit::fit::{FitOptions, FitReport, Fitter, IterationRow, Method, StepControl, StopReason};
+use std::path::PathBuf;
+
+use subfit::fit::{
+    fit_stages, FitOptions, IterationRow, Method, StageEvent, StageOptions, StageReport,
+    StagesReport, StepControl,
+};
+use subfit::init::{default_control_points, initial_control_mesh, InitOptions};
+use subfit::io::ply::VertexProperty;
+use subfit::io::usda::{UsdBoundary, UsdScheme};
 use subfit::io::{Encoding, WriteOptions};
-use subfit::mesh::{PolyMesh, Polygons, Tags};
+use subfit::mesh::{HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit::subdiv::{sampling_operator, Options, Scheme};
 use subfit::target::{Target, TargetOptions};
 
@@ -21,14 +29,25 @@ use crate::commands::subdivide::pick_scheme;
 /// Finest tessellation level tried for `limit.ply`.
 const MAX_TESSELLATION_LEVEL: usize = 6;
 /// Largest tessellation (vertices) written to `limit.ply`.
-const MAX_TESSELLATION_VERTICES: usize = 4_000_000;
+const MAX_TESSELLATION_VERTICES: usize = 1_000_000;
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     // Validate every flag before touching a file.
     if !(a.lambda.is_finite() && a.lambda >= 0.0) {
         bail!("--lambda must be a finite number ≥ 0, got {}", a.lambda);
     }
-    for (name, v) in [("--tolerance", a.tolerance), ("--max-error", a.max_error)] {
+    let lambda_end = a.lambda_end.unwrap_or(a.lambda.min(1e-5));
+    if !(lambda_end.is_finite() && lambda_end >= 0.0 && lambda_end <= a.lambda) {
+        bail!(
+            "--lambda-end must be a finite number in [0, --lambda = {}], got {lambda_end}",
+            a.lambda
+        );
+    }
+    for (name, v) in [
+        ("--tolerance", Some(a.tolerance)),
+        ("--max-error", a.max_error),
+        ("--error-scale", a.error_scale),
+    ] {
         if let Some(v) = v {
             if !(v.is_finite() && v > 0.0 && v < 1.0) {
                 bail!("{name} must be in (0, 1) (unit-cube units), got {v}");
@@ -38,28 +57,29 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     if a.output.exists() && !a.output.is_dir() {
         bail!("{}: exists and is not a directory", a.output.display());
     }
+    let init_file = (a.init != "auto").then(|| PathBuf::from(&a.init));
+    if init_file.is_some() && a.control_points.is_some() {
+        bail!("--control-points sets the size of the automatic initial mesh; it cannot be used with --init FILE");
+    }
     let (method, step) = (method_of(a.method), step_of(a.step));
 
     let t0 = Instant::now();
-    let (target_mesh, _) = crate::progress::load(&a.target)?;
-    let (control, _) = crate::progress::load(&a.init)?;
-    if control.faces.is_empty() {
-        bail!(
-            "{}: has no faces; an initial control mesh is needed",
-            a.init.display()
-        );
+    let (mut target_mesh, _) = crate::progress::load(&a.target)?;
+    if a.as_points {
+        target_mesh.faces = Polygons::new();
     }
-    let scheme = pick_scheme(a.scheme, &control);
-    let options = FitOptions {
-        scheme,
-        sample_level: a.sample_level as usize,
-        method,
-        step,
-        lambda: a.lambda,
-        max_iterations: a.max_iterations as usize,
-        tolerance_rms: a.tolerance.unwrap_or(0.0),
-        tolerance_max: a.max_error.unwrap_or(0.0),
-        ..FitOptions::default()
+    let given = match &init_file {
+        Some(path) => {
+            let (control, _) = crate::progress::load(path)?;
+            if control.faces.is_empty() {
+                bail!(
+                    "{}: has no faces; an initial control mesh is needed",
+                    path.display()
+                );
+            }
+            Some(control)
+        }
+        None => None,
     };
     let read_time = t0.elapsed();
 
@@ -68,39 +88,135 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("{}: cannot use as a target", a.target.display()))?;
     sp.finish_and_clear();
     let preprocess = target.stats().timings.total;
+    let target_topology = mesh_topology(&target_mesh)
+        .with_context(|| format!("{}: the target mesh is not usable", a.target.display()))?;
 
-    let mut points: Vec<[f64; 3]> = control
-        .positions
-        .iter()
-        .map(|&p| target.to_normalized(p))
-        .collect();
-    let t_fit = Instant::now();
-    let mut fitter = Fitter::new(
-        &target,
-        &control.faces,
-        points.len(),
-        &Tags::new(),
-        &options,
-    )
-    .with_context(|| format!("{}: cannot fit this control mesh", a.init.display()))?;
-    let bar = crate::progress::bar(options.max_iterations as u64, "fitting");
-    let mut on_iteration = |row: &IterationRow| {
-        bar.set_message(format!("fitting: E_rms {:.3e}", row.errors.e_rms));
-        bar.inc(1);
+    // The initial control mesh, in normalized units.
+    let t_init = Instant::now();
+    let (control, init_json) = match given {
+        Some(c) => {
+            let path = init_file.as_ref().expect("given implies a file");
+            let topo = mesh_topology(&c)
+                .with_context(|| format!("{}: not a usable control mesh", path.display()))?
+                .expect("a control mesh has faces");
+            if let Some(t) = &target_topology {
+                if (t.genus, t.boundary_loops) != (topo.genus, topo.boundary_loops) {
+                    bail!(
+                        "{}: the control mesh has genus {} and {} boundary loop(s), the target {} has genus {} and {} — their topologies must match",
+                        path.display(),
+                        topo.genus,
+                        topo.boundary_loops,
+                        a.target.display(),
+                        t.genus,
+                        t.boundary_loops
+                    );
+                }
+            }
+            let normalized = PolyMesh::new(
+                c.positions
+                    .iter()
+                    .map(|&p| target.to_normalized(p))
+                    .collect(),
+                c.faces.clone(),
+            );
+            let j = json!({ "file": path.display().to_string(), "genus": topo.genus,
+                "boundary_loops": topo.boundary_loops });
+            (normalized, j)
+        }
+        None => {
+            let n = a
+                .control_points
+                .map(|n| n as usize)
+                .unwrap_or_else(|| default_control_points(target.len()));
+            let sp = crate::progress::spinner("building the initial control mesh");
+            let mesh = (!target_mesh.faces.is_empty()).then_some(&target_mesh);
+            let (m, r) = initial_control_mesh(&target, mesh, n, &InitOptions::default())
+                .with_context(|| {
+                    format!(
+                        "{}: cannot build an initial control mesh",
+                        a.target.display()
+                    )
+                })?;
+            sp.finish_and_clear();
+            if !r.genus_matches {
+                eprintln!(
+                    "subfit: warning: the initial control mesh has genus {}, the target {}",
+                    r.genus_after, r.genus_target
+                );
+            }
+            let j = json!({
+                "source": format!("{:?}", r.source),
+                "requested_control_points": n,
+                "control_points": m.num_vertices(),
+                "faces": m.faces.len(),
+                "genus_target": r.genus_target,
+                "genus": r.genus_after,
+                "genus_matches": r.genus_matches,
+                "boundary_loops": { "target": r.boundary_loops.0, "cage": r.boundary_loops.1 },
+                "timings_s": { "contour": r.timings.contour.as_secs_f64(),
+                    "simplify": r.timings.simplify.as_secs_f64(), "total": r.timings.total.as_secs_f64() },
+            });
+            (m, j)
+        }
     };
-    let report = fitter
-        .run(&mut points, Some(&mut on_iteration))
+    let init_time = t_init.elapsed();
+
+    let scheme = pick_scheme(a.scheme, &control);
+    let options = FitOptions {
+        scheme,
+        sample_level: a.sample_level as usize,
+        method,
+        step,
+        ..FitOptions::default()
+    };
+    let stages = StageOptions {
+        lambda_start: a.lambda,
+        lambda_end,
+        iterations_per_stage: a.stage_iterations as usize,
+        max_iterations: a.max_iterations as usize,
+        tolerance_rms: a.tolerance,
+        tolerance_max: a.max_error.unwrap_or(0.0),
+        max_control_points: a.max_control_points as usize,
+        refine: !a.no_refine,
+        edge_flips: !(a.no_refine || a.no_flips),
+        ..StageOptions::default()
+    };
+    if !a.no_refine && scheme != Scheme::Loop {
+        eprintln!("subfit: note: local refinement is implemented for Loop cages only; this Catmull-Clark cage keeps its connectivity");
+    }
+
+    let t_fit = Instant::now();
+    let bar = crate::progress::bar(stages.max_iterations as u64, "fitting");
+    let mut on_event = |e: StageEvent<'_>| match e {
+        StageEvent::Iteration { stage, row } => {
+            bar.set_message(format!(
+                "stage {stage}: E_rms {:.3e}, E_max {:.3e}",
+                row.errors.e_rms, row.errors.e_max
+            ));
+            bar.inc(1);
+        }
+        StageEvent::Stage(_) => {}
+    };
+    let result = fit_stages(&target, &control, &options, &stages, Some(&mut on_event))
         .with_context(|| format!("{}: fitting failed", a.target.display()))?;
     bar.finish_and_clear();
     let fit_time = t_fit.elapsed();
+    let report = &result.report;
+    let fitted = &result.mesh;
+    let last = report.last;
 
-    // Outputs, in the target's original coordinates.
+    // Outputs, in the target's original coordinates; every file is written to a temporary
+    // name and renamed.
+    let t_out = Instant::now();
     std::fs::create_dir_all(&a.output)
         .with_context(|| format!("{}: cannot create directory", a.output.display()))?;
-    let last = report.last();
     let cage = PolyMesh::new(
-        points.iter().map(|&p| target.to_original(p)).collect(),
-        control.faces.clone(),
+        fitted
+            .positions
+            .iter()
+            .map(|&p| target.to_original(p))
+            .collect(),
+        fitted.faces.clone(),
     );
     let obj = WriteOptions {
         format: None,
@@ -108,7 +224,32 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
         single_precision: false,
     };
     subfit::io::write_file(&a.output.join("control.obj"), &cage, &obj)?;
-    let (limit, level, chord) = limit_tessellation(&control.faces, &points, scheme, last.e_rms)?;
+    let usd_scheme = match scheme {
+        Scheme::Loop => UsdScheme::Loop,
+        _ => UsdScheme::CatmullClark,
+    };
+    subfit::io::write_usda_file(
+        &a.output.join("control.usda"),
+        &cage,
+        &Tags::new(),
+        usd_scheme,
+        UsdBoundary::EdgeOnly,
+    )?;
+    let (limit, level, chord) =
+        limit_tessellation(&fitted.faces, &fitted.positions, scheme, last.e_rms)?;
+    // Local error of every limit vertex: its distance to the target (unit-cube units).
+    let local: Vec<f64> = target
+        .foot_points(&limit.positions)
+        .iter()
+        .zip(&limit.positions)
+        .map(|(f, p)| {
+            (0..3)
+                .map(|k| (p[k] - f.point[k]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect();
+    let scale = a.error_scale.unwrap_or(last.e_max).max(f64::MIN_POSITIVE);
     let limit = PolyMesh {
         positions: limit
             .positions
@@ -123,37 +264,69 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
         single_precision: false,
     };
     subfit::io::write_file(&a.output.join("limit.ply"), &limit, &ply)?;
-    subfit::io::write_atomic(&a.output.join("log.csv"), log_csv(&report).as_bytes())?;
-    let reached = tolerance_reached(&report, &options);
+    let to_original = target.normalization().length_to_original(1.0);
+    let error_original: Vec<f64> = local.iter().map(|e| e * to_original).collect();
+    let colored = PolyMesh {
+        colors: Some(local.iter().map(|&e| error_color(e / scale)).collect()),
+        ..limit
+    };
+    subfit::io::write_ply_with_properties(
+        &a.output.join("error.ply"),
+        &colored,
+        &[
+            VertexProperty {
+                name: "error",
+                values: &error_original,
+            },
+            VertexProperty {
+                name: "error_unit_cube",
+                values: &local,
+            },
+        ],
+        &ply,
+    )?;
+    subfit::io::write_atomic(&a.output.join("log.csv"), log_csv(report).as_bytes())?;
+    let reached = stages.reached(&last);
+    let output_time = t_out.elapsed();
     let doc = json!({
         "target": a.target.display().to_string(),
-        "init": a.init.display().to_string(),
+        "target_points": target.len(),
+        "target_topology": target_topology.map(|t| json!({"genus": t.genus, "boundary_loops": t.boundary_loops})),
+        "normalized_unit_in_original_units": to_original,
+        "bbox_diagonal_unit_cube": last.e_rms / last.e_rms_diag.max(f64::MIN_POSITIVE),
+        "init": init_json,
         "options": {
             "scheme": format!("{scheme:?}"),
             "method": format!("{method:?}").to_uppercase(),
             "step": format!("{step:?}"),
-            "lambda": options.lambda,
+            "lambda_start": stages.lambda_start,
+            "lambda_end": stages.lambda_end,
+            "lambda_factor": stages.lambda_factor,
             "sample_level": options.sample_level,
-            "max_iterations": options.max_iterations,
-            "tolerance_rms": a.tolerance,
+            "max_iterations": stages.max_iterations,
+            "stage_iterations": stages.iterations_per_stage,
+            "tolerance_rms": stages.tolerance_rms,
             "tolerance_max": a.max_error,
+            "max_control_points": stages.max_control_points,
+            "refine": stages.refine,
+            "edge_flips": stages.edge_flips,
         },
-        "target_points": target.len(),
-        "normalized_unit_in_original_units": target.normalization().length_to_original(1.0),
-        "control_points": points.len(),
-        "control_faces": control.faces.len(),
-        "samples": report.num_samples,
+        "control_points": fitted.num_vertices(),
+        "control_faces": fitted.faces.len(),
         "initial": stats_json(&report.initial),
         "final": stats_json(&last),
         "stop": format!("{:?}", report.stop),
         "tolerance_reached": reached,
-        "iterations": report.iterations.iter().map(row_json).collect::<Vec<_>>(),
+        "stages": report.stages.iter().map(stage_json).collect::<Vec<_>>(),
+        "iterations": report.stages.iter().flat_map(|s| s.fit.iterations.iter().map(move |r| row_json(s.stage, r))).collect::<Vec<_>>(),
         "limit_tessellation": { "level": level, "estimated_chordal_error": chord },
+        "error_color_scale_unit_cube": scale,
         "timings_s": {
             "read": read_time.as_secs_f64(),
             "preprocess": preprocess.as_secs_f64(),
-            "setup": report.setup.as_secs_f64(),
+            "init": init_time.as_secs_f64(),
             "fit": fit_time.as_secs_f64(),
+            "output": output_time.as_secs_f64(),
             "total": t0.elapsed().as_secs_f64(),
         },
     });
@@ -162,14 +335,17 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
     println!(
-        "{} control points, {} iterations ({:?}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (unit cube); wrote {}",
-        points.len(),
-        report.iterations.len(),
+        "{} → {} control points, {} stages, {} iterations ({:?}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (unit cube); {:.1} s; wrote {}",
+        control.num_vertices(),
+        fitted.num_vertices(),
+        report.stages.len(),
+        report.iterations(),
         report.stop,
         report.initial.e_rms,
         last.e_rms,
         report.initial.e_max,
         last.e_max,
+        t0.elapsed().as_secs_f64(),
         a.output.display()
     );
     Ok(if reached {
@@ -177,6 +353,61 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     } else {
         eprintln!("subfit: the requested tolerance was not reached (outputs written)");
         ExitCode::from(1)
+    })
+}
+
+/// Genus and boundary loops of a mesh (`None` for a point cloud).
+struct Topo {
+    genus: u32,
+    boundary_loops: usize,
+}
+
+fn mesh_topology(m: &PolyMesh) -> anyhow::Result<Option<Topo>> {
+    if m.faces.is_empty() {
+        return Ok(None);
+    }
+    let h = HalfEdgeMesh::from_mesh(m)?;
+    Ok(Some(Topo {
+        genus: h.genus(),
+        boundary_loops: h.boundary_loops().len(),
+    }))
+}
+
+/// The papers' error colours (Cheng 2007 §IV-D): blue, green, yellow, red at 0, ⅓, ⅔ and 1 of
+/// the scale, linear in between, red beyond.
+pub fn error_color(t: f64) -> [u8; 3] {
+    const STOPS: [[f64; 3]; 4] = [
+        [0.0, 0.0, 255.0],
+        [0.0, 255.0, 0.0],
+        [255.0, 255.0, 0.0],
+        [255.0, 0.0, 0.0],
+    ];
+    let x = if t.is_finite() {
+        t.clamp(0.0, 1.0) * 3.0
+    } else {
+        3.0
+    };
+    let i = (x.floor() as usize).min(2);
+    let f = x - i as f64;
+    std::array::from_fn(|k| (STOPS[i][k] + f * (STOPS[i + 1][k] - STOPS[i][k])).round() as u8)
+}
+
+fn stage_json(s: &StageReport) -> serde_json::Value {
+    json!({
+        "stage": s.stage,
+        "lambda": s.lambda,
+        "control_points": s.num_control_points,
+        "faces": s.num_faces,
+        "iterations": s.fit.iterations.len(),
+        "stop": format!("{:?}", s.fit.stop),
+        "initial": stats_json(&s.fit.initial),
+        "final": stats_json(&s.fit.last()),
+        "samples": s.fit.num_samples,
+        "setup_s": s.fit.setup.as_secs_f64(),
+        "flips_tried": s.flips_tried,
+        "flips_kept": s.flips_kept,
+        "refine": s.refine.map(|r| json!({"marked": r.marked, "red": r.red, "green": r.green, "new_points": r.new_points})),
+        "time_s": s.time.as_secs_f64(),
     })
 }
 
@@ -196,14 +427,6 @@ fn step_of(s: StepArg) -> StepControl {
     }
 }
 
-/// Whether every tolerance asked for is met by the final errors (true when none was asked).
-fn tolerance_reached(r: &FitReport, o: &FitOptions) -> bool {
-    let last = r.last();
-    (o.tolerance_rms <= 0.0 || last.e_rms <= o.tolerance_rms)
-        && (o.tolerance_max <= 0.0 || last.e_max <= o.tolerance_max)
-        || r.stop == StopReason::Tolerance
-}
-
 fn stats_json(s: &subfit::fit::ErrorStats) -> serde_json::Value {
     json!({
         "e_max": s.e_max, "e_rms": s.e_rms,
@@ -212,9 +435,9 @@ fn stats_json(s: &subfit::fit::ErrorStats) -> serde_json::Value {
     })
 }
 
-fn row_json(r: &IterationRow) -> serde_json::Value {
+fn row_json(stage: usize, r: &IterationRow) -> serde_json::Value {
     json!({
-        "iteration": r.iteration, "accepted": r.accepted, "errors": stats_json(&r.errors),
+        "stage": stage, "iteration": r.iteration, "accepted": r.accepted, "errors": stats_json(&r.errors),
         "trial_objective": r.trial_objective, "damping": r.damping, "step_length": r.step_length,
         "gain_ratio": r.gain_ratio,
         "timings_s": {
@@ -225,48 +448,61 @@ fn row_json(r: &IterationRow) -> serde_json::Value {
     })
 }
 
-/// The per-iteration table as CSV (unit-cube units; times in seconds).
-pub fn log_csv(r: &FitReport) -> String {
+/// The per-iteration table of all stages as CSV (unit-cube units; times in seconds): a row
+/// for the initial mesh (iteration 0), then one per iteration, numbered across stages.
+pub fn log_csv(r: &StagesReport) -> String {
     let mut s = String::from(
-        "iteration,accepted,e_max,e_rms,e_max_diag,e_rms_diag,objective,trial_objective,damping,step_length,gain_ratio,t_sample,t_project,t_assemble,t_solve,t_evaluate\n",
+        "stage,iteration,lambda,control_points,accepted,e_max,e_rms,e_max_diag,e_rms_diag,objective,trial_objective,damping,step_length,gain_ratio,t_sample,t_project,t_assemble,t_solve,t_evaluate\n",
     );
     let i = &r.initial;
+    let (lambda0, n0) = r
+        .stages
+        .first()
+        .map_or((0.0, 0), |s| (s.lambda, s.num_control_points));
     let _ = writeln!(
         s,
-        "0,true,{},{},{},{},{},{},,,,,,,,",
+        "0,0,{lambda0},{n0},true,{},{},{},{},{},{},,,,,,,,",
         i.e_max, i.e_rms, i.e_max_diag, i.e_rms_diag, i.objective, i.objective
     );
-    for row in &r.iterations {
-        let e = &row.errors;
-        let t = &row.timings;
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            row.iteration,
-            row.accepted,
-            e.e_max,
-            e.e_rms,
-            e.e_max_diag,
-            e.e_rms_diag,
-            e.objective,
-            row.trial_objective,
-            row.damping,
-            row.step_length,
-            row.gain_ratio,
-            t.sample.as_secs_f64(),
-            t.project.as_secs_f64(),
-            t.assemble.as_secs_f64(),
-            t.solve.as_secs_f64(),
-            t.evaluate.as_secs_f64()
-        );
+    let mut k = 0;
+    for st in &r.stages {
+        for row in &st.fit.iterations {
+            k += 1;
+            let e = &row.errors;
+            let t = &row.timings;
+            let _ = writeln!(
+                s,
+                "{},{k},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                st.stage,
+                st.lambda,
+                st.num_control_points,
+                row.accepted,
+                e.e_max,
+                e.e_rms,
+                e.e_max_diag,
+                e.e_rms_diag,
+                e.objective,
+                row.trial_objective,
+                row.damping,
+                row.step_length,
+                row.gain_ratio,
+                t.sample.as_secs_f64(),
+                t.project.as_secs_f64(),
+                t.assemble.as_secs_f64(),
+                t.solve.as_secs_f64(),
+                t.evaluate.as_secs_f64()
+            );
+        }
     }
     s
 }
 
 /// The limit surface tessellated at the coarsest level whose chordal error, estimated as the
 /// largest distance between the level-`L+1` limit point of an edge and the midpoint of the
-/// limit points of its ends, is at most a tenth of `e_rms` (or the finest level allowed).
-/// Returns the mesh (positions, limit normals, faces), the level and the estimate.
+/// limit points of its ends, is at most a tenth of `e_rms` — or the finest level with at most
+/// [`MAX_TESSELLATION_VERTICES`] vertices (up to level [`MAX_TESSELLATION_LEVEL`]).
+/// Returns the mesh (positions, limit normals, faces), the level and the estimate (NaN when
+/// the next level was not built).
 pub fn limit_tessellation(
     faces: &Polygons,
     control: &[[f64; 3]],
@@ -278,24 +514,31 @@ pub fn limit_tessellation(
     let goal = 0.1 * e_rms;
     let mut level = 1;
     let mut current = sampling_operator(faces, control.len(), &tags, &opts, level)?;
+    let mut chord = f64::NAN;
     loop {
+        // Each level has about four times the vertices of the previous one.
+        let next_too_big = current.num_vertices.saturating_mul(4) > MAX_TESSELLATION_VERTICES;
+        if next_too_big || level + 1 > MAX_TESSELLATION_LEVEL {
+            break;
+        }
         let next = sampling_operator(faces, control.len(), &tags, &opts, level + 1)?;
         let fine = next.position.apply(control);
-        let chord = chordal_estimate(&current.faces, current.num_vertices, &fine);
-        let too_big = next.num_vertices > MAX_TESSELLATION_VERTICES;
-        if chord <= goal || level + 1 > MAX_TESSELLATION_LEVEL || too_big {
-            let s = current.evaluate(control);
-            let mesh = PolyMesh {
-                positions: s.positions,
-                normals: Some(s.normals),
-                colors: None,
-                faces: current.faces,
-            };
-            return Ok((mesh, level, chord));
+        chord = chordal_estimate(&current.faces, current.num_vertices, &fine);
+        if chord <= goal {
+            break;
         }
         current = next;
         level += 1;
+        chord = f64::NAN;
     }
+    let s = current.evaluate(control);
+    let mesh = PolyMesh {
+        positions: s.positions,
+        normals: Some(s.normals),
+        colors: None,
+        faces: current.faces,
+    };
+    Ok((mesh, level, chord))
 }
 
 /// Largest `|fine[V + e] − (fine[a] + fine[b]) / 2|` over the edges `e = (a, b)` of the coarse

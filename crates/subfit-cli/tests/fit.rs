@@ -1,0 +1,173 @@
+//! `subfit fit` end to end on generated shapes: automatic initial mesh, multi-stage fitting with
+//! local refinement, every output file, exit codes and topology checks.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use subfit::io::{Encoding, WriteOptions};
+use subfit::mesh::shapes::{octahedron_mesh, torus_mesh, Shape};
+use subfit::mesh::PolyMesh;
+
+fn subfit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subfit"))
+        .args(args)
+        .output()
+        .expect("run subfit")
+}
+
+fn save(path: &Path, mesh: &PolyMesh) {
+    let opts = WriteOptions {
+        format: None,
+        encoding: Encoding::BinaryLittleEndian,
+        single_precision: false,
+    };
+    subfit::io::write_file(path, mesh, &opts).unwrap();
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn fit_without_init_refines_a_coarse_cage_until_the_tolerance() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = d.path().join("ellipsoid.ply");
+    save(&cloud, &Shape::PAPER_ELLIPSOID.sample(20_000, 0.0, 3));
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        cloud.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--control-points",
+        "20",
+        "--tolerance",
+        "0.0001",
+        "--sample-level",
+        "2",
+    ]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let rep = report(&out);
+    assert_eq!(rep["init"]["source"], "Contour");
+    assert_eq!(rep["init"]["genus"], 0);
+    assert!(rep["tolerance_reached"].as_bool().unwrap());
+    let e = rep["final"]["e_rms"].as_f64().unwrap();
+    assert!(e <= 0.0001, "{e}");
+    // 20 control points cannot reach 1e-4 on their own (λ = 1e-3 first): stages refined.
+    let stages = rep["stages"].as_array().unwrap();
+    assert!(stages.len() >= 2, "{rep}");
+    let n0 = stages[0]["control_points"].as_u64().unwrap();
+    let n1 = rep["control_points"].as_u64().unwrap();
+    assert!(n1 > n0, "{n0} -> {n1}");
+    assert!(stages[1]["lambda"].as_f64().unwrap() < stages[0]["lambda"].as_f64().unwrap());
+    // Every output, in the target's coordinates.
+    let info = |f: &str| -> serde_json::Value {
+        serde_json::from_slice(&subfit(&["info", "--json", out.join(f).to_str().unwrap()]).stdout)
+            .unwrap()
+    };
+    let cage = info("control.obj");
+    assert_eq!(cage["vertices"].as_u64().unwrap(), n1);
+    assert_eq!(cage["topology"]["genus"], 0);
+    let limit = info("limit.ply");
+    assert_eq!(limit["normals"], true);
+    let z = limit["bbox"]["max"][2].as_f64().unwrap();
+    assert!((z - 1.0).abs() < 0.01, "{z}");
+    let err = info("error.ply");
+    assert_eq!(err["colors"], true);
+    let header =
+        String::from_utf8_lossy(&std::fs::read(out.join("error.ply")).unwrap()[..700]).to_string();
+    assert!(header.contains("property double error\n"), "{header}");
+    let usda = std::fs::read_to_string(out.join("control.usda")).unwrap();
+    assert!(
+        usda.contains("uniform token subdivisionScheme = \"loop\""),
+        "{usda}"
+    );
+    let csv = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    let iterations: u64 = stages
+        .iter()
+        .map(|s| s["iterations"].as_u64().unwrap())
+        .sum();
+    assert_eq!(csv.lines().count() as u64, iterations + 2);
+}
+
+#[test]
+fn a_cage_of_the_wrong_topology_is_rejected_before_fitting() {
+    let d = tempfile::tempdir().unwrap();
+    let torus = d.path().join("torus.ply");
+    save(&torus, &torus_mesh(0.35, 0.15, 48, 24, true));
+    let octa = d.path().join("octa.ply");
+    save(&octa, &octahedron_mesh(0.5, 0.5, 0.15));
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        torus.to_str().unwrap(),
+        "--init",
+        octa.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&r.stderr);
+    assert!(msg.contains("genus 0") && msg.contains("genus 1"), "{msg}");
+    assert!(!out.join("control.obj").exists());
+    // --control-points belongs to the automatic initial mesh.
+    let r = subfit(&[
+        "fit",
+        torus.to_str().unwrap(),
+        "--init",
+        octa.to_str().unwrap(),
+        "--control-points",
+        "50",
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    // λ_end above λ.
+    let r = subfit(&[
+        "fit",
+        torus.to_str().unwrap(),
+        "--lambda",
+        "1e-4",
+        "--lambda-end",
+        "1e-3",
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+}
+
+#[test]
+fn a_torus_mesh_keeps_its_genus_through_refinement() {
+    let d = tempfile::tempdir().unwrap();
+    let torus = d.path().join("torus.ply");
+    save(&torus, &torus_mesh(0.35, 0.15, 96, 48, true));
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        torus.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--control-points",
+        "60",
+        "--tolerance",
+        "0.0015",
+        "--sample-level",
+        "2",
+    ]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let rep = report(&out);
+    assert_eq!(rep["init"]["source"], "Mesh");
+    assert_eq!(rep["target_topology"]["genus"], 1);
+    let cage: serde_json::Value = serde_json::from_slice(
+        &subfit(&["info", "--json", out.join("control.obj").to_str().unwrap()]).stdout,
+    )
+    .unwrap();
+    assert_eq!(cage["topology"]["genus"], 1, "{cage}");
+    assert_eq!(cage["topology"]["boundary_loops"], 0, "{cage}");
+}
