@@ -15,7 +15,7 @@
 //! (comma-separated control-point counts, default `1000,10000`), `SUBFIT_ITERS` (default 3),
 //! `SUBFIT_SAMPLE_LEVEL` (default 3), `SUBFIT_LAMBDA` (default 1e-3), `SUBFIT_SOLVER`
 //! (`auto`, `cholesky` or `pcg`; default `auto`), `SUBFIT_ORDERING` (`scalar-amd`,
-//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-3). CPU time is the process's user + system time
+//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-2). CPU time is the process's user + system time
 //! from `/proc/self/stat` (Linux only; 0 elsewhere).
 #![allow(clippy::print_stdout)]
 
@@ -67,7 +67,7 @@ fn main() {
     let iters = env("SUBFIT_ITERS", 3usize);
     let level = env("SUBFIT_SAMPLE_LEVEL", 3usize);
     let lambda = env("SUBFIT_LAMBDA", 1e-3f64);
-    let pcg_tol = env("SUBFIT_PCG_TOL", 1e-3f64);
+    let pcg_tol = env("SUBFIT_PCG_TOL", 1e-2f64);
     let solver = match std::env::var("SUBFIT_SOLVER").as_deref() {
         Ok("cholesky") => LinearSolver::Cholesky,
         Ok("pcg") => LinearSolver::Pcg,

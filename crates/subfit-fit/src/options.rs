@@ -143,7 +143,9 @@ pub struct FitOptions {
     /// [`LinearSolver::Auto`] switches to PCG at this many control points. Default 4000.
     pub pcg_min_points: usize,
     /// PCG stops when `‖r‖ ≤ pcg_tolerance · ‖g‖` (relative residual, dimensionless).
-    /// Default `1e-3`.
+    /// Default `1e-2`: on Igea at 10k control points the per-iteration errors match those
+    /// with `1e-3` to three digits at half the PCG iterations (the LM gain ratio stays exact
+    /// for any tolerance, see [`crate::pcg`]).
     pub pcg_tolerance: f64,
     /// PCG iteration cap per solve. Default 500.
     pub pcg_max_iterations: usize,
@@ -169,7 +171,7 @@ impl Default for FitOptions {
             linear_solver: LinearSolver::Auto,
             fill_ordering: FillOrdering::BlockAmd,
             pcg_min_points: 4000,
-            pcg_tolerance: 1e-3,
+            pcg_tolerance: 1e-2,
             pcg_max_iterations: 500,
         }
     }
