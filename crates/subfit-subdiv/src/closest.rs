@@ -15,8 +15,12 @@
 //! between `r` and the normal, i.e. the gradient of the squared distance projected on the tangent
 //! plane, relative to the distance — and the search stops below `tolerance` (default 1e-10), or
 //! when `|r|` is below 1e-14 of the mesh size (the query is on the surface). At a mesh boundary
-//! the closest point may be on the boundary curve, where this residual need not vanish: the search
-//! then stops when no step along the boundary decreases `F` and reports `converged = false`.
+//! the closest point may be on the boundary curve, where this residual need not vanish: there the
+//! domain constraint is active (moving into the surface does not decrease `F`), the Newton step
+//! is restricted to the boundary edge (a projected Newton step, 1-D along the edge), and the
+//! residual counts only the gradient along the boundary (`|r·S_t| / (|r| |S_t|)` with `S_t` the
+//! derivative along the edge); at a boundary corner with both constraints active it is 0. So
+//! queries whose closest point is on the boundary converge too.
 
 use crate::bvh::TriangleBvh;
 use crate::eval::{EvalError, EvalKind, Evaluator, SurfaceParam, SurfacePoint};
@@ -245,7 +249,7 @@ impl<'a> ClosestPointFinder<'a> {
         let mut iterations = 0;
         let mut came_from: Option<u32> = None;
         let mut f_at_cross = f64::INFINITY;
-        let mut residual = self.residual(&s, q);
+        let mut residual = self.residual(p, &s, q);
         while iterations < self.opts.max_iterations {
             if residual <= self.opts.tolerance {
                 break;
@@ -255,7 +259,9 @@ impl<'a> ClosestPointFinder<'a> {
             // vertex): try the corner itself, where the limit masks give the exact normal.
             if let Some((c, cs)) = self.corner_candidate(p)? {
                 let cf = half_norm2(sub(cs.position, q));
-                let cres = self.residual(&cs, q);
+                // The exact corner's tangents come from limit masks, not the parametrisation:
+                // only the unconstrained residual is meaningful there.
+                let cres = self.free_residual(&cs, q);
                 if cf <= f * (1.0 + 1e-13) && cres <= self.opts.tolerance {
                     p = c;
                     s = cs;
@@ -274,6 +280,7 @@ impl<'a> ClosestPointFinder<'a> {
                 h[1][0] += dot(suv, r);
                 h[1][1] += dot(svv, r);
             }
+            let boundary = self.mesh_boundary_edges(p);
             let mut accepted = false;
             for _ in 0..30 {
                 let a = [
@@ -281,14 +288,34 @@ impl<'a> ClosestPointFinder<'a> {
                     [h[1][0], h[1][1] + mu * jtj[1]],
                 ];
                 let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-                if !(a[0][0] > 0.0 && det > 0.0) {
-                    mu = (mu * 10.0).max(1e-3);
-                    continue;
-                }
-                let d = [
-                    -(a[1][1] * g[0] - a[0][1] * g[1]) / det,
-                    -(-a[1][0] * g[0] + a[0][0] * g[1]) / det,
-                ];
+                let free = (a[0][0] > 0.0 && det > 0.0).then(|| {
+                    [
+                        -(a[1][1] * g[0] - a[0][1] * g[1]) / det,
+                        -(-a[1][0] * g[0] + a[0][0] * g[1]) / det,
+                    ]
+                });
+                // On a mesh boundary where the constraint is active (moving into the surface
+                // does not decrease F, or the Newton step points out of it): Newton along the
+                // boundary edge only, which needs only positive curvature along the edge.
+                let inward =
+                    |b: &&BoundaryEdge, x: [f64; 2]| b.inward[0] * x[0] + b.inward[1] * x[1];
+                let active = boundary
+                    .iter()
+                    .find(|b| inward(b, g) >= 0.0 || free.is_some_and(|d| inward(b, d) < 0.0));
+                let d = match (active, free) {
+                    (Some(b), _) => match b.restricted_step(g, a) {
+                        Some(d) => d,
+                        None => {
+                            mu = (mu * 10.0).max(1e-3);
+                            continue;
+                        }
+                    },
+                    (None, Some(d)) => d,
+                    (None, None) => {
+                        mu = (mu * 10.0).max(1e-3);
+                        continue;
+                    }
+                };
                 let (mut cand, mut exit) = self.clip(p, d);
                 if let Some(e) = exit {
                     // On the edge and pointing back into the patch just left: the minimum is on
@@ -304,7 +331,7 @@ impl<'a> ClosestPointFinder<'a> {
                 let cf = half_norm2(sub(cs.position, q));
                 // Near convergence F changes below its rounding: then accept a step that lowers
                 // the residual without raising F beyond rounding.
-                let flat = cf <= f * (1.0 + 1e-13) && self.residual(&cs, q) < residual;
+                let flat = cf <= f * (1.0 + 1e-13) && self.residual(cand, &cs, q) < residual;
                 if cf < f || flat || (cf <= f && exit.is_some()) {
                     let progressed = cf < f || flat;
                     p = cand;
@@ -331,7 +358,7 @@ impl<'a> ClosestPointFinder<'a> {
                 }
                 mu = (mu * 10.0).max(1e-3);
             }
-            residual = self.residual(&s, q);
+            residual = self.residual(p, &s, q);
             if !accepted {
                 break;
             }
@@ -375,7 +402,45 @@ impl<'a> ClosestPointFinder<'a> {
         Ok(None)
     }
 
-    fn residual(&self, s: &SurfacePoint, q: [f64; 3]) -> f64 {
+    /// The convergence measure at `p` (module docs): the tangential part of `r = S − q`
+    /// relative to `|r|`; on a mesh boundary where moving into the surface would not decrease
+    /// the distance (the constraint is active), only the part along the boundary counts, and at
+    /// a boundary corner with both constraints active it is 0 (the KKT conditions hold).
+    fn residual(&self, p: SurfaceParam, s: &SurfacePoint, q: [f64; 3]) -> f64 {
+        let free = self.free_residual(s, q);
+        if free == 0.0 {
+            return 0.0;
+        }
+        let r = sub(s.position, q);
+        let len = dot(r, r).sqrt();
+        let g = [dot(s.du, r), dot(s.dv, r)];
+        let active: Vec<BoundaryEdge> = self
+            .mesh_boundary_edges(p)
+            .into_iter()
+            .filter(|b| b.inward[0] * g[0] + b.inward[1] * g[1] >= 0.0)
+            .collect();
+        match active.as_slice() {
+            [] => free,
+            [b] => {
+                let st = [
+                    b.tangent[0] * s.du[0] + b.tangent[1] * s.dv[0],
+                    b.tangent[0] * s.du[1] + b.tangent[1] * s.dv[1],
+                    b.tangent[0] * s.du[2] + b.tangent[1] * s.dv[2],
+                ];
+                let sl = dot(st, st).sqrt();
+                if sl > 0.0 {
+                    (dot(st, r).abs() / (sl * len)).min(free)
+                } else {
+                    free
+                }
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// The tangential part of `r = S − q` relative to `|r|` (0 when `|r|` is below 1e-14 of the
+    /// mesh size).
+    fn free_residual(&self, s: &SurfacePoint, q: [f64; 3]) -> f64 {
         let r = sub(s.position, q);
         let len = dot(r, r).sqrt();
         if len <= 1e-14 * self.scale {
@@ -388,6 +453,33 @@ impl<'a> ClosestPointFinder<'a> {
             r[2] - rn * s.normal[2],
         ];
         dot(t, t).sqrt() / len
+    }
+
+    /// The edges of `p`'s patch that `p` lies on (within 1e-14 in parameters) and that are on
+    /// the boundary of the surface (no patch across).
+    fn mesh_boundary_edges(&self, p: SurfaceParam) -> Vec<BoundaryEdge> {
+        const ON: f64 = 1e-14;
+        let s2 = std::f64::consts::FRAC_1_SQRT_2;
+        // (distance to the edge, inward normal, unit tangent, edge id)
+        let cands: &[(f64, [f64; 2], [f64; 2], u8)] = if self.ev.triangular() {
+            &[
+                (p.v, [0.0, 1.0], [1.0, 0.0], 0),
+                (1.0 - p.u - p.v, [-1.0, -1.0], [-s2, s2], 1),
+                (p.u, [1.0, 0.0], [0.0, 1.0], 2),
+            ]
+        } else {
+            &[
+                (p.v, [0.0, 1.0], [1.0, 0.0], 0),
+                (1.0 - p.u, [-1.0, 0.0], [0.0, 1.0], 1),
+                (1.0 - p.v, [0.0, -1.0], [1.0, 0.0], 2),
+                (p.u, [1.0, 0.0], [0.0, 1.0], 3),
+            ]
+        };
+        cands
+            .iter()
+            .filter(|c| c.0 <= ON && self.cross(p, c.3).is_none())
+            .map(|&(_, inward, tangent, _)| BoundaryEdge { inward, tangent })
+            .collect()
     }
 
     /// The point `p + d` clipped to the patch domain, and the patch edge where it was clipped.
@@ -459,6 +551,39 @@ impl<'a> ClosestPointFinder<'a> {
         let (u, v) = edge_point(tri, other.edge, s2);
         let (face, sub) = self.ev.patch(other.patch as usize);
         Some((SurfaceParam { face, sub, u, v }, pi))
+    }
+}
+
+/// A patch edge on the boundary of the surface, in parameter space.
+#[derive(Clone, Copy, Debug)]
+struct BoundaryEdge {
+    /// Normal pointing into the patch domain.
+    inward: [f64; 2],
+    /// Unit direction along the edge.
+    tangent: [f64; 2],
+}
+
+impl BoundaryEdge {
+    /// The (damped) Newton step restricted to the edge: `−(g·t)/(tᵀAt) t` for gradient `g`
+    /// and the damped Hessian `a`; `None` when the curvature along the edge is not positive
+    /// (then damping grows and the step is retried).
+    fn restricted_step(&self, g: [f64; 2], a: [[f64; 2]; 2]) -> Option<[f64; 2]> {
+        let t = self.tangent;
+        let gt = g[0] * t[0] + g[1] * t[1];
+        let ht =
+            t[0] * (a[0][0] * t[0] + a[0][1] * t[1]) + t[1] * (a[1][0] * t[0] + a[1][1] * t[1]);
+        if ht.is_nan() || ht <= 0.0 {
+            return None;
+        }
+        let x = -gt / ht;
+        // Exactly along the edge (no round-off component across it).
+        Some(if t[0] == 0.0 {
+            [0.0, x * t[1]]
+        } else if t[1] == 0.0 {
+            [x * t[0], 0.0]
+        } else {
+            [x * t[0], -x * t[0]]
+        })
     }
 }
 

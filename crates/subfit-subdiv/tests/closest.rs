@@ -140,3 +140,98 @@ fn extraordinary_vertices_and_ngons() {
     let o = subfit_mesh::shapes::octahedron_mesh(1.0, 0.7, 1.3);
     check("loop octahedron", Scheme::Loop, &o.positions, &o.faces, 300);
 }
+
+/// An open `n × n` grid patch over `[0, n]²` with a smooth height field: quads, or each quad
+/// split into two triangles.
+fn open_grid(n: u32, tris: bool) -> (Vec<[f64; 3]>, Polygons) {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64, j as f64);
+            p.push([x, y, 0.4 * (0.9 * x).sin() * (0.7 * y).cos()]);
+        }
+    }
+    let id = |i: u32, j: u32| j * (n + 1) + i;
+    let mut f = Polygons::new();
+    for j in 0..n {
+        for i in 0..n {
+            let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+            if tris {
+                f.push(&[q[0], q[1], q[2]]);
+                f.push(&[q[0], q[2], q[3]]);
+            } else {
+                f.push(&q);
+            }
+        }
+    }
+    (p, f)
+}
+
+/// Queries beside an open grid (outside its boundary, and beyond its corners) have their
+/// closest points on the boundary curve of the limit surface: the search converges there (the
+/// residual projected on the boundary reaches the tolerance) and agrees with dense sampling.
+#[test]
+fn open_grid_boundary_closest_points_converge() {
+    for (name, scheme, tris) in [
+        ("cc open grid", Scheme::CatmullClark, false),
+        ("loop open grid", Scheme::Loop, true),
+    ] {
+        let (p, f) = open_grid(4, tris);
+        let ev = Evaluator::new(&f, p.len(), &Tags::new(), &Options::new(scheme)).unwrap();
+        let finder = ClosestPointFinder::new(&ev, &p, ClosestOptions::default()).unwrap();
+        let dense = dense_samples(&ev, &p, 48);
+        let mut rng = Rng(7);
+        let mut on_boundary = 0;
+        for k in 0..120 {
+            // Beside one of the four sides (k % 4) or beyond a corner (every 5th query).
+            let t = 0.2 + 3.6 * rng.f();
+            let out = 0.3 + 1.5 * rng.f();
+            let z = 1.0 * rng.f() - 0.5;
+            let q = if k % 5 == 4 {
+                let c = [(k / 5) % 2, (k / 10) % 2].map(|b| if b == 0 { -out } else { 4.0 + out });
+                [c[0], c[1], z]
+            } else {
+                match k % 4 {
+                    0 => [t, -out, z],
+                    1 => [4.0 + out, t, z],
+                    2 => [t, 4.0 + out, z],
+                    _ => [-out, t, z],
+                }
+            };
+            let c = finder.closest(q).unwrap();
+            assert!(
+                c.converged,
+                "{name}: query {q:?}: residual {} after {} iterations at {:?}",
+                c.residual, c.iterations, c.param
+            );
+            let bf = dense
+                .iter()
+                .map(|x| {
+                    ((x[0] - q[0]).powi(2) + (x[1] - q[1]).powi(2) + (x[2] - q[2]).powi(2)).sqrt()
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                c.distance <= bf + 1e-12,
+                "{name}: {q:?}: {} > {bf} at {:?} after {} iterations",
+                c.distance,
+                c.param,
+                c.iterations
+            );
+            assert!(
+                bf - c.distance < 2e-3,
+                "{name}: sampling gap {}",
+                bf - c.distance
+            );
+            let (u, v) = (c.param.u, c.param.v);
+            let on_edge = [u, v, 1.0 - u, 1.0 - v, 1.0 - u - v]
+                .iter()
+                .any(|x| x.abs() < 1e-12);
+            on_boundary += usize::from(on_edge);
+        }
+        // The queries do exercise the boundary case.
+        assert!(
+            on_boundary >= 100,
+            "{name}: only {on_boundary} boundary foot points"
+        );
+    }
+}
