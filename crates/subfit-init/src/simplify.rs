@@ -209,28 +209,38 @@ fn q_minimizer(q: &Quadric) -> Option<[f64; 3]> {
     p.iter().all(|x| x.is_finite()).then_some(p)
 }
 
+/// A queued collapse (24 bytes: the heap's sift-down dominated the run time with the position
+/// stored too, so the position is recomputed when the entry is popped and still valid).
 #[derive(Clone, Copy, Debug)]
-struct Candidate {
+struct Entry {
     cost: f64,
     keep: u32,
     remove: u32,
     stamp_keep: u32,
     stamp_remove: u32,
+}
+
+/// A collapse about to be checked or performed.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    cost: f64,
+    keep: u32,
+    remove: u32,
     pos: [f64; 3],
 }
 
-impl PartialEq for Candidate {
+impl PartialEq for Entry {
     fn eq(&self, other: &Self) -> bool {
         self.cmp(other) == Ordering::Equal
     }
 }
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
+impl Eq for Entry {}
+impl PartialOrd for Entry {
     fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
         Some(self.cmp(other))
     }
 }
-impl Ord for Candidate {
+impl Ord for Entry {
     /// Reversed, so that `BinaryHeap` pops the cheapest; ties broken by vertex ids.
     fn cmp(&self, other: &Self) -> Ordering {
         other
@@ -262,7 +272,7 @@ struct Collapser {
     /// Whether a collapse of an edge at this vertex was rejected since its edges were last queued.
     dirty: Vec<bool>,
     alive_vertices: usize,
-    heap: BinaryHeap<Candidate>,
+    heap: BinaryHeap<Entry>,
     min_cos: f64,
     min_quality: f64,
     min_area2: f64,
@@ -379,6 +389,20 @@ impl Collapser {
             (a, b)
         };
         let (ki, ri) = (keep as usize, remove as usize);
+        let (cost, _) = self.plan(ki, ri);
+        self.heap.push(Entry {
+            cost,
+            keep,
+            remove,
+            stamp_keep: self.stamp[ki],
+            stamp_remove: self.stamp[ri],
+        });
+    }
+
+    /// Cost and position of the collapse `remove → keep`: the quadric minimizer (near the
+    /// edge), else the best of the endpoints and the midpoint; the boundary endpoint when only
+    /// one is on the boundary.
+    fn plan(&self, ki: usize, ri: usize) -> (f64, [f64; 3]) {
         let mut q = self.quad[ki];
         add_q(&mut q, &self.quad[ri]);
         let pos = if self.boundary[ki] != self.boundary[ri] {
@@ -395,15 +419,7 @@ impl Collapser {
                     .unwrap_or(mid),
             }
         };
-        let cost = eval_q(&q, pos).max(0.0);
-        self.heap.push(Candidate {
-            cost,
-            keep,
-            remove,
-            stamp_keep: self.stamp[ki],
-            stamp_remove: self.stamp[ri],
-            pos,
-        });
+        (eval_q(&q, pos).max(0.0), pos)
     }
 
     /// Relaxes the geometric checks and re-queues the edges of every vertex that had a
@@ -428,16 +444,22 @@ impl Collapser {
 
     fn run(&mut self, target: usize) {
         while self.alive_vertices > target {
-            let Some(c) = self.heap.pop() else { break };
-            let (k, r) = (c.keep as usize, c.remove as usize);
-            if self.stamp[k] != c.stamp_keep
-                || self.stamp[r] != c.stamp_remove
+            let Some(e) = self.heap.pop() else { break };
+            let (k, r) = (e.keep as usize, e.remove as usize);
+            if self.stamp[k] != e.stamp_keep
+                || self.stamp[r] != e.stamp_remove
                 || self.vfaces[k].is_empty()
                 || self.vfaces[r].is_empty()
             {
                 continue;
             }
-            let mut c = c;
+            let (cost, pos) = self.plan(k, r);
+            let mut c = Candidate {
+                cost,
+                keep: e.keep,
+                remove: e.remove,
+                pos,
+            };
             let mut verdict = self.check(c.keep, c.remove, c.pos);
             if self.report.relaxations > 0
                 && matches!(verdict, Verdict::Flip | Verdict::Degenerate)
