@@ -112,6 +112,13 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     let write_time = t.elapsed();
 
     print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
+    if let Some(r) = report.carve_radius {
+        println!(
+            "note: the implicit surface missed genus {}; used the space-carving fallback \
+             (normals ignored, radius {r:.4} unit cube; the cage sits about that far outside)",
+            report.genus_target
+        );
+    }
     println!(
         "time: read {:.3} s, target {:.3} s, contour {:.3} s, simplify {:.3} s, write {:.3} s, total {:.3} s",
         read_time.as_secs_f64(),
@@ -182,13 +189,20 @@ fn print_summary(
             r.simplify.vertices_before, r.simplify.faces_before
         ),
     }
+    let versus = if r.source == InitSource::Contour && input.is_none() && a.genus.is_none() {
+        "target genus unknown (a point cloud: pass --genus G to check it)".to_owned()
+    } else {
+        format!(
+            "target genus {} ({})",
+            r.genus_target,
+            if r.genus_matches { "same" } else { "DIFFERENT" }
+        )
+    };
     println!(
-        "cage: {} vertices ({requested} requested), {} faces, {}, {} component(s); target genus {} ({})",
+        "cage: {} vertices ({requested} requested), {} faces, {}, {} component(s); {versus}",
         out.num_vertices(),
         out.num_faces(),
         topo(Some(r.genus_after), r.boundary_loops.1),
         r.components,
-        r.genus_target,
-        if r.genus_matches { "same" } else { "DIFFERENT" }
     );
 }
