@@ -6,6 +6,8 @@
 //! * [`contour`](mod@contour): a point cloud's IMLS function (Xie et al. 2023 eq. 2–3) sampled on a grid and
 //!   contoured by marching tetrahedra (the ambiguity-free variant of Lorensen & Cline 1987), which
 //!   always yields a closed, manifold, consistently oriented surface.
+//! * [`carve`](mod@carve): a normal-free wrap of a point cloud (space carving with a ball), the
+//!   fallback when the IMLS contour misses an expected genus (e.g. badly oriented normals).
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
 //!   contoured then simplified; the genus is checked against the target's and reported.
 //!
