@@ -44,6 +44,7 @@ use crate::patch::{bicubic_bspline, loop_box_spline};
 use crate::scheme::{Options, Scheme};
 use crate::topology::Topology;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use subfit_mesh::{Polygons, Tags};
 
@@ -341,6 +342,12 @@ impl PatchCoef {
 /// Construction validates the mesh, classifies every patch and caches the control points of the
 /// patches that are regular at level 0 (the common case). Cost O(#F · s) with `s` the size of a
 /// two-ring (parallel); memory about 16–20 weights per cached patch point.
+///
+/// Memory after construction: evaluations memoise the local refinements of irregular patches
+/// (up to [`CACHE_DEPTH`] levels, tens of kB per patch evaluated near an irregular vertex),
+/// within a budget ([`Self::set_cache_budget`], default [`DEFAULT_CACHE_BYTES`]); past it,
+/// evaluation stays exact but is not memoised. [`Self::cache_bytes`] reports the memoised
+/// amount and [`Self::clear_cache`] drops it.
 #[derive(Clone, Debug)]
 pub struct Evaluator {
     options: Options,
@@ -356,6 +363,38 @@ pub struct Evaluator {
     /// Memoised local-refinement tree of each patch (built on first use; regular level-0
     /// patches at construction).
     roots: Vec<OnceLock<Node>>,
+    /// Bytes held by nodes memoised after construction, and the budget they may use.
+    memo: MemoBudget,
+}
+
+/// Default budget of the memoised local refinements of an [`Evaluator`]: 256 MiB.
+pub const DEFAULT_CACHE_BYTES: usize = 256 << 20;
+
+/// Heap bytes held by memoised nodes (approximate: array payloads only), and the budget beyond
+/// which no more nodes are memoised.
+#[derive(Debug)]
+struct MemoBudget {
+    used: AtomicUsize,
+    budget: usize,
+}
+
+impl Clone for MemoBudget {
+    fn clone(&self) -> Self {
+        Self {
+            used: AtomicUsize::new(self.used.load(Ordering::Relaxed)),
+            budget: self.budget,
+        }
+    }
+}
+
+impl MemoBudget {
+    fn full(&self) -> bool {
+        self.used.load(Ordering::Relaxed) >= self.budget
+    }
+
+    fn add(&self, node: &Node) {
+        self.used.fetch_add(node.heap_bytes(), Ordering::Relaxed);
+    }
 }
 
 /// Local refinement levels whose results are memoised per patch: evaluations reuse the refined
@@ -376,6 +415,25 @@ enum Node {
     },
     /// Local refinement failed (a broken invariant, reported as [`EvalError::Incomplete`]).
     Failed,
+}
+
+impl Node {
+    /// Approximate heap bytes of this node (not of its children).
+    fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        match self {
+            Node::Regular(pc) => pc.cols.len() * 4 + pc.coef.len() * 8,
+            Node::Irregular { mesh, .. } => {
+                mesh.cols.len() * 4
+                    + mesh.rows.len() * 8
+                    + (mesh.fo.len() + mesh.fv.len() + mesh.nfaces.len()) * 4
+                    + mesh.fe.len()
+                    + mesh.corner.len()
+                    + size_of::<[OnceLock<Node>; 4]>()
+            }
+            Node::Failed => 0,
+        }
+    }
 }
 
 impl Evaluator {
@@ -449,6 +507,10 @@ impl Evaluator {
             corner,
             patch_start,
             roots: Vec::new(),
+            memo: MemoBudget {
+                used: AtomicUsize::new(0),
+                budget: DEFAULT_CACHE_BYTES,
+            },
         };
         let regular: Vec<Option<PatchCoef>> = (0..nf)
             .into_par_iter()
@@ -479,6 +541,49 @@ impl Evaluator {
         }
         ev.roots = roots;
         Ok(ev)
+    }
+
+    /// Sets the memory budget (bytes) of the local refinements memoised by [`Self::weights`]
+    /// (default [`DEFAULT_CACHE_BYTES`]). Once the memoised nodes hold this much, further
+    /// evaluations still work and give the same results (to round-off), but refine from the
+    /// deepest memoised node each time instead of memoising more; 0 turns memoisation off.
+    /// The budget is checked before each node is added, so concurrent evaluations may exceed it
+    /// by one node (tens of kB) per thread. Does not drop what is already memoised (see
+    /// [`Self::clear_cache`]).
+    pub fn set_cache_budget(&mut self, bytes: usize) {
+        self.memo.budget = bytes;
+    }
+
+    /// Builder-style [`Self::set_cache_budget`].
+    pub fn with_cache_budget(mut self, bytes: usize) -> Self {
+        self.set_cache_budget(bytes);
+        self
+    }
+
+    /// The memory budget of memoised local refinements, in bytes.
+    pub fn cache_budget(&self) -> usize {
+        self.memo.budget
+    }
+
+    /// Approximate heap bytes held by local refinements memoised since construction (array
+    /// payloads; the regular level-0 patches built by [`Self::new`] are not counted).
+    pub fn cache_bytes(&self) -> usize {
+        self.memo.used.load(Ordering::Relaxed)
+    }
+
+    /// Drops every memoised local refinement (keeping the regular level-0 patches built by
+    /// [`Self::new`]). Cost O(#patches).
+    pub fn clear_cache(&mut self) {
+        for (pi, cell) in self.roots.iter_mut().enumerate() {
+            let keep = matches!(cell.get(), Some(Node::Regular(_))) && {
+                let f = self.patch_start.partition_point(|&s| s as usize <= pi) - 1;
+                self.patch_start[f + 1] - self.patch_start[f] == 1
+            };
+            if !keep {
+                *cell = OnceLock::new();
+            }
+        }
+        *self.memo.used.get_mut() = 0;
     }
 
     /// The options (scheme, boundary rule).
@@ -651,8 +756,20 @@ impl Evaluator {
             depth,
         };
         let root_depth = u32::from(self.num_subpatches(p.face) > 1);
-        let mut node = self.roots[self.patch_index(p.face, p.sub)]
-            .get_or_init(|| self.root_node(p.face, p.sub));
+        let cell = &self.roots[self.patch_index(p.face, p.sub)];
+        let owned;
+        let mut node = match cell.get() {
+            Some(n) => n,
+            None if self.memo.full() => {
+                owned = self.root_node(p.face, p.sub);
+                &owned
+            }
+            None => cell.get_or_init(|| {
+                let n = self.root_node(p.face, p.sub);
+                self.memo.add(&n);
+                n
+            }),
+        };
         let mut a = [[1.0, 0.0], [0.0, 1.0]];
         let mut depth = root_depth;
         loop {
@@ -665,10 +782,17 @@ impl Evaluator {
                     }
                     let ch = children(mesh, scheme, *t);
                     let which = best_child(&ch, u, v);
+                    if kids[which].get().is_none() && self.memo.full() {
+                        // Over the memory budget: refine from here without memoising.
+                        return self.descend(mesh.clone(), *t, u, v, a, depth, p.face);
+                    }
                     let (cu, cv, ca) = child_local(&ch[which].params, u, v);
                     node = kids[which].get_or_init(|| {
-                        self.refine_local(mesh, *t, which)
-                            .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme))
+                        let n = self
+                            .refine_local(mesh, *t, which)
+                            .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme));
+                        self.memo.add(&n);
+                        n
                     });
                     u = cu;
                     v = cv;

@@ -39,6 +39,7 @@ pub mod patch;
 
 pub use eval::{
     random_samples, EvalError, EvalKind, EvalWeights, Evaluator, SurfaceParam, SurfacePoint,
+    DEFAULT_CACHE_BYTES,
 };
 pub mod bvh;
 pub mod closest;

@@ -443,3 +443,67 @@ fn evaluation_commutes_with_global_refinement() {
         assert!(max_err < 1e-13, "{name}: {max_err:e}");
     }
 }
+
+/// The memoisation budget bounds the memory of an evaluator without changing its results:
+/// budget 0 memoises nothing, a small budget stops near its limit, the default memoises
+/// freely; all agree to round-off, and `clear_cache` gives the memory back.
+#[test]
+fn cache_budget_bounds_memory_without_changing_results() {
+    for (scheme, (p, f)) in [
+        (Scheme::Loop, bicone(7)),
+        (Scheme::CatmullClark, cc_prism(5)),
+    ] {
+        let o = Options::new(scheme);
+        let mut params = Evaluator::new(&f, p.len(), &Tags::new(), &o)
+            .unwrap()
+            .random_params(300, 11);
+        // Points close to the extraordinary vertices, where local refinement is deep.
+        params.extend(dyadic(
+            &Evaluator::new(&f, p.len(), &Tags::new(), &o).unwrap(),
+            3,
+        ));
+        let eval_all = |ev: &Evaluator| -> Vec<[f64; 3]> {
+            params
+                .iter()
+                .map(|&q| ev.evaluate(&p, q).unwrap().position)
+                .collect()
+        };
+        let mut free = Evaluator::new(&f, p.len(), &Tags::new(), &o).unwrap();
+        let reference = eval_all(&free);
+        let used = free.cache_bytes();
+        assert!(used > 0, "{scheme:?}: nothing memoised");
+        assert!(used <= subfit_subdiv::DEFAULT_CACHE_BYTES);
+        let none = Evaluator::new(&f, p.len(), &Tags::new(), &o)
+            .unwrap()
+            .with_cache_budget(0);
+        let small = Evaluator::new(&f, p.len(), &Tags::new(), &o)
+            .unwrap()
+            .with_cache_budget(used / 4);
+        let tol = 1e-12 * diag(&p);
+        for ev in [&none, &small] {
+            for (a, b) in eval_all(ev).into_iter().zip(&reference) {
+                assert!(dist(a, *b) <= tol, "{scheme:?}: {a:?} vs {b:?}");
+            }
+        }
+        assert_eq!(none.cache_bytes(), 0, "{scheme:?}: budget 0 memoised");
+        // At most one node past the budget (single-threaded here); nodes are far below `used`.
+        assert!(
+            small.cache_bytes() >= used / 4,
+            "{scheme:?}: small budget not used"
+        );
+        assert!(
+            small.cache_bytes() < used / 2,
+            "{scheme:?}: small budget exceeded"
+        );
+        free.clear_cache();
+        assert_eq!(free.cache_bytes(), 0);
+        for (a, b) in eval_all(&free).into_iter().zip(&reference) {
+            assert!(dist(a, *b) <= tol, "{scheme:?}: after clear_cache");
+        }
+        assert_eq!(
+            free.cache_bytes(),
+            used,
+            "{scheme:?}: memoised again the same"
+        );
+    }
+}
