@@ -15,8 +15,9 @@
 //! (comma-separated control-point counts, default `1000,10000`), `SUBFIT_ITERS` (default 3),
 //! `SUBFIT_SAMPLE_LEVEL` (default 3), `SUBFIT_LAMBDA` (default 1e-3), `SUBFIT_SOLVER`
 //! (`auto`, `cholesky` or `pcg`; default `auto`), `SUBFIT_ORDERING` (`scalar-amd`,
-//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-2). CPU time is the process's user + system time
-//! from `/proc/self/stat` (Linux only; 0 elsewhere).
+//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-2). CPU time is
+//! the process's user + system time from `/proc/self/stat` (Linux only; 0 elsewhere). The
+//! machine is shared: run with `RAYON_NUM_THREADS=2` and note `uptime`'s load with the figures.
 #![allow(clippy::print_stdout)]
 
 use std::time::{Duration, Instant};

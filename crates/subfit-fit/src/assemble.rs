@@ -42,7 +42,7 @@ pub struct Pattern {
     diag_slots: Vec<usize>,
     /// Transposed sampling operator: samples touching control point `j` with weight `c_kj`.
     samp_ptr: Vec<usize>,
-    samp: Vec<(u32, f64)>,
+    samp: Vec<SampleRef>,
     lap: Laplacian,
     lap_t: Laplacian,
 }
@@ -81,8 +81,8 @@ impl Pattern {
                             rows.push(i);
                         }
                     };
-                    for &(k, _) in &samp[samp_ptr[j]..samp_ptr[j + 1]] {
-                        position.row(k as usize).0.iter().for_each(|&i| visit(i));
+                    for e in &samp[samp_ptr[j]..samp_ptr[j + 1]] {
+                        position.row(e.k as usize).0.iter().for_each(|&i| visit(i));
                     }
                     let (rs, _) = lap_t.row(j);
                     for &r in rs {
@@ -249,12 +249,10 @@ impl Pattern {
         for (p, &i) in rows.iter().enumerate() {
             pos[i as usize] = p as u32;
         }
-        for &(k, ckj) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
-            let (idx, wts) = position.row(k as usize);
-            let w = w_e * ckj;
-            // Rows are sorted: the entries i ≤ j form a prefix.
-            let end = idx.partition_point(|&i| i as usize <= j);
-            for (&i, &cki) in idx[..end].iter().zip(wts) {
+        for e in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+            let (idx, wts) = position.row(e.k as usize);
+            let w = w_e * e.w;
+            for (&i, &cki) in idx[..e.upto as usize].iter().zip(wts) {
                 chunk[pos[i as usize] as usize] += w * cki;
             }
         }
@@ -297,10 +295,10 @@ impl Pattern {
         }
         acc.clear();
         acc.resize(nb, [0.0; 6]);
-        for &(k, ckj) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
-            let (idx, wts) = position.row(k as usize);
-            let qk = &q[k as usize];
-            let w = w_e * ckj;
+        for e in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+            let (idx, wts) = position.row(e.k as usize);
+            let qk = &q[e.k as usize];
+            let w = w_e * e.w;
             let wq = [
                 w * qk[0][0],
                 w * qk[0][1],
@@ -309,9 +307,7 @@ impl Pattern {
                 w * qk[1][2],
                 w * qk[2][2],
             ];
-            // Rows are sorted: the entries i ≤ j form a prefix.
-            let end = idx.partition_point(|&i| i as usize <= j);
-            for (&i, &cki) in idx[..end].iter().zip(wts) {
+            for (&i, &cki) in idx[..e.upto as usize].iter().zip(wts) {
                 let a = &mut acc[pos[i as usize] as usize];
                 for (a, &v) in a.iter_mut().zip(&wq) {
                     *a += cki * v;
@@ -373,8 +369,8 @@ impl Pattern {
             .into_par_iter()
             .map(|j| {
                 let mut g = [0.0; 3];
-                for &(k, c) in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
-                    let rk = r[k as usize];
+                for e in &self.samp[self.samp_ptr[j]..self.samp_ptr[j + 1]] {
+                    let (rk, c) = (r[e.k as usize], e.w);
                     for a in 0..3 {
                         g[a] += w_e * c * rk[a];
                     }
@@ -421,8 +417,20 @@ pub fn weighted_residuals(s: &[[f64; 3]], v: &[[f64; 3]], q: Option<&[Mat3]>) ->
         .collect()
 }
 
-/// Columns of a CSR operator: for each column `j`, the `(row, weight)` pairs.
-fn transpose_operator(c: &StencilMatrix) -> (Vec<usize>, Vec<(u32, f64)>) {
+/// One nonzero `c_kj` of the sampling operator, seen from its column `j`.
+#[derive(Clone, Copy, Debug, Default)]
+struct SampleRef {
+    /// The sample (row) `k`.
+    k: u32,
+    /// Length of the prefix of row `k` with columns `≤ j` (rows are sorted and unique, so
+    /// `j`'s position + 1): the entries that fall in the upper triangle of column `j`.
+    upto: u32,
+    /// The weight `c_kj`.
+    w: f64,
+}
+
+/// Columns of a CSR operator: for each column `j`, its nonzeros as [`SampleRef`]s.
+fn transpose_operator(c: &StencilMatrix) -> (Vec<usize>, Vec<SampleRef>) {
     let n = c.ncols();
     let mut ptr = vec![0usize; n + 1];
     for &j in c.indices() {
@@ -432,12 +440,20 @@ fn transpose_operator(c: &StencilMatrix) -> (Vec<usize>, Vec<(u32, f64)>) {
         ptr[j + 1] += ptr[j];
     }
     let mut next = ptr.clone();
-    let mut out = vec![(0u32, 0.0); c.nnz()];
+    let mut out = vec![SampleRef::default(); c.nnz()];
     for k in 0..c.nrows() {
         let (idx, w) = c.row(k);
-        for (&j, &w) in idx.iter().zip(w) {
+        debug_assert!(
+            idx.windows(2).all(|p| p[0] < p[1]),
+            "rows sorted and unique"
+        );
+        for (p, (&j, &w)) in idx.iter().zip(w).enumerate() {
             let s = &mut next[j as usize];
-            out[*s] = (k as u32, w);
+            out[*s] = SampleRef {
+                k: k as u32,
+                upto: p as u32 + 1,
+                w,
+            };
             *s += 1;
         }
     }
