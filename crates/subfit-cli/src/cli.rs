@@ -21,7 +21,7 @@ pub enum Command {
     Info(InfoArgs),
     /// Convert between PLY, OBJ, OFF, STL and XYZ.
     Convert(ConvertArgs),
-    /// Generate the built-in shapes (ellipsoid 0.25/0.5/1, torus, genus-2) as point clouds.
+    /// Fit the built-in shapes (ellipsoid 0.25/0.5/1, torus, genus-2 point clouds) end to end.
     Demo(DemoArgs),
     /// Refine a control mesh uniformly (Loop or Catmull-Clark), or push it to the limit surface.
     Subdivide(SubdivideArgs),
@@ -340,6 +340,9 @@ pub struct DemoArgs {
     /// Random seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Only write the sampled point clouds; do not fit them.
+    #[arg(long)]
+    pub no_fit: bool,
 }
 
 /// A file format named on the command line.

@@ -202,7 +202,14 @@ fn convert_round_trips_through_every_format_and_never_leaves_partial_files() {
 fn demo_writes_the_builtin_shapes() {
     let d = tempfile::tempdir().unwrap();
     let out_dir = d.path().join("demo");
-    let out = subfit(&["demo", "-o", out_dir.to_str().unwrap(), "--points", "500"]);
+    let out = subfit(&[
+        "demo",
+        "-o",
+        out_dir.to_str().unwrap(),
+        "--points",
+        "500",
+        "--no-fit",
+    ]);
     assert!(
         out.status.success(),
         "{}",
@@ -287,11 +294,16 @@ f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
 fn analyze_writes_normals_curvatures_and_directions() {
     let d = tempfile::tempdir().unwrap();
     let demo = d.path().join("demo");
-    assert!(
-        subfit(&["demo", "-o", demo.to_str().unwrap(), "--points", "4000"])
-            .status
-            .success()
-    );
+    assert!(subfit(&[
+        "demo",
+        "-o",
+        demo.to_str().unwrap(),
+        "--points",
+        "4000",
+        "--no-fit"
+    ])
+    .status
+    .success());
     let cloud = demo.join("ellipsoid.ply");
     let out = d.path().join("an.ply");
     let r = subfit(&[
@@ -398,11 +410,16 @@ f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
 fn fit_writes_cage_limit_log_and_report() {
     let d = tempfile::tempdir().unwrap();
     let demo = d.path().join("demo");
-    assert!(
-        subfit(&["demo", "-o", demo.to_str().unwrap(), "--points", "8000"])
-            .status
-            .success()
-    );
+    assert!(subfit(&[
+        "demo",
+        "-o",
+        demo.to_str().unwrap(),
+        "--points",
+        "8000",
+        "--no-fit"
+    ])
+    .status
+    .success());
     let target = demo.join("ellipsoid.ply");
     let init = write(d.path(), "octa.obj", ELLIPSOID_OCTAHEDRON);
     let out = d.path().join("fit");

@@ -171,3 +171,24 @@ fn a_torus_mesh_keeps_its_genus_through_refinement() {
     assert_eq!(cage["topology"]["genus"], 1, "{cage}");
     assert_eq!(cage["topology"]["boundary_loops"], 0, "{cage}");
 }
+
+#[test]
+fn demo_fits_the_builtin_shapes_end_to_end() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("demo");
+    let r = subfit(&["demo", "-o", out.to_str().unwrap(), "--points", "10000"]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let table = String::from_utf8_lossy(&r.stdout);
+    for (shape, genus) in [("ellipsoid", 0), ("torus", 1), ("genus2", 2)] {
+        let rep = report(&out.join(format!("fit-{shape}")));
+        assert!(rep["tolerance_reached"].as_bool().unwrap(), "{shape}");
+        assert_eq!(rep["init"]["genus"], genus, "{shape}");
+        assert!(table.contains(shape), "{table}");
+        assert!(out.join(format!("fit-{shape}/control.usda")).exists());
+    }
+}

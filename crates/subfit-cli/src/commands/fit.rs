@@ -32,6 +32,28 @@ const MAX_TESSELLATION_LEVEL: usize = 6;
 const MAX_TESSELLATION_VERTICES: usize = 1_000_000;
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
+    let out = execute(&a)?;
+    println!("{}", out.summary);
+    Ok(if out.reached {
+        ExitCode::SUCCESS
+    } else {
+        eprintln!("subfit: the requested tolerance was not reached (outputs written)");
+        ExitCode::from(1)
+    })
+}
+
+/// What one run of the pipeline gives back to its callers (`fit`, `demo`, `bench fit`).
+pub struct Outcome {
+    /// Whether every tolerance was reached.
+    pub reached: bool,
+    /// A one-line summary.
+    pub summary: String,
+    /// The content of `report.json`.
+    pub report: serde_json::Value,
+}
+
+/// The whole pipeline of `subfit fit`; writes every output, returns the outcome.
+pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
     // Validate every flag before touching a file.
     if !(a.lambda.is_finite() && a.lambda >= 0.0) {
         bail!("--lambda must be a finite number ≥ 0, got {}", a.lambda);
@@ -334,7 +356,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
         &a.output.join("report.json"),
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
-    println!(
+    let summary = format!(
         "{} → {} control points, {} stages, {} iterations ({:?}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (unit cube); {:.1} s; wrote {}",
         control.num_vertices(),
         fitted.num_vertices(),
@@ -348,11 +370,10 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
         t0.elapsed().as_secs_f64(),
         a.output.display()
     );
-    Ok(if reached {
-        ExitCode::SUCCESS
-    } else {
-        eprintln!("subfit: the requested tolerance was not reached (outputs written)");
-        ExitCode::from(1)
+    Ok(Outcome {
+        reached,
+        summary,
+        report: doc,
     })
 }
 
