@@ -202,3 +202,60 @@ fn bad_inputs_exit_with_2_and_leave_no_file() {
     assert_eq!(r.status.code(), Some(2));
     assert!(!p.join("cage.xyz").exists());
 }
+
+/// A torus cloud with every third normal flipped: the implicit surface misses genus 1; with
+/// `--genus 1 --require-genus` the carving fallback finds it.
+#[test]
+fn known_genus_rescues_a_cloud_with_bad_normals() {
+    let d = tempfile::tempdir().unwrap();
+    let (nu, nv) = (120, 48);
+    let mut xyz = String::new();
+    for i in 0..nu {
+        let u = std::f64::consts::TAU * i as f64 / nu as f64;
+        for j in 0..nv {
+            let v = std::f64::consts::TAU * j as f64 / nv as f64;
+            let rho = 10.0 + 3.5 * v.cos();
+            let p = [rho * u.cos(), rho * u.sin(), 3.5 * v.sin()];
+            let s = if (i * nv + j) % 3 == 0 { -1.0 } else { 1.0 };
+            let n = [v.cos() * u.cos(), v.cos() * u.sin(), v.sin()].map(|c| s * c);
+            let _ = writeln!(xyz, "{} {} {} {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
+        }
+    }
+    let cloud = write(d.path(), "torus.xyz", &xyz);
+    let out = d.path().join("cage.obj");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "init",
+            cloud.to_str().unwrap(),
+            "--control-points",
+            "150",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        subfit(&args)
+    };
+    let plain = run(&[]);
+    assert_eq!(plain.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&plain.stdout);
+    assert!(text.contains("target genus unknown"), "{text}");
+    let (v, f) = read_obj(&out);
+    assert_ne!(
+        closed_genus(v.len(), &f),
+        1,
+        "bad normals should mislead: {text}"
+    );
+
+    let r = run(&["--genus", "1", "--require-genus"]);
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert!(text.contains("space-carving"), "{text}");
+    let (v, f) = read_obj(&out);
+    assert!(v.len() <= 150);
+    assert_eq!(closed_genus(v.len(), &f), 1, "{text}");
+}
