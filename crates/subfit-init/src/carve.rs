@@ -4,13 +4,13 @@
 //! data point (the complement of an `r`-offset "wrap", as in alpha wrapping; Edelsbrunner &
 //! Mücke 1994 describe the related α-shapes): grid nodes farther than `r` from every point are
 //! flood-filled from the grid boundary (6-connected); the rest is inside. The contour of
-//! `d(x) − r` between the two (marching tetrahedra, as [`crate::contour`]) is the wrap: it lies
+//! `d(x) − r` between the two (marching tetrahedra, as [`crate::contour()`]) is the wrap: it lies
 //! about `r` outside the data (the fitter pulls the cage in). Moving the dense wrap's vertices
 //! back along their normals was tried and folded thin parts (the simplification then stalled on
 //! fold-over checks), so it is not done.
 //!
-//! Used as the fallback of [`crate::initial_control_mesh`] when the IMLS contour
-//! ([`crate::contour`]) misses the expected genus: wrong normal orientations (e.g. a sparse,
+//! Used as the fallback of [`crate::initial_control_mesh()`] when the IMLS contour
+//! ([`crate::contour()`]) misses the expected genus: wrong normal orientations (e.g. a sparse,
 //! decimated scan) make the IMLS sign unreliable, carving does not use them. Tunnels narrower
 //! than about `2r` are closed, so `r` must stay below the target's real holes.
 //!

@@ -2,7 +2,7 @@
 //!
 //! Mesh targets are simplified ([`crate::simplify`](mod@crate::simplify), Garland & Heckbert 1997 with the link
 //! condition of Dey et al. 1999), like the method of reference 13 in Cheng et al. 2007 §I; point
-//! clouds are contoured first ([`crate::contour`](mod@crate::contour): IMLS of Xie et al. 2023 on a grid, marching
+//! clouds are contoured first ([`crate::contour()`](mod@crate::contour): IMLS of Xie et al. 2023 on a grid, marching
 //! tetrahedra) and then simplified, as Cheng et al. 2004 §4.3 (marching cubes on an octree, then
 //! simplification).
 
@@ -23,7 +23,7 @@ pub struct InitOptions {
     /// Contouring options (point clouds only).
     pub contour: ContourOptions,
     /// Genus the caller expects for a point cloud (compared in the report). When the IMLS
-    /// contour has another genus, the space-carving fallback ([`crate::carve`], which ignores
+    /// contour has another genus, the space-carving fallback ([`crate::carve()`], which ignores
     /// the normals) is tried and used if it matches. Default `None`: the contour's genus is
     /// reported as the target's. Ignored for mesh targets (their genus is
     /// computed).
@@ -123,7 +123,7 @@ pub struct InitReport {
     /// Contouring details (point clouds only).
     pub contour: Option<ContourReport>,
     /// Point clouds: the carving radius (normalized units) when the IMLS contour missed
-    /// [`InitOptions::expected_genus`] and the space-carving fallback ([`crate::carve`]) was
+    /// [`InitOptions::expected_genus`] and the space-carving fallback ([`crate::carve()`]) was
     /// used; `None` otherwise.
     pub carve_radius: Option<f64>,
     /// Step times.
@@ -185,10 +185,20 @@ pub enum InitError {
 /// * `mesh = Some(m)` with faces: `m` (in the target's **original** coordinates, e.g. the mesh the
 ///   target was built from) is mapped into normalized units and simplified.
 /// * otherwise the target's points (with their oriented normals) are contoured, then simplified.
+///   When [`InitOptions::expected_genus`] is set and the contour misses it, the normal-free
+///   space-carving wrap ([`crate::carve()`]) is tried instead (`report.carve_radius`).
 ///
 /// The result is in the target's normalized units, manifold, consistently oriented (outward for
 /// contours; as the input for meshes), closed when the target is; it may keep more than
 /// `n_vertices` vertices when no legal collapse remains (see `report.simplify.reached_target`).
+///
+/// Errors: [`InitError::TooFewVertices`] (`n_vertices < 4`), [`InitError::InvalidMesh`] /
+/// [`InitError::NonFinite`] for a bad mesh target, [`InitError::TooFewForTopology`] when
+/// `n_vertices` is below [`min_vertices_for_topology`] of the surface (checked after contouring
+/// for point clouds), [`InitError::Contour`], [`InitError::GenusMismatch`] (only with
+/// [`InitOptions::require_genus`]). A target with too few points fails earlier, in
+/// [`Target`]'s constructor.
+///
 /// Cost: contouring `O(N³ + band·k)` for an `N`-cell grid, simplification `O(E log E)`.
 pub fn initial_control_mesh(
     target: &Target,
