@@ -537,31 +537,29 @@ impl<const K: usize, S> Scratch<K, S> {
                 big[k] = big[k].max(a[k].abs());
             }
         }
-        // One pass writing all `K` rows, branch-free: every entry is written, and kept (its
-        // slot advanced) only if above the tolerance.
+        // One pass writing all `K` rows; the tolerance test almost always keeps the entry, so
+        // its branch is well predicted.
         let t = touched.len();
         let tol: [f64; K] = std::array::from_fn(|k| DROP_TOLERANCE * big[k]);
         let mut base = [0usize; K];
-        let mut len = [0usize; K];
         for (k, b) in blk.iter_mut().enumerate() {
             base[k] = b.indices.len();
-            b.indices.resize(base[k] + t, 0);
-            b.weights.resize(base[k] + t, 0.0);
+            b.indices.reserve(t);
+            b.weights.reserve(t);
         }
         for &c in touched.iter() {
             let a = std::mem::replace(&mut acc[c as usize], [0.0; K]);
             mark[c as usize] = false;
             for (k, b) in blk.iter_mut().enumerate() {
-                let at = base[k] + len[k];
-                b.indices[at] = c;
-                b.weights[at] = a[k];
-                len[k] += usize::from(a[k].abs() > tol[k]);
+                if a[k].abs() > tol[k] {
+                    b.indices.push(c);
+                    b.weights.push(a[k]);
+                }
             }
         }
         for (k, b) in blk.iter_mut().enumerate() {
-            b.indices.truncate(base[k] + len[k]);
-            b.weights.truncate(base[k] + len[k]);
-            b.lens.push(len[k] as u32);
+            let len = b.indices.len() - base[k];
+            b.lens.push(len as u32);
         }
     }
 }
