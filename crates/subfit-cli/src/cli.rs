@@ -90,6 +90,23 @@ pub enum BenchCommand {
     /// Reproduce Cheng et al. 2007 Examples 1–4 and 6–10 on the ellipsoid: error-curve CSVs and
     /// SVG plots of E_rms per iteration, one line per method.
     Convergence(ConvergenceArgs),
+    /// Fit the models of `$SUBFIT_DATA` end to end and print a table per model (control
+    /// points, iterations, E_max, E_rms, time per phase) next to the papers' figures.
+    Fit(BenchFitArgs),
+}
+
+/// `subfit bench fit`.
+#[derive(clap::Args, Debug)]
+pub struct BenchFitArgs {
+    /// Directory of the models [default: $SUBFIT_DATA].
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// Output directory: one fit directory per model and `summary.json`.
+    #[arg(short, long, default_value = "subfit-bench-fit")]
+    pub output: PathBuf,
+    /// Run only these models (e.g. `--models igea,rocker-arm`).
+    #[arg(long, value_delimiter = ',')]
+    pub models: Vec<String>,
 }
 
 /// `subfit bench convergence`.

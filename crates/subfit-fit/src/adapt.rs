@@ -109,6 +109,15 @@ fn key(a: u32, b: u32) -> (u32, u32) {
 /// uniform; other old points stay. Old points keep their ids, new ones are appended. Winding
 /// is preserved. Returns `None` when the cage is not all triangles.
 pub fn refine_red_green(mesh: &PolyMesh, marked: &[bool]) -> Option<(PolyMesh, RefineStats)> {
+    refine_red_green_with_parents(mesh, marked).map(|(m, s, _)| (m, s))
+}
+
+/// [`refine_red_green`], also giving the parent face of every output face (children of a
+/// face are consecutive).
+pub fn refine_red_green_with_parents(
+    mesh: &PolyMesh,
+    marked: &[bool],
+) -> Option<(PolyMesh, RefineStats, Vec<u32>)> {
     if !mesh.faces.is_triangles() {
         return None;
     }
@@ -218,7 +227,8 @@ pub fn refine_red_green(mesh: &PolyMesh, marked: &[bool]) -> Option<(PolyMesh, R
         ..RefineStats::default()
     };
     let mut out = Vec::with_capacity(tris.len() + 3 * split.len());
-    for (t, &r) in tris.iter().zip(&red) {
+    let mut parents = Vec::with_capacity(tris.len() + 3 * split.len());
+    for (f, (t, &r)) in tris.iter().zip(&red).enumerate() {
         let mid = |i: usize| split.get(&key(t[i], t[(i + 1) % 3])).copied();
         if r {
             stats.red += 1;
@@ -233,10 +243,12 @@ pub fn refine_red_green(mesh: &PolyMesh, marked: &[bool]) -> Option<(PolyMesh, R
         } else {
             out.push(*t);
         }
+        parents.resize(out.len(), f as u32);
     }
     Some((
         PolyMesh::new(positions, Polygons::from_triangles(&out)),
         stats,
+        parents,
     ))
 }
 

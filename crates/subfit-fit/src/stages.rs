@@ -17,7 +17,8 @@ use subfit_subdiv::{sampling_operator, Options};
 use subfit_target::Target;
 
 use crate::adapt::{
-    apply_flips, face_errors, independent_flips, refine_red_green, FaceError, RefineStats,
+    apply_flips, face_errors, independent_flips, refine_red_green_with_parents, FaceError,
+    RefineStats,
 };
 use crate::error::FitError;
 use crate::fitter::Fitter;
@@ -56,6 +57,10 @@ pub struct StageOptions {
     pub growth: f64,
     /// Edge flips in high-error regions, kept only where they lower the error.
     pub edge_flips: bool,
+    /// A face that descends from this many splits of an initial face is not split again:
+    /// where refinement does not lower the error (a foot point on the wrong side of a thin
+    /// part, a sharp crease), it would otherwise only pile up control points.
+    pub max_depth: u8,
 }
 
 impl Default for StageOptions {
@@ -74,6 +79,7 @@ impl Default for StageOptions {
             refine: true,
             growth: 0.6,
             edge_flips: true,
+            max_depth: 3,
         }
     }
 }
@@ -223,6 +229,8 @@ pub fn fit_stages(
     let mut mesh = PolyMesh::new(mesh.positions.clone(), mesh.faces.clone());
     let tags = Tags::new();
     let mut lambda = stages.lambda_start;
+    // Refinement depth of every face (0 for the initial faces).
+    let mut depth = vec![0u8; mesh.faces.len()];
     let mut reports: Vec<StageReport> = Vec::new();
     let mut initial = None;
     let mut stop = StageStop::Limit;
@@ -284,9 +292,10 @@ pub fn fit_stages(
                 errors
             };
             if stages.refine && n < stages.max_control_points {
-                if let Some((refined, rs)) = refine_step(&mesh, &errors, stages, &last) {
+                if let Some((refined, rs, d)) = refine_step(&mesh, &errors, &depth, stages, &last) {
                     changed |= rs.new_points > 0;
                     mesh = refined;
+                    depth = d;
                     report.refine = Some(rs);
                 }
             }
@@ -428,13 +437,15 @@ fn flip_pass(
 }
 
 /// Marks the faces above the tolerance, worst first, within the growth and control-point
-/// budget, and refines them with red-green closure.
+/// budget and the refinement depth, and refines them with red-green closure. Returns the new
+/// mesh, what was done, and the depth of every new face.
 fn refine_step(
     mesh: &PolyMesh,
     errors: &[FaceError],
+    depth: &[u8],
     stages: &StageOptions,
     last: &ErrorStats,
-) -> Option<(PolyMesh, RefineStats)> {
+) -> Option<(PolyMesh, RefineStats, Vec<u8>)> {
     let n = mesh.num_vertices();
     let room = stages.max_control_points.saturating_sub(n);
     let allowed = room.min(((n as f64) * stages.growth).ceil() as usize);
@@ -444,6 +455,7 @@ fn refine_step(
     let mut order: Vec<(f64, usize)> = errors
         .iter()
         .enumerate()
+        .filter(|&(f, _)| depth[f] < stages.max_depth)
         .map(|(f, e)| (face_score(e, stages, last), f))
         .filter(|(s, _)| *s > 1.0)
         .collect();
@@ -461,12 +473,29 @@ fn refine_step(
         for &(_, f) in &order[..take] {
             marked[f] = true;
         }
-        let (refined, rs) = refine_red_green(mesh, &marked)?;
+        let (refined, rs, parents) = refine_red_green_with_parents(mesh, &marked)?;
         if refined.num_vertices() <= n + allowed || take == 1 {
             if refined.num_vertices() > stages.max_control_points {
                 return None;
             }
-            return Some((refined, rs));
+            // An unsplit face (its parent's only child) keeps its depth; children of a split
+            // face (red or green) are one deeper.
+            let mut children = vec![0u32; mesh.faces.len()];
+            for &p in &parents {
+                children[p as usize] += 1;
+            }
+            let d = parents
+                .iter()
+                .map(|&p| {
+                    let dp = depth[p as usize];
+                    if children[p as usize] > 1 {
+                        dp.saturating_add(1)
+                    } else {
+                        dp
+                    }
+                })
+                .collect();
+            return Some((refined, rs, d));
         }
         take = (take * 3 / 4).max(1);
     }

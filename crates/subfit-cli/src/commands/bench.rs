@@ -24,6 +24,7 @@ const TOLERANCE: f64 = 0.002;
 pub fn run(cmd: BenchCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         BenchCommand::Convergence(a) => convergence(a),
+        BenchCommand::Fit(a) => crate::commands::bench_fit::run(a),
     }
 }
 

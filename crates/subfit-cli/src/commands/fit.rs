@@ -87,7 +87,11 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
 
     let t0 = Instant::now();
     let (mut target_mesh, _) = crate::progress::load(&a.target)?;
-    if a.as_points {
+    // With --as-points the file's faces are dropped, but their genus still tells the initial
+    // mesh what topology to aim for.
+    let mut expected_genus = None;
+    if a.as_points && !target_mesh.faces.is_empty() {
+        expected_genus = mesh_topology(&target_mesh).ok().flatten().map(|t| t.genus);
         target_mesh.faces = Polygons::new();
     }
     let given = match &init_file {
@@ -152,7 +156,11 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
                 .unwrap_or_else(|| default_control_points(target.len()));
             let sp = crate::progress::spinner("building the initial control mesh");
             let mesh = (!target_mesh.faces.is_empty()).then_some(&target_mesh);
-            let (m, r) = initial_control_mesh(&target, mesh, n, &InitOptions::default())
+            let init_options = InitOptions {
+                expected_genus,
+                ..InitOptions::default()
+            };
+            let (m, r) = initial_control_mesh(&target, mesh, n, &init_options)
                 .with_context(|| {
                     format!(
                         "{}: cannot build an initial control mesh",

@@ -2,6 +2,7 @@
 
 mod analyze;
 mod bench;
+mod bench_fit;
 mod compare;
 mod convert;
 mod demo;
