@@ -347,11 +347,11 @@ impl<'a> Stacked<'a> {
 ///
 /// Rows are produced in waves of [`WAVE`] blocks of [`BLOCK`] rows: the blocks of a wave are
 /// computed in parallel (one `init()` state and one dense scratch row of `rhs.ncols` entries per
-/// worker) into buffers reused from wave to wave, then copied in parallel into the output.
-/// The output arrays are allocated zeroed once, sized by extrapolating the first wave (a
-/// zeroed allocation of that size is mapped lazily by the OS, so the unused part costs no
-/// memory and the page faults are taken by the parallel copies), and grown if the guess was
-/// short.
+/// worker) into buffers reused from wave to wave, then appended to the output, whose capacity is
+/// extrapolated from the first wave. So the output is written once and no large temporary is
+/// allocated per call beyond one wave's buffers. (A parallel copy into a zero-filled output was
+/// tried: the allocator zero-fills allocations below its mmap threshold, which cost more than
+/// the serial append it saved.)
 pub(crate) fn compose_rows<const K: usize, S>(
     nrows: usize,
     rhs: Stacked<'_>,
@@ -366,8 +366,6 @@ where
     for m in &mut out {
         m.offsets.reserve_exact(nrows);
     }
-    // Entries written to each output so far (`indices`/`weights` are longer, zero-filled).
-    let mut len = [0usize; K];
     // One task slot per block of a wave, each with its own output buffers and scratch, both
     // reused from wave to wave (small enough to stay in cache; no allocation per wave).
     let nslots = nrows.div_ceil(BLOCK).min(WAVE);
@@ -394,61 +392,33 @@ where
                 }
             });
         let done = (first + nblocks * BLOCK).min(nrows);
-        let slots = &slots[..nblocks];
-        let start = len;
         for (k, m) in out.iter_mut().enumerate() {
-            let wave_nnz: usize = slots.iter().map(|s| s.0[k].indices.len()).sum();
-            let need = len[k] + wave_nnz;
-            if need > m.indices.len() {
-                // Extrapolate the total from the rows done so far, generously: unused zeroed
-                // capacity is never touched (so costs no memory) and is given back below.
-                let guess = (need as f64 * nrows as f64 / done as f64 * 1.25) as usize;
-                let size = guess.max(need);
-                if m.indices.is_empty() {
-                    m.indices = vec![0; size];
-                    m.weights = vec![0.0; size];
-                } else {
-                    m.indices.resize(size, 0);
-                    m.weights.resize(size, 0.0);
-                }
+            if first == 0 {
+                // Extrapolate the total from the first wave, generously: unused capacity is
+                // never touched (so costs no memory) and is given back below.
+                let wave_nnz: usize = slots.iter().map(|s| s.0[k].indices.len()).sum();
+                let guess = (wave_nnz as f64 * nrows as f64 / done as f64 * 1.25) as usize;
+                m.indices.reserve_exact(guess);
+                m.weights.reserve_exact(guess);
             }
-            for (blk, _) in slots {
-                for &l in &blk[k].lens {
-                    len[k] += l as usize;
-                    m.offsets.push(len[k]);
+            for (blk, _) in &slots[..nblocks] {
+                let RowBlock {
+                    lens,
+                    indices,
+                    weights,
+                } = &blk[k];
+                let mut end = m.indices.len();
+                for &l in lens {
+                    end += l as usize;
+                    m.offsets.push(end);
                 }
+                m.indices.extend_from_slice(indices);
+                m.weights.extend_from_slice(weights);
             }
         }
-        // Parallel copy of the blocks into their places in the outputs.
-        let mut it = out.iter_mut().zip(start);
-        let mut rest: [(&mut [u32], &mut [f64]); K] = std::array::from_fn(|_| {
-            let (m, s) = it.next().expect("K outputs");
-            (&mut m.indices[s..], &mut m.weights[s..])
-        });
-        let jobs: Vec<_> = slots
-            .iter()
-            .map(|(blk, _)| {
-                let dests: [(&mut [u32], &mut [f64]); K] = std::array::from_fn(|k| {
-                    let n = blk[k].indices.len();
-                    let (i, irest) = std::mem::take(&mut rest[k].0).split_at_mut(n);
-                    let (w, wrest) = std::mem::take(&mut rest[k].1).split_at_mut(n);
-                    rest[k] = (irest, wrest);
-                    (i, w)
-                });
-                (blk, dests)
-            })
-            .collect();
-        jobs.into_par_iter().for_each(|(blk, dests)| {
-            for (b, (i, w)) in blk.iter().zip(dests) {
-                i.copy_from_slice(&b.indices);
-                w.copy_from_slice(&b.weights);
-            }
-        });
         first = done;
     }
-    for (m, &l) in out.iter_mut().zip(&len) {
-        m.indices.truncate(l);
-        m.weights.truncate(l);
+    for m in &mut out {
         m.indices.shrink_to_fit();
         m.weights.shrink_to_fit();
     }
