@@ -450,8 +450,9 @@ impl RowBlock {
 /// marker array and the list of touched columns (Gustavson), the current left row, and the
 /// caller's state.
 struct Scratch<const K: usize, S> {
-    acc: Vec<[f64; K]>,
-    mark: Vec<bool>,
+    /// Per column: the accumulated weights and whether the column is in `touched` (one array,
+    /// so one bounds check and one cache line per update).
+    acc: Vec<([f64; K], bool)>,
     touched: Vec<u32>,
     ntouched: usize,
     lrow: Vec<(u32, [f64; K])>,
@@ -461,8 +462,7 @@ struct Scratch<const K: usize, S> {
 impl<const K: usize, S> Scratch<K, S> {
     fn new(ncols: usize, state: S) -> Self {
         Self {
-            acc: vec![[0.0; K]; ncols],
-            mark: vec![false; ncols],
+            acc: vec![([0.0; K], false); ncols],
             // One slot more than columns: the branch-free append writes before it counts.
             touched: vec![0; ncols + 1],
             ntouched: 0,
@@ -475,16 +475,16 @@ impl<const K: usize, S> Scratch<K, S> {
     /// `touched[..ntouched]` (branch-free: most columns repeat, unpredictably).
     #[inline]
     fn accumulate(&mut self, rhs: &Stacked<'_>) {
-        let (acc, mark, touched) = (&mut self.acc, &mut self.mark, &mut self.touched);
+        let (acc, touched) = (&mut self.acc, &mut self.touched);
         let mut n = self.ntouched;
         for &(j, w) in &self.lrow {
             let (c2, w2) = rhs.row(j as usize);
             for (&c, &u) in c2.iter().zip(w2) {
                 let cu = c as usize;
                 touched[n] = c;
-                n += usize::from(!mark[cu]);
-                mark[cu] = true;
-                let a = &mut acc[cu];
+                let (a, mark) = &mut acc[cu];
+                n += usize::from(!*mark);
+                *mark = true;
                 for k in 0..K {
                     a[k] += w[k] * u;
                 }
@@ -496,13 +496,13 @@ impl<const K: usize, S> Scratch<K, S> {
     /// Appends the accumulated row (sorted, pruned) to `blk` and resets the accumulator.
     #[inline]
     fn emit(&mut self, blk: &mut [RowBlock; K]) {
-        let (acc, mark) = (&mut self.acc, &mut self.mark);
+        let acc = &mut self.acc;
         let touched = &mut self.touched[..self.ntouched];
         self.ntouched = 0;
         touched.sort_unstable();
         let mut big = [0.0f64; K];
         for &c in touched.iter() {
-            let a = &acc[c as usize];
+            let a = &acc[c as usize].0;
             for k in 0..K {
                 big[k] = big[k].max(a[k].abs());
             }
@@ -518,8 +518,7 @@ impl<const K: usize, S> Scratch<K, S> {
             b.weights.reserve(t);
         }
         for &c in touched.iter() {
-            let a = std::mem::replace(&mut acc[c as usize], [0.0; K]);
-            mark[c as usize] = false;
+            let (a, _) = std::mem::replace(&mut acc[c as usize], ([0.0; K], false));
             for (k, b) in blk.iter_mut().enumerate() {
                 if a[k].abs() > tol[k] {
                     b.indices.push(c);
