@@ -1,8 +1,10 @@
 //! Benchmark of target construction and foot-point queries (plain binary, prints figures).
 //!
-//! `cargo bench -p subfit-target --bench target` — with `SUBFIT_DATA` set, also Igea
-//! (134,345 points). Figures: preprocessing time (normals, curvature, orientation) for Igea and
-//! for 1M points (a jittered-sampled torus), foot-point queries per second (parallel batch).
+//! `SUBFIT_DATA=../shared/data cargo bench -p subfit-target --bench target` (without
+//! `SUBFIT_DATA` it measures nothing). Figures: preprocessing time (normals, curvature,
+//! orientation) for Igea (134,345 points) and for 1M points sampled uniformly on Igea's
+//! triangles; foot-point queries per second (parallel batch), cold (`foot_points`) and warm
+//! (`foot_points_hinted` with the previous call's hints); wall and CPU time.
 #![allow(clippy::print_stdout)]
 
 use std::time::Instant;
@@ -10,8 +12,9 @@ use std::time::Instant;
 use subfit_mesh::PolyMesh;
 use subfit_target::{NormalSource, Target, TargetOptions};
 
-fn torus_points(n: usize) -> Vec<[f64; 3]> {
-    // Deterministic low-discrepancy-ish sampling of a torus R = 0.35, r = 0.15, with jitter.
+/// `n` points uniformly distributed on the triangles of `mesh` (triangle chosen with probability
+/// proportional to its area, uniform barycentric coordinates), from a fixed seed.
+fn sample_surface(mesh: &PolyMesh, n: usize) -> Vec<[f64; 3]> {
     let mut s = 0x9e37_79b9_7f4a_7c15u64;
     let mut rnd = || {
         s ^= s << 13;
@@ -19,17 +22,37 @@ fn torus_points(n: usize) -> Vec<[f64; 3]> {
         s ^= s << 17;
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
-    let (rr, r) = (0.35, 0.15);
-    let mut out = Vec::with_capacity(n);
-    while out.len() < n {
-        let th = rnd() * std::f64::consts::TAU;
-        let ph = rnd() * std::f64::consts::TAU;
-        if rnd() * (rr + r) < rr + r * ph.cos() {
-            let w = rr + r * ph.cos();
-            out.push([w * th.cos(), w * th.sin(), r * ph.sin()]);
-        }
+    let tris = mesh.faces.triangulate_fan();
+    let p = &mesh.positions;
+    let mut cum = Vec::with_capacity(tris.len());
+    let mut total = 0.0;
+    for t in &tris {
+        let [a, b, c] = t.map(|v| p[v as usize]);
+        let (u, v) = (sub(b, a), sub(c, a));
+        let x = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        total += 0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        cum.push(total);
     }
-    out
+    (0..n)
+        .map(|_| {
+            let r = rnd() * total;
+            let k = cum.partition_point(|&c| c < r).min(tris.len() - 1);
+            let [a, b, c] = tris[k].map(|v| p[v as usize]);
+            let (mut u, mut v) = (rnd(), rnd());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            [0, 1, 2].map(|i| a[i] + u * (b[i] - a[i]) + v * (c[i] - a[i]))
+        })
+        .collect()
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// Process CPU time (user + system, all threads) in seconds, from `/proc/self/stat` (Linux; 0
@@ -84,10 +107,11 @@ fn report(name: &str, t: &Target) {
 }
 
 fn queries(t: &Target, n: usize) {
-    // Points near the surface: data points offset along their normals by up to ±0.02.
+    // Points near the surface: data points offset along their normals by up to ±0.02, plus a
+    // small lateral jitter.
     let pts = t.points();
     let nrm = t.normals();
-    let xs: Vec<[f64; 3]> = (0..n)
+    let mut xs: Vec<[f64; 3]> = (0..n)
         .map(|i| {
             let j = (i * 7919) % pts.len();
             let d = 0.02 * (((i * 31) % 101) as f64 / 50.0 - 1.0);
@@ -100,7 +124,30 @@ fn queries(t: &Target, n: usize) {
     let (dt, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds() - c0);
     let checksum: f64 = f.iter().map(|f| f.distance).sum();
     println!(
-        "  foot points: {n} in {dt:.3} s = {:.2} M/s; CPU {cpu:.2} s = {:.2} M/CPU-s (checksum {checksum:.3}, load average {})",
+        "  foot points, cold (kd-tree; Morton-sorted runs): {n} in {dt:.3} s = {:.2} M/s; CPU {cpu:.2} s = {:.2} M/CPU-s (checksum {checksum:.3}, load average {})",
+        n as f64 / dt / 1e6,
+        n as f64 / cpu.max(1e-9) / 1e6,
+        load_average()
+    );
+    // Warm start, as in the fitter: queries in a spatially coherent order (its samples come
+    // face by face), hints from the previous call, every query moved by up to 2e-4 (normalized).
+    xs.sort_by_key(|x| x.map(|c| (c.clamp(0.0, 1.0) * 64.0) as u32));
+    let mut hints = vec![u32::MAX; n];
+    let (t0, c0) = (Instant::now(), cpu_seconds());
+    let _ = t.foot_points_hinted(&xs, &mut hints);
+    let (dt0, cpu0) = (t0.elapsed().as_secs_f64(), cpu_seconds() - c0);
+    for (i, x) in xs.iter_mut().enumerate() {
+        for (k, c) in x.iter_mut().enumerate() {
+            *c += 2e-4 * (((i * 13 + k * 5) % 17) as f64 / 8.0 - 1.0);
+        }
+    }
+    let (t0, c0) = (Instant::now(), cpu_seconds());
+    let g = t.foot_points_hinted(&xs, &mut hints);
+    let (dt, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds() - c0);
+    let checksum: f64 = g.iter().map(|f| f.distance).sum();
+    println!(
+        "  foot points, hinted: first call (no hints) {:.2} M/s, CPU {cpu0:.2} s; warm call {n} in {dt:.3} s = {:.2} M/s; CPU {cpu:.2} s = {:.2} M/CPU-s (checksum {checksum:.3}, load average {})",
+        n as f64 / dt0 / 1e6,
         n as f64 / dt / 1e6,
         n as f64 / cpu.max(1e-9) / 1e6,
         load_average()
@@ -119,28 +166,31 @@ fn queries(t: &Target, n: usize) {
 
 fn main() {
     let opts = TargetOptions::default();
-    if let Some(dir) = std::env::var_os("SUBFIT_DATA") {
-        let path = std::path::Path::new(&dir).join("igea.ply");
-        match subfit_io::read_file(&path, &subfit_io::ReadOptions::default()) {
-            Ok((mesh, _)) => {
-                // Point cloud only: estimated normals (the hard case).
-                let cloud = PolyMesh::point_cloud(mesh.positions.clone(), None);
-                let est = TargetOptions {
-                    normals: NormalSource::Estimate,
-                    ..opts.clone()
-                };
-                let t = build("igea (points, estimated normals)", &cloud, &est);
-                queries(&t, 2_000_000);
-                build("igea (mesh: face normals + BVH)", &mesh, &opts);
-            }
-            Err(e) => println!("igea: cannot read {}: {e}", path.display()),
+    let Some(dir) = std::env::var_os("SUBFIT_DATA") else {
+        println!("SUBFIT_DATA not set: nothing to measure (igea.ply is the benchmark input)");
+        return;
+    };
+    let path = std::path::Path::new(&dir).join("igea.ply");
+    let mesh = match subfit_io::read_file(&path, &subfit_io::ReadOptions::default()) {
+        Ok((mesh, _)) => mesh,
+        Err(e) => {
+            println!("igea: cannot read {}: {e}", path.display());
+            return;
         }
-    } else {
-        println!("SUBFIT_DATA not set: skipping igea");
-    }
-    let pts = torus_points(1_000_000);
+    };
+    // Point cloud only: estimated normals (the hard case).
+    let est = TargetOptions {
+        normals: NormalSource::Estimate,
+        ..opts.clone()
+    };
+    let cloud = PolyMesh::point_cloud(mesh.positions.clone(), None);
+    let t = build("igea (points, estimated normals)", &cloud, &est);
+    queries(&t, 2_000_000);
+    drop(t);
+    build("igea (mesh: face normals + BVH)", &mesh, &opts);
+    let pts = sample_surface(&mesh, 1_000_000);
     let t = build(
-        "torus 1M (estimated normals)",
+        "igea 1M (points sampled uniformly on its triangles, estimated normals)",
         &PolyMesh::point_cloud(pts, None),
         &opts,
     );

@@ -79,6 +79,30 @@ impl PointIndex {
         }
     }
 
+    /// The nearest indexed point to `q` among those within squared distance `bound2`
+    /// (inclusive), `None` when there is none. With a tight bound (e.g. the distance to a point
+    /// known to be near) much cheaper than [`Self::nearest`] for queries off the surface: fewer
+    /// tree nodes are visited, no allocation.
+    pub fn nearest_within2(&self, q: &[f64; 3], bound2: f64) -> Option<Neighbor> {
+        if !(bound2 >= 0.0) {
+            return None;
+        }
+        let mut best: Option<(f64, u32)> = None;
+        self.tree
+            .query(q)
+            .within::<SquaredEuclidean<f64>>(bound2)
+            .unsorted()
+            .visit(|r| {
+                if best.is_none_or(|(d, _)| r.distance < d) {
+                    best = Some((r.distance, r.item));
+                }
+            });
+        best.map(|(d, i)| Neighbor {
+            index: i,
+            distance: d.max(0.0).sqrt(),
+        })
+    }
+
     /// The `k` nearest points to `q`, sorted by increasing distance (fewer when the index has
     /// fewer than `k` points). `k == 0` gives an empty list. A point of the index queried at its
     /// own position finds itself first.
@@ -197,24 +221,26 @@ impl NeighborGraph {
         }
     }
 
-    /// The certified nearest point of `points` (the slice the graph was built over) to `q`, by
-    /// greedy descent from point `start`: move to the row entry nearest to `q` while it is
-    /// strictly nearer than the current point. At a local minimum `c` at distance `d`, the result
-    /// is exact when `2 d < R_c` (`R_c` the row radius): a point `p` nearer to `q` than `c` has
-    /// `|p − c| ≤ |p − q| + |q − c| < 2 d < R_c`, so it is in the row and the descent would
-    /// have moved to it. Returns `None` when that condition fails (typically `q` farther from
-    /// the points than about the neighbour spacing), after [`MAX_DESCENT_STEPS`] steps, or for
-    /// an out-of-range `start`. Exact up to rounding of the squared distances (ties may resolve
-    /// to either point). Cost: O(steps · stride).
+    /// Greedy descent towards `q` from point `start` over the graph of `points` (the slice the
+    /// graph was built over): move to the row entry nearest to `q` while it is strictly nearer
+    /// than the current point. Returns the local minimum `c` reached and whether it is
+    /// certified to be the nearest point: at distance `d` from `q`, it is when `2d < R_c` (`R_c`
+    /// the row radius), since a point `p` nearer to `q` than `c` has
+    /// `|p − c| ≤ |p − q| + |q − c| < 2d < R_c`, so it is in the row and the descent would have
+    /// moved to it. Uncertified results (typically `q` farther from the points than about the
+    /// neighbour spacing, or [`MAX_DESCENT_STEPS`] reached) are still an upper bound on the
+    /// nearest distance. `None` for an out-of-range `start`. Exact up to rounding of the squared
+    /// distances (ties may resolve to either point). Cost: O(steps · stride).
     #[inline]
     pub(crate) fn descend(
         &self,
         points: &[[f64; 3]],
         q: &[f64; 3],
         start: u32,
-    ) -> Option<Neighbor> {
+    ) -> Option<(Neighbor, bool)> {
         let mut c = start as usize;
         let mut dc = dist2(q, points.get(c)?);
+        let mut certified = false;
         for _ in 0..MAX_DESCENT_STEPS {
             let row = &self.targets[c * self.stride..(c + 1) * self.stride];
             let (mut best, mut bd) = (c, dc);
@@ -229,14 +255,16 @@ impl NeighborGraph {
             }
             if best == c {
                 // 2d < R ⇔ 4d² < R², with a margin for rounding.
-                return (4.0 * dc * (1.0 + 1e-12) < self.radius2[c]).then(|| Neighbor {
-                    index: c as u32,
-                    distance: dc.sqrt(),
-                });
+                certified = 4.0 * dc * (1.0 + 1e-12) < self.radius2[c];
+                break;
             }
             (c, dc) = (best, bd);
         }
-        None
+        let n = Neighbor {
+            index: c as u32,
+            distance: dc.sqrt(),
+        };
+        Some((n, certified))
     }
 }
 

@@ -138,15 +138,20 @@ impl Target {
         self.foot_point_from(x, None).0
     }
 
-    /// The data point nearest to `x`: by certified greedy descent over the neighbour graph from
-    /// `start` when given (see `NeighborGraph::descend`), else, or when the descent cannot
-    /// certify its result, by the kd-tree. Exact either way (up to ties).
+    /// The data point nearest to `x`: by greedy descent over the neighbour graph from `start`
+    /// when given (see `NeighborGraph::descend`); when the descent cannot certify its result,
+    /// by the kd-tree, bounded by the distance the descent reached (fewer nodes visited);
+    /// without `start`, by the kd-tree. Exact either way (up to ties).
     #[inline]
     fn nearest_from(&self, x: &[f64; 3], start: Option<u32>) -> u32 {
-        start
-            .and_then(|s| self.descent_graph().descend(self.points(), x, s))
-            .unwrap_or_else(|| self.index().nearest(x))
-            .index
+        match start.and_then(|s| self.descent_graph().descend(self.points(), x, s)) {
+            Some((c, true)) => c.index,
+            Some((c, false)) => {
+                let bound = c.distance * c.distance * (1.0 + 1e-9);
+                self.index().nearest_within2(x, bound).unwrap_or(c).index
+            }
+            None => self.index().nearest(x).index,
+        }
     }
 
     /// [`Self::foot_point`] with the nearest-point search started at `start`; also returns the

@@ -65,7 +65,7 @@ fn check_estimates(
     }
 }
 
-/// `foot_points_hinted` agrees with `foot_points` (the certified descent is exact; only exact
+/// `foot_points` agrees with `foot_point`, and `foot_points_hinted` with `foot_points` (the certified descent is exact; only exact
 /// distance ties may resolve differently, so at most 0.1 % may differ, and then within the
 /// foot-point accuracy), cold and after moving the queries slightly; the hints returned are the
 /// nearest data points; out-of-range hints are ignored.
@@ -88,6 +88,10 @@ fn check_hinted(
         }
         differ
     };
+    // The batch (descent from the previous query, bounded kd-tree fallback) against one query at
+    // a time (kd-tree first).
+    let single: Vec<_> = queries.iter().map(|&q| t.foot_point(q)).collect();
+    compare("single", feet, &single);
     let mut hints = vec![u32::MAX; queries.len()];
     // Some hints out of range: treated as none.
     for (q, h) in hints.iter_mut().enumerate().step_by(5) {
