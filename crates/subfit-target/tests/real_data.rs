@@ -37,15 +37,14 @@ const CLOSED: &[&str] = &[
 ];
 
 /// Known failures, reported but not asserted (open issue 4): lucy.ply (7.5k points, a sparse
-/// decimation with thin parts): ~90 %; about 5 % of its estimated normals are more than 60° off
-/// the mesh's, whatever the sign. Measured limits of the local approach there: 3.4 % of lucy's
-/// points have their nearest neighbour on an opposite-facing sheet (|cos| > 0.3 the wrong way;
-/// Igea 0.001 %, bunny 0.09 %); PCA directions at the best fixed k (10) are within 45° at only
-/// 87 % of points (98.5 % with an oracle choice of k per point); and even with the mesh's own
-/// normal directions (random signs), the MST propagation here reaches at most 98.0 % (graph k 6–16,
-/// tangent penalty 0–3), and a
-/// dipole-field (winding-number gradient) re-orientation 98.6 %. Reaching 99.5 % needs a global
-/// method (e.g. winding-number or visibility based), not a better-tuned local one.
+/// decimation with thin parts): ~90 %; about 5 % of its estimated normals are more than 60° off the
+/// mesh's, whatever the sign. Measured limits of the local approach there: 3.4 % of lucy's points
+/// have their nearest neighbour on an opposite-facing sheet (|cos| > 0.3 the wrong way; Igea 0.001
+/// %, bunny 0.09 %); PCA directions at the best fixed k (10) are within 45° at only 87 % of points
+/// (98.5 % with an oracle choice of k per point); and even with the mesh's own normal directions
+/// (random signs), the MST propagation here reaches at most 98.0 % (graph k 6–16, tangent penalty
+/// 0–3), and a dipole-field (winding-number gradient) re-orientation 98.6 %. Reaching 99.5 % needs
+/// a global method (e.g. winding-number or visibility based), not a better-tuned local one.
 const KNOWN_HARD: &[&str] = &["lucy.ply"];
 
 fn face_normals(mesh: &PolyMesh) -> Vec<[f64; 3]> {
