@@ -241,11 +241,13 @@ impl Target {
     /// the hint. Greedy descent alone is not exact (it can stop at a local minimum); its result
     /// is accepted only when certified — at the local minimum `c`, at distance `d` from the
     /// query, `2d` is less than the distance from `c` to its 16th neighbour, which proves no
-    /// other point is nearer — and otherwise the kd-tree is queried. So the results equal
+    /// other point is nearer — and otherwise the kd-tree is asked for the nearest point within
+    /// distance `d` (exact, and cheaper than an unbounded query). So the results equal
     /// [`Self::foot_points`]' (up to exact distance ties); the hints only save time. Queries
-    /// farther from the data than about the neighbour spacing usually fall back to the kd-tree.
-    /// Parallel over chunks of consecutive queries, no reordering: cost O(#Q · steps · 16)
-    /// when the hints are good.
+    /// farther from the data than about the neighbour spacing (`d` above about 1.1 spacings)
+    /// usually need that kd-tree query, so the gain is largest near convergence. Parallel over
+    /// chunks of consecutive queries, no reordering (give them in a spatially coherent order):
+    /// cost O(#Q · steps · 16) when the hints are good.
     ///
     /// # Panics
     /// If `hints.len() != xs.len()` (a caller bug, like a length mismatch in
