@@ -50,13 +50,16 @@ pub struct LimitSamples {
 /// refinement `level`.
 ///
 /// Errors: bad topology, or non-triangles for Loop (see [`SubdivError`]).
-/// Cost: `l` refinements and adjacency builds, then one fused pass producing the three
-/// products; memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15 (Catmull-Clark)
-/// control points per row. Measured (`benches/stencils.rs`, release, CPU time summed over
-/// threads on a shared, loaded 2-core machine): 10k-face control meshes at level 3 take ≈ 0.65 s
-/// for Loop (320k rows, 11M entries) and ≈ 1.9 s for Catmull-Clark (686k rows, 30M entries);
-/// 1k-face meshes ≈ 0.06 s and 0.15 s. About 60 % of it is the two sparse products of the last
-/// level, the rest refinement, adjacency builds and page faults on the output.
+/// Cost: `l` adjacency builds (parallel) and `l` parallel sparse products whose left rows are
+/// generated on the fly (refinement rows for `P_k = M_k · P_{k−1}`, Catmull-Clark face points
+/// first and then reused as single rows; limit rows for the last, fused product giving the three
+/// matrices); memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15 (Catmull-Clark)
+/// control points per row. Measured (`benches/stencils.rs`, release, shared 2-core machine under
+/// load): 10k-face control meshes at level 3 take ≈ 0.7–1 s CPU for Loop (320k rows, 11M
+/// entries) and ≈ 2 s for Catmull-Clark (686k rows, 30M entries); one-thread instruction counts
+/// (cachegrind) 3.5 G and 8.1 G. Most of it is the last level's two products (scattered reads of
+/// `P_{l−1}` / `P_l` rows and scattered accumulation), then page faults on the ~0.4 GB output
+/// and the adjacency builds.
 pub fn sampling_operator(
     faces: &Polygons,
     num_vertices: usize,
