@@ -190,7 +190,7 @@ pub(crate) struct NeighborGraph {
 
 /// Descent steps after which [`NeighborGraph::descend`] gives up (the caller falls back to the
 /// kd-tree). Descents from a nearby start take a handful.
-const MAX_DESCENT_STEPS: usize = 48;
+const MAX_DESCENT_STEPS: usize = 16;
 
 #[inline]
 fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {

@@ -139,18 +139,15 @@ impl Target {
     }
 
     /// The data point nearest to `x`: by greedy descent over the neighbour graph from `start`
-    /// when given (see `NeighborGraph::descend`); when the descent cannot certify its result,
-    /// by the kd-tree, bounded by the distance the descent reached (fewer nodes visited);
-    /// without `start`, by the kd-tree. Exact either way (up to ties).
+    /// when given (see `NeighborGraph::descend`), else, or when the descent cannot certify its
+    /// result, by the kd-tree. Exact either way (up to ties). (A kd-tree radius query bounded by
+    /// the descent's distance was tried for the fallback: no faster on Igea, and much slower
+    /// when the start is poor, as the radius then holds many points.)
     #[inline]
     fn nearest_from(&self, x: &[f64; 3], start: Option<u32>) -> u32 {
         match start.and_then(|s| self.descent_graph().descend(self.points(), x, s)) {
             Some((c, true)) => c.index,
-            Some((c, false)) => {
-                let bound = c.distance * c.distance * (1.0 + 1e-9);
-                self.index().nearest_within2(x, bound).unwrap_or(c).index
-            }
-            None => self.index().nearest(x).index,
+            _ => self.index().nearest(x).index,
         }
     }
 
@@ -241,11 +238,10 @@ impl Target {
     /// the hint. Greedy descent alone is not exact (it can stop at a local minimum); its result
     /// is accepted only when certified — at the local minimum `c`, at distance `d` from the
     /// query, `2d` is less than the distance from `c` to its 16th neighbour, which proves no
-    /// other point is nearer — and otherwise the kd-tree is asked for the nearest point within
-    /// distance `d` (exact, and cheaper than an unbounded query). So the results equal
+    /// other point is nearer — and otherwise the kd-tree is queried. So the results equal
     /// [`Self::foot_points`]' (up to exact distance ties); the hints only save time. Queries
     /// farther from the data than about the neighbour spacing (`d` above about 1.1 spacings)
-    /// usually need that kd-tree query, so the gain is largest near convergence. Parallel over
+    /// usually need the kd-tree, so the gain is largest near convergence. Parallel over
     /// chunks of consecutive queries, no reordering (give them in a spatially coherent order):
     /// cost O(#Q · steps · 16) when the hints are good.
     ///
