@@ -4,7 +4,7 @@
 //! appears, and edge flips in high-error regions.
 //!
 //! Everything here works on triangle control meshes (Loop); the stage driver in
-//! [`crate::stages`] does not refine Catmull-Clark cages.
+//! [`crate::fit_stages`] does not refine Catmull-Clark cages.
 
 use std::collections::HashMap;
 

@@ -123,6 +123,11 @@ impl<'t> Fitter<'t> {
         &self.op
     }
 
+    /// Foot points of `xs` from the source the options name (normalized coordinates).
+    pub fn foot_points(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
+        crate::feet::foot_points(self.target, self.options.foot_points, xs)
+    }
+
     /// The pattern of the normal matrix.
     pub fn pattern(&self) -> &Pattern {
         &self.pattern
@@ -149,7 +154,7 @@ impl<'t> Fitter<'t> {
         let t0 = Instant::now();
         let samples = self.op.position.apply(control);
         let t1 = Instant::now();
-        let feet = self.target.foot_points(&samples);
+        let feet = crate::feet::foot_points(self.target, self.options.foot_points, &samples);
         let t2 = Instant::now();
         let stats = self.stats(control, &samples, &feet);
         t.sample += t1 - t0;

@@ -48,6 +48,7 @@
 pub mod adapt;
 pub mod assemble;
 mod error;
+pub mod feet;
 mod fitter;
 mod options;
 pub mod ordering;
@@ -59,6 +60,7 @@ mod stages;
 pub mod terms;
 
 pub use error::{FitError, FitPhase};
+pub use feet::FootPointSource;
 pub use fitter::{fit, FitResult, Fitter};
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};

@@ -2,6 +2,8 @@
 
 use subfit_subdiv::Scheme;
 
+use crate::feet::FootPointSource;
+
 pub use crate::ordering::FillOrdering;
 pub use crate::terms::Method;
 
@@ -152,6 +154,9 @@ pub struct FitOptions {
     pub pcg_tolerance: f64,
     /// PCG iteration cap per solve. Default 500.
     pub pcg_max_iterations: usize,
+    /// Where foot points come from: the target's triangles when it has them (default), or
+    /// always the local quadrics.
+    pub foot_points: FootPointSource,
 }
 
 impl Default for FitOptions {
@@ -176,6 +181,7 @@ impl Default for FitOptions {
             pcg_min_points: 2000,
             pcg_tolerance: 1e-2,
             pcg_max_iterations: 500,
+            foot_points: FootPointSource::Auto,
         }
     }
 }

@@ -21,6 +21,7 @@ use crate::adapt::{
     RefineStats,
 };
 use crate::error::FitError;
+use crate::feet::FootPointSource;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
 use crate::report::{ErrorStats, FitReport, IterationRow};
@@ -349,12 +350,12 @@ pub fn fit_stages(
 fn sample_face_errors(target: &Target, mesh: &PolyMesh, fitter: &Fitter<'_>) -> Vec<FaceError> {
     let op = fitter.sampling_operator();
     let samples = op.position.apply(&mesh.positions);
-    let err2 = squared_errors(target, &samples);
+    let err2 = squared_errors(target, fitter.options().foot_points, &samples);
     face_errors(&mesh.faces, op, &err2)
 }
 
-fn squared_errors(target: &Target, samples: &[[f64; 3]]) -> Vec<f64> {
-    let feet = target.foot_points(samples);
+fn squared_errors(target: &Target, source: FootPointSource, samples: &[[f64; 3]]) -> Vec<f64> {
+    let feet = crate::feet::foot_points(target, source, samples);
     samples
         .par_iter()
         .zip(feet.par_iter())
@@ -403,7 +404,11 @@ fn flip_pass(
         base.sample_level,
     )?;
     let samples = op.position.apply(&mesh.positions);
-    let new_errors = face_errors(&flipped, &op, &squared_errors(target, &samples));
+    let new_errors = face_errors(
+        &flipped,
+        &op,
+        &squared_errors(target, base.foot_points, &samples),
+    );
     // Faces incident to each vertex of the old mesh (the same faces are incident to a, b, c,
     // d in both meshes).
     let mut vf: Vec<Vec<u32>> = vec![Vec::new(); mesh.num_vertices()];

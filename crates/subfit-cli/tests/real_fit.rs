@@ -1,0 +1,173 @@
+//! `subfit fit` on the real models of `$SUBFIT_DATA` (issue 6): Igea as a point cloud against
+//! Cheng 2007 Table IV, genus kept through fitting on fertility (genus 4) and the armadillo,
+//! and the fitted limit surface against our own QEM simplification at the same vertex count.
+//!
+//! Without `SUBFIT_DATA`: fails when `CI=true`, else prints a notice and passes.
+#![allow(clippy::print_stdout)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn data_dir() -> Option<PathBuf> {
+    match std::env::var_os("SUBFIT_DATA") {
+        Some(d) => Some(PathBuf::from(d)),
+        None => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
+            );
+            println!("notice: SUBFIT_DATA not set, skipping the real-data fitting tests");
+            None
+        }
+    }
+}
+
+fn subfit(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_subfit"))
+        .args(args)
+        .output()
+        .expect("run subfit")
+}
+
+fn json_of(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)))
+}
+
+fn report(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("report.json")).unwrap()).unwrap()
+}
+
+fn cage_topology(dir: &Path) -> serde_json::Value {
+    let info = subfit(&["info", "--json", dir.join("control.obj").to_str().unwrap()]);
+    json_of(&info)["topology"].clone()
+}
+
+#[test]
+fn igea_as_a_point_cloud_reaches_table_iv_rms_within_its_control_point_budget() {
+    let Some(data) = data_dir() else { return };
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("igea");
+    let r = subfit(&[
+        "fit",
+        data.join("igea.ply").to_str().unwrap(),
+        "--as-points",
+        "--tolerance",
+        "0.0005",
+        "--max-control-points",
+        "2385",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let rep = report(&out);
+    let (e_rms, e_max) = (
+        rep["final"]["e_rms"].as_f64().unwrap(),
+        rep["final"]["e_max"].as_f64().unwrap(),
+    );
+    let n = rep["control_points"].as_u64().unwrap();
+    println!("igea (points): {n} control points, E_rms {e_rms:.3e}, E_max {e_max:.3e}");
+    // Cheng 2007 Table IV: E_rms 0.0005 with 2,385 control points (unit cube).
+    assert!(e_rms <= 0.0005, "{e_rms}");
+    assert!(n <= 2385, "{n}");
+    assert_eq!(rep["init"]["source"], "Contour");
+    let topo = cage_topology(&out);
+    assert_eq!(topo["genus"], 0, "{topo}");
+    assert_eq!(topo["manifold"], true, "{topo}");
+    assert_eq!(topo["closed"], true, "{topo}");
+}
+
+#[test]
+fn fitting_keeps_the_genus_of_fertility_and_the_armadillo() {
+    let Some(data) = data_dir() else { return };
+    let d = tempfile::tempdir().unwrap();
+    for (file, genus) in [("fertility.off", 4), ("armadillo.obj", 0)] {
+        let out = d.path().join(file);
+        let r = subfit(&[
+            "fit",
+            data.join(file).to_str().unwrap(),
+            "--tolerance",
+            "0.001",
+            "--max-control-points",
+            "1500",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        // Exit 1 (tolerance missed, outputs written) is reported, not hidden: see below.
+        assert!(
+            matches!(r.status.code(), Some(0 | 1)),
+            "{file}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        let rep = report(&out);
+        let e_rms = rep["final"]["e_rms"].as_f64().unwrap();
+        println!(
+            "{file}: {} control points, E_rms {e_rms:.3e}, tolerance reached: {}",
+            rep["control_points"], rep["tolerance_reached"]
+        );
+        let topo = cage_topology(&out);
+        assert_eq!(topo["genus"], genus, "{file}: {topo}");
+        assert_eq!(topo["manifold"], true, "{file}: {topo}");
+        assert_eq!(topo["boundary_loops"], 0, "{file}: {topo}");
+        if file == "armadillo.obj" {
+            assert!(e_rms <= 0.001, "{file}: {e_rms}");
+        }
+    }
+}
+
+#[test]
+fn the_fitted_limit_surface_beats_qem_simplification_at_equal_vertex_count() {
+    let Some(data) = data_dir() else { return };
+    let d = tempfile::tempdir().unwrap();
+    for file in ["bunny.off", "armadillo.obj"] {
+        let target = data.join(file);
+        let qem = d.path().join(format!("{file}.qem.obj"));
+        let r = subfit(&[
+            "init",
+            target.to_str().unwrap(),
+            "--control-points",
+            "300",
+            "-o",
+            qem.to_str().unwrap(),
+        ]);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        // The QEM mesh is the initial cage; fit it without changing its connectivity.
+        let out = d.path().join(format!("{file}.fit"));
+        let r = subfit(&[
+            "fit",
+            target.to_str().unwrap(),
+            "--init",
+            qem.to_str().unwrap(),
+            "--no-refine",
+            "--tolerance",
+            "0.00001",
+            "--max-iterations",
+            "12",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            matches!(r.status.code(), Some(0 | 1)),
+            "{}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert_eq!(report(&out)["control_points"], 300);
+        let compare = |a: &Path| -> f64 {
+            let r = subfit(&[
+                "compare",
+                a.to_str().unwrap(),
+                target.to_str().unwrap(),
+                "--json",
+            ]);
+            json_of(&r)["two_sided_rms"].as_f64().unwrap()
+        };
+        let (e_fit, e_qem) = (compare(&out.join("limit.ply")), compare(&qem));
+        println!("{file}: two-sided RMS, limit of the fitted 300-point cage {e_fit:.3e}, QEM 300 vertices {e_qem:.3e}");
+        assert!(e_fit < e_qem, "{file}: {e_fit} vs {e_qem}");
+    }
+}
