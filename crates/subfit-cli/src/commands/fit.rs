@@ -160,8 +160,8 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
                 expected_genus,
                 ..InitOptions::default()
             };
-            let (m, r) = initial_control_mesh(&target, mesh, n, &init_options)
-                .with_context(|| {
+            let (m, r) =
+                initial_control_mesh(&target, mesh, n, &init_options).with_context(|| {
                     format!(
                         "{}: cannot build an initial control mesh",
                         a.target.display()
@@ -268,17 +268,17 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
     let (limit, level, chord) =
         limit_tessellation(&fitted.faces, &fitted.positions, scheme, last.e_rms)?;
     // Local error of every limit vertex: its distance to the target (unit-cube units).
-    let local: Vec<f64> = target
-        .foot_points(&limit.positions)
-        .iter()
-        .zip(&limit.positions)
-        .map(|(f, p)| {
-            (0..3)
-                .map(|k| (p[k] - f.point[k]).powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .collect();
+    let local: Vec<f64> =
+        subfit::fit::feet::foot_points(&target, options.foot_points, &limit.positions)
+            .iter()
+            .zip(&limit.positions)
+            .map(|(f, p)| {
+                (0..3)
+                    .map(|k| (p[k] - f.point[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .collect();
     let scale = a.error_scale.unwrap_or(last.e_max).max(f64::MIN_POSITIVE);
     let limit = PolyMesh {
         positions: limit
