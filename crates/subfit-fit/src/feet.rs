@@ -32,6 +32,26 @@ pub fn foot_points(target: &Target, source: FootPointSource, xs: &[[f64; 3]]) ->
     }
 }
 
+/// [`foot_points`] warm-started for samples that moved little since the last call: `hints`
+/// holds, per sample, the nearest data point found last time (resized to `xs.len()` with
+/// "no hint"; updated). Same results as [`foot_points`] (the quadric path certifies every
+/// warm-started nearest point or falls back to the kd-tree; see
+/// [`Target::foot_points_hinted`]); the triangle path needs no hints.
+pub fn foot_points_hinted(
+    target: &Target,
+    source: FootPointSource,
+    xs: &[[f64; 3]],
+    hints: &mut Vec<u32>,
+) -> Vec<FootPoint> {
+    match source {
+        FootPointSource::Auto if target.mesh().is_some() => foot_points(target, source, xs),
+        _ => {
+            hints.resize(xs.len(), u32::MAX);
+            target.foot_points_hinted(xs, hints)
+        }
+    }
+}
+
 /// The foot point of `x` on the target's triangles (falls back to the quadric foot point when
 /// the target has no triangles or the closest triangle is degenerate).
 pub fn mesh_foot_point(target: &Target, x: [f64; 3]) -> FootPoint {

@@ -43,6 +43,8 @@ pub struct Fitter<'t> {
     q: Vec<Mat3>,
     bbox_diagonal: f64,
     setup: Duration,
+    /// Nearest data point of every sample at the last projection (warm start).
+    hints: std::sync::Mutex<Vec<u32>>,
 }
 
 impl<'t> Fitter<'t> {
@@ -105,6 +107,7 @@ impl<'t> Fitter<'t> {
             q: Vec::new(),
             bbox_diagonal,
             setup: t0.elapsed(),
+            hints: std::sync::Mutex::new(Vec::new()),
         })
     }
 
@@ -154,7 +157,20 @@ impl<'t> Fitter<'t> {
         let t0 = Instant::now();
         let samples = self.op.position.apply(control);
         let t1 = Instant::now();
-        let feet = crate::feet::foot_points(self.target, self.options.foot_points, &samples);
+        let feet = {
+            // Samples move little between calls: warm-start the nearest-point search from the
+            // last call's answers (a poisoned lock only loses the hints).
+            let mut hints = self
+                .hints
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            crate::feet::foot_points_hinted(
+                self.target,
+                self.options.foot_points,
+                &samples,
+                &mut hints,
+            )
+        };
         let t2 = Instant::now();
         let stats = self.stats(control, &samples, &feet);
         t.sample += t1 - t0;

@@ -349,7 +349,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         "tolerance_reached": reached,
         "stages": report.stages.iter().map(stage_json).collect::<Vec<_>>(),
         "iterations": report.stages.iter().flat_map(|s| s.fit.iterations.iter().map(move |r| row_json(s.stage, r))).collect::<Vec<_>>(),
-        "limit_tessellation": { "level": level, "estimated_chordal_error": chord },
+        "limit_tessellation": { "level": level, "predicted_chordal_error": chord },
         "error_color_scale_unit_cube": scale,
         "timings_s": {
             "read": read_time.as_secs_f64(),
@@ -526,12 +526,13 @@ pub fn log_csv(r: &StagesReport) -> String {
     s
 }
 
-/// The limit surface tessellated at the coarsest level whose chordal error, estimated as the
-/// largest distance between the level-`L+1` limit point of an edge and the midpoint of the
-/// limit points of its ends, is at most a tenth of `e_rms` — or the finest level with at most
-/// [`MAX_TESSELLATION_VERTICES`] vertices (up to level [`MAX_TESSELLATION_LEVEL`]).
-/// Returns the mesh (positions, limit normals, faces), the level and the estimate (NaN when
-/// the next level was not built).
+/// The limit surface tessellated at the coarsest level whose chordal error is at most a tenth
+/// of `e_rms` — or the finest level with at most [`MAX_TESSELLATION_VERTICES`] vertices (up
+/// to level [`MAX_TESSELLATION_LEVEL`]). The chordal error of level 1 is measured (the largest
+/// distance between the level-2 limit point of an edge and the midpoint of the limit points of
+/// its ends) and divided by 4 per level, as it shrinks with the square of the edge length on a
+/// smooth surface; so only levels 1, 2 and the chosen one are built. Returns the mesh
+/// (positions, limit normals, faces), the level and the predicted chordal error.
 pub fn limit_tessellation(
     faces: &Polygons,
     control: &[[f64; 3]],
@@ -541,33 +542,31 @@ pub fn limit_tessellation(
     let opts = Options::new(scheme);
     let tags = Tags::new();
     let goal = 0.1 * e_rms;
+    let one = sampling_operator(faces, control.len(), &tags, &opts, 1)?;
+    let two = sampling_operator(faces, control.len(), &tags, &opts, 2)?;
+    let chord1 = chordal_estimate(&one.faces, one.num_vertices, &two.position.apply(control));
     let mut level = 1;
-    let mut current = sampling_operator(faces, control.len(), &tags, &opts, level)?;
-    let mut chord = f64::NAN;
-    loop {
-        // Each level has about four times the vertices of the previous one.
-        let next_too_big = current.num_vertices.saturating_mul(4) > MAX_TESSELLATION_VERTICES;
-        if next_too_big || level + 1 > MAX_TESSELLATION_LEVEL {
-            break;
-        }
-        let next = sampling_operator(faces, control.len(), &tags, &opts, level + 1)?;
-        let fine = next.position.apply(control);
-        chord = chordal_estimate(&current.faces, current.num_vertices, &fine);
-        if chord <= goal {
-            break;
-        }
-        current = next;
+    let mut vertices = one.num_vertices;
+    while level < MAX_TESSELLATION_LEVEL
+        && chord1 / 4f64.powi(level as i32 - 1) > goal
+        && vertices.saturating_mul(4) <= MAX_TESSELLATION_VERTICES
+    {
         level += 1;
-        chord = f64::NAN;
+        vertices = vertices.saturating_mul(4);
     }
-    let s = current.evaluate(control);
+    let op = match level {
+        1 => one,
+        2 => two,
+        l => sampling_operator(faces, control.len(), &tags, &opts, l)?,
+    };
+    let s = op.evaluate(control);
     let mesh = PolyMesh {
         positions: s.positions,
         normals: Some(s.normals),
         colors: None,
-        faces: current.faces,
+        faces: op.faces,
     };
-    Ok((mesh, level, chord))
+    Ok((mesh, level, chord1 / 4f64.powi(level as i32 - 1)))
 }
 
 /// Largest `|fine[V + e] − (fine[a] + fine[b]) / 2|` over the edges `e = (a, b)` of the coarse
