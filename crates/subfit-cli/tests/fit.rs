@@ -192,3 +192,31 @@ fn demo_fits_the_builtin_shapes_end_to_end() {
         assert!(out.join(format!("fit-{shape}/control.usda")).exists());
     }
 }
+
+#[test]
+fn bad_targets_exit_with_2_and_write_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    let empty = d.path().join("empty.xyz");
+    std::fs::write(&empty, b"").unwrap();
+    let five = d.path().join("five.xyz");
+    std::fs::write(&five, b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n").unwrap();
+    // Three triangles on one edge (a fin): not a manifold surface.
+    let fin = d.path().join("fin.obj");
+    std::fs::write(
+        &fin,
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+    )
+    .unwrap();
+    for (target, needle) in [
+        (&empty, "empty.xyz"),
+        (&five, "five.xyz"),
+        (&fin, "fin.obj"),
+    ] {
+        let out = d.path().join("out");
+        let r = subfit(&["fit", target.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        assert_eq!(r.status.code(), Some(2), "{}", target.display());
+        let msg = String::from_utf8_lossy(&r.stderr);
+        assert!(msg.contains(needle), "{msg}");
+        assert!(!out.join("control.obj").exists() && !out.join("report.json").exists());
+    }
+}
