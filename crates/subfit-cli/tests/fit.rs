@@ -217,6 +217,9 @@ fn bad_targets_exit_with_2_and_write_nothing() {
         assert_eq!(r.status.code(), Some(2), "{}", target.display());
         let msg = String::from_utf8_lossy(&r.stderr);
         assert!(msg.contains(needle), "{msg}");
+        if needle == "fin.obj" {
+            assert!(msg.contains("shared by 3 faces"), "{msg}");
+        }
         assert!(!out.join("control.obj").exists() && !out.join("report.json").exists());
     }
 }

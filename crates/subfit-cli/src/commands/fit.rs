@@ -109,13 +109,13 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
     };
     let read_time = t0.elapsed();
 
+    let target_topology = mesh_topology(&target_mesh)
+        .with_context(|| format!("{}: the target mesh is not usable", a.target.display()))?;
     let sp = crate::progress::spinner("analysing the target");
     let target = Target::build(&target_mesh, &TargetOptions::default(), None)
         .with_context(|| format!("{}: cannot use as a target", a.target.display()))?;
     sp.finish_and_clear();
     let preprocess = target.stats().timings.total;
-    let target_topology = mesh_topology(&target_mesh)
-        .with_context(|| format!("{}: the target mesh is not usable", a.target.display()))?;
 
     // The initial control mesh, in normalized units.
     let t_init = Instant::now();
