@@ -79,6 +79,10 @@ pub struct CompareArgs {
     /// Random seed of the sampling.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Treat A as a control mesh and compare its exact limit surface under this scheme
+    /// (`auto`: Loop for triangle meshes, Catmull-Clark otherwise).
+    #[arg(long, value_enum)]
+    pub scheme: Option<SchemeArg>,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,

@@ -223,3 +223,53 @@ fn bad_targets_exit_with_2_and_write_nothing() {
         assert!(!out.join("control.obj").exists() && !out.join("report.json").exists());
     }
 }
+
+#[test]
+fn compare_measures_the_exact_limit_surface_of_a_cage() {
+    let d = tempfile::tempdir().unwrap();
+    let cage = d.path().join("torus.ply");
+    save(&cage, &torus_mesh(0.35, 0.15, 12, 6, true));
+    let fine = d.path().join("limit.ply");
+    let r = subfit(&[
+        "subdivide",
+        cage.to_str().unwrap(),
+        "--levels",
+        "5",
+        "--limit",
+        "-o",
+        fine.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let compare = |extra: &[&str]| -> serde_json::Value {
+        let mut args = vec![
+            "compare",
+            cage.to_str().unwrap(),
+            fine.to_str().unwrap(),
+            "--samples",
+            "4000",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let r = subfit(&args);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        serde_json::from_slice(&r.stdout).unwrap()
+    };
+    // The cage itself lies far from its limit surface; the exact limit surface coincides with
+    // the fine limit tessellation up to its chordal error (vertices exact, ~1e-4 between).
+    let as_mesh = compare(&[])["hausdorff"].as_f64().unwrap();
+    let as_limit = compare(&["--scheme", "loop"]);
+    let h = as_limit["hausdorff"].as_f64().unwrap();
+    assert!(as_mesh > 0.01, "{as_mesh}");
+    assert!(h < 1e-3 && h < as_mesh / 20.0, "{as_limit}");
+    // A point cloud cannot be evaluated as a limit surface.
+    let cloud = d.path().join("cloud.xyz");
+    std::fs::write(&cloud, "0 0 0\n1 0 0\n0 1 0\n0 0 1\n".repeat(4)).unwrap();
+    let r = subfit(&[
+        "compare",
+        cloud.to_str().unwrap(),
+        fine.to_str().unwrap(),
+        "--scheme",
+        "loop",
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+}

@@ -4,16 +4,21 @@
 //! exact closest point on its triangles (BVH); a point set is used as it is and queried through
 //! its nearest point (kd-tree). Distances are reported in the units of the files and as a
 //! fraction of B's bounding-box diagonal: RMS, mean and max in each direction, the two-sided RMS
-//! over both sample sets, and the Hausdorff distance (the larger max). Limit surfaces of control
-//! meshes are compared by tessellating them first (`subfit subdivide --limit`).
+//! over both sample sets, and the Hausdorff distance (the larger max). With `--scheme`, A is a
+//! control mesh and its exact limit surface is used: samples are exact limit points at random
+//! `(face, u, v)` (uniform in each patch's parameters, not by area), and distances to it are
+//! exact closest points on the limit surface (BVH start, Newton in `(u, v)`).
 
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use rayon::prelude::*;
 use serde::Serialize;
-use subfit::mesh::PolyMesh;
+use subfit::mesh::{PolyMesh, Tags};
+use subfit::subdiv::{random_samples, ClosestOptions, ClosestPointFinder, Evaluator, Options};
 use subfit::target::{PointIndex, TriangleBvh};
+
+use crate::commands::subdivide::pick_scheme;
 
 use crate::cli::CompareArgs;
 
@@ -62,20 +67,50 @@ struct Comparison {
 pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
     let (ma, _) = crate::progress::load(&a.a)?;
     let (mb, _) = crate::progress::load(&a.b)?;
-    let sa = surface(&ma, a.samples as usize, a.seed).with_context(|| a.a.display().to_string())?;
     let sb = surface(&mb, a.samples as usize, a.seed ^ 0x9e37_79b9)
         .with_context(|| a.b.display().to_string())?;
     let sp = crate::progress::spinner("measuring distances");
-    let dab: Vec<f64> = sa
-        .samples
-        .par_iter()
-        .map(|&x| sb.query.distance(x))
-        .collect();
-    let dba: Vec<f64> = sb
-        .samples
-        .par_iter()
-        .map(|&x| sa.query.distance(x))
-        .collect();
+    let (dab, dba): (Vec<f64>, Vec<f64>) = if let Some(scheme) = a.scheme {
+        if ma.faces.is_empty() {
+            bail!(
+                "{}: --scheme needs a control mesh with faces",
+                a.a.display()
+            );
+        }
+        let ctx = || format!("{}: cannot evaluate its limit surface", a.a.display());
+        let options = Options::new(pick_scheme(scheme, &ma));
+        let ev = Evaluator::new(&ma.faces, ma.num_vertices(), &Tags::new(), &options)
+            .with_context(ctx)?;
+        let (_, points) =
+            random_samples(&ev, &ma.positions, a.samples as usize, a.seed).with_context(ctx)?;
+        let finder = ClosestPointFinder::new(&ev, &ma.positions, ClosestOptions::default())
+            .with_context(ctx)?;
+        let dab = points
+            .par_iter()
+            .map(|p| sb.query.distance(p.position))
+            .collect();
+        let dba = sb
+            .samples
+            .par_iter()
+            .map(|&x| finder.closest(x).map(|c| c.distance))
+            .collect::<Result<Vec<f64>, _>>()
+            .with_context(ctx)?;
+        (dab, dba)
+    } else {
+        let sa =
+            surface(&ma, a.samples as usize, a.seed).with_context(|| a.a.display().to_string())?;
+        let dab = sa
+            .samples
+            .par_iter()
+            .map(|&x| sb.query.distance(x))
+            .collect();
+        let dba = sb
+            .samples
+            .par_iter()
+            .map(|&x| sa.query.distance(x))
+            .collect();
+        (dab, dba)
+    };
     sp.finish_and_clear();
     let (ab, ba) = (stats(&dab), stats(&dba));
     let n = (dab.len() + dba.len()) as f64;
