@@ -183,6 +183,9 @@ pub struct FitArgs {
     /// No edge flips between stages.
     #[arg(long)]
     pub no_flips: bool,
+    /// Split a face of the initial cage at most this many times (levels of local refinement).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=12))]
+    pub max_depth: u8,
     /// Error that maps to red in error.ply (unit-cube units) [default: the final E_max].
     #[arg(long)]
     pub error_scale: Option<f64>,

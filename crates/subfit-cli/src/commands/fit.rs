@@ -209,6 +209,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         max_control_points: a.max_control_points as usize,
         refine: !a.no_refine,
         edge_flips: !(a.no_refine || a.no_flips),
+        max_depth: a.max_depth,
         ..StageOptions::default()
     };
     if !a.no_refine && scheme != Scheme::Loop {
@@ -340,6 +341,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
             "max_control_points": stages.max_control_points,
             "refine": stages.refine,
             "edge_flips": stages.edge_flips,
+            "max_depth": stages.max_depth,
         },
         "control_points": fitted.num_vertices(),
         "control_faces": fitted.faces.len(),
