@@ -6,8 +6,11 @@
 
 #![allow(clippy::print_stderr)]
 
-use std::path::PathBuf;
+mod common;
+
 use std::process::Command;
+
+use common::data_dir;
 
 /// `(file, vertices, faces, boundary loops, genus)`; `None` genus for point clouds.
 const TABLE: &[(&str, u64, u64, u64, Option<u64>)] = &[
@@ -25,19 +28,6 @@ const TABLE: &[(&str, u64, u64, u64, Option<u64>)] = &[
     ("rocker-arm.off", 10044, 20088, 0, Some(1)),
     ("stanford-bunny.obj", 35947, 69451, 5, Some(0)),
 ];
-
-fn data_dir() -> Option<PathBuf> {
-    match std::env::var_os("SUBFIT_DATA") {
-        Some(d) => Some(PathBuf::from(d)),
-        None if std::env::var("CI").is_ok_and(|v| v == "true") => {
-            panic!("SUBFIT_DATA is not set, and CI=true: the data tests cannot run")
-        }
-        None => {
-            eprintln!("notice: SUBFIT_DATA not set; skipping the shared-data test");
-            None
-        }
-    }
-}
 
 #[test]
 fn info_matches_sources_md_for_every_model() {

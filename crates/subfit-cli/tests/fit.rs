@@ -1,19 +1,15 @@
 //! `subfit fit` end to end on generated shapes: automatic initial mesh, multi-stage fitting with
 //! local refinement, every output file, exit codes and topology checks.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+
+use common::subfit;
 
 use subfit::io::{Encoding, WriteOptions};
 use subfit::mesh::shapes::{octahedron_mesh, torus_mesh, Shape};
 use subfit::mesh::PolyMesh;
-
-fn subfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_subfit"))
-        .args(args)
-        .output()
-        .expect("run subfit")
-}
 
 fn save(path: &Path, mesh: &PolyMesh) {
     let opts = WriteOptions {

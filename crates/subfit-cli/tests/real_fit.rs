@@ -5,29 +5,12 @@
 //! Without `SUBFIT_DATA`: fails when `CI=true`, else prints a notice and passes.
 #![allow(clippy::print_stdout)]
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn data_dir() -> Option<PathBuf> {
-    match std::env::var_os("SUBFIT_DATA") {
-        Some(d) => Some(PathBuf::from(d)),
-        None => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
-            );
-            println!("notice: SUBFIT_DATA not set, skipping the real-data fitting tests");
-            None
-        }
-    }
-}
+use std::path::Path;
+use std::process::Output;
 
-fn subfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_subfit"))
-        .args(args)
-        .output()
-        .expect("run subfit")
-}
+use common::{data_dir, subfit};
 
 fn json_of(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout)
