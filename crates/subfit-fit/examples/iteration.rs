@@ -15,8 +15,8 @@
 use std::time::Instant;
 
 use subfit_fit::{FitOptions, Fitter, Variant};
-use subfit_mesh::shapes::{octahedron_mesh, Shape};
-use subfit_mesh::{PolyMesh, Polygons, Tags};
+use subfit_mesh::shapes::{cheng_ellipsoid_cage, Shape};
+use subfit_mesh::{PolyMesh, Tags};
 use subfit_subdiv::{refine, Options, Scheme};
 use subfit_target::{Target, TargetOptions};
 
@@ -25,29 +25,6 @@ fn env(name: &str, default: usize) -> usize {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(default)
-}
-
-/// The 14-vertex ellipsoid mesh (octahedron, faces split 1-to-3 at centroids pushed onto the
-/// ellipsoid), original units.
-fn fourteen(a: f64, b: f64, c: f64) -> PolyMesh {
-    let octa = octahedron_mesh(a, b, c);
-    let mut pos = octa.positions.clone();
-    let mut faces = Polygons::new();
-    for f in octa.faces.iter() {
-        let cen: [f64; 3] = std::array::from_fn(|k| {
-            f.iter()
-                .map(|&v| octa.positions[v as usize][k])
-                .sum::<f64>()
-                / 3.0
-        });
-        let s = ((cen[0] / a).powi(2) + (cen[1] / b).powi(2) + (cen[2] / c).powi(2)).sqrt();
-        let id = pos.len() as u32;
-        pos.push([cen[0] / s, cen[1] / s, cen[2] / s]);
-        for e in 0..3 {
-            faces.push(&[f[e], f[(e + 1) % 3], id]);
-        }
-    }
-    PolyMesh::new(pos, faces)
 }
 
 fn main() {
@@ -74,7 +51,7 @@ fn main() {
         rayon::current_num_threads()
     );
     for r in refines {
-        let mut mesh = fourteen(0.25, 0.5, 1.0);
+        let mut mesh = cheng_ellipsoid_cage(0.25, 0.5, 1.0, false);
         for _ in 0..r {
             let rf = refine(
                 &mesh.faces,

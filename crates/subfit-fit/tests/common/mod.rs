@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use subfit_mesh::shapes::Shape;
-use subfit_mesh::{PolyMesh, Polygons};
+use subfit_mesh::PolyMesh;
 use subfit_target::{Target, TargetOptions};
 
 /// Semi-axes of Cheng 2007's ellipsoid (original units).
@@ -25,24 +25,7 @@ pub fn ellipsoid_target(n: usize) -> Target {
 /// 8 and 3). Cheng 2007 Example 1 starts from a 14-point control mesh of this kind.
 pub fn fourteen_vertex_mesh() -> PolyMesh {
     let [a, b, c] = AXES;
-    let octa = subfit_mesh::shapes::octahedron_mesh(a, b, c);
-    let mut pos = octa.positions.clone();
-    let mut faces = Polygons::new();
-    for f in octa.faces.iter() {
-        let cen: [f64; 3] = std::array::from_fn(|k| {
-            (octa.positions[f[0] as usize][k]
-                + octa.positions[f[1] as usize][k]
-                + octa.positions[f[2] as usize][k])
-                / 3.0
-        });
-        let s = ((cen[0] / a).powi(2) + (cen[1] / b).powi(2) + (cen[2] / c).powi(2)).sqrt();
-        let id = pos.len() as u32;
-        pos.push([cen[0] / s, cen[1] / s, cen[2] / s]);
-        for e in 0..3 {
-            faces.push(&[f[e], f[(e + 1) % 3], id]);
-        }
-    }
-    PolyMesh::new(pos, faces)
+    subfit_mesh::shapes::cheng_ellipsoid_cage(a, b, c, false)
 }
 
 /// `mesh` mapped into the target's normalized coordinates.
