@@ -58,15 +58,33 @@ impl Pattern {
     /// If `block` is not 1 or 3, or the operator and Laplacian sizes differ.
     #[track_caller]
     pub fn new(position: &StencilMatrix, lap: &Laplacian, block: usize) -> Self {
-        assert!(block == 1 || block == 3, "block size must be 1 or 3");
-        let n = position.ncols();
         assert_eq!(
             lap.len(),
-            n,
+            position.ncols(),
             "Laplacian size differs from the control-point count"
         );
+        Self::with_smoothing_rows(position, lap, block)
+    }
+
+    /// Like [`Self::new`] with a rectangular smoothing operator: `lap` holds any number of
+    /// rows over the `n = position.ncols()` unknowns, and the smoothing block is
+    /// `w_s · lapᵀ lap ⊗ I`. This is how a sub-problem over some of the control points is built
+    /// (the rows of `L` that touch them, restricted to their columns; see
+    /// [`crate::Fitter::set_active`]); [`Self::gradient`]'s smoothing part then needs `p`'s
+    /// full context and is better added by the caller (pass `w_s = 0`).
+    ///
+    /// # Panics
+    /// If `block` is not 1 or 3, or a column of `lap` is `≥ n`.
+    #[track_caller]
+    pub fn with_smoothing_rows(position: &StencilMatrix, lap: &Laplacian, block: usize) -> Self {
+        assert!(block == 1 || block == 3, "block size must be 1 or 3");
+        let n = position.ncols();
+        assert!(
+            lap.indices.iter().all(|&j| (j as usize) < n),
+            "smoothing column out of range"
+        );
         let (samp_ptr, samp) = transpose_operator(position);
-        let lap_t = lap.transpose();
+        let lap_t = transpose_rows(lap, n);
 
         // Block rows of each block column (i ≤ j), in parallel with a per-thread marker.
         let cols: Vec<Vec<u32>> = (0..n)
@@ -180,7 +198,8 @@ impl Pattern {
         &self.brow[self.bcol_ptr[j]..self.bcol_ptr[j + 1]]
     }
 
-    /// The smoothing operator the pattern was built with.
+    /// The smoothing operator the pattern was built with (`rows × n`; square for
+    /// [`Self::new`]).
     pub fn laplacian(&self) -> &Laplacian {
         &self.lap
     }
@@ -399,6 +418,36 @@ impl Pattern {
             }
         }
         out
+    }
+}
+
+/// The transpose of a CSR operator with `rows` rows over `ncols` columns: `ncols` rows, the
+/// entries of column `j` in increasing row order. Equals [`Laplacian::transpose`] for a square
+/// operator. Cost: O(nnz + ncols).
+pub(crate) fn transpose_rows(l: &Laplacian, ncols: usize) -> Laplacian {
+    let mut offsets = vec![0usize; ncols + 1];
+    for &j in &l.indices {
+        offsets[j as usize + 1] += 1;
+    }
+    for j in 0..ncols {
+        offsets[j + 1] += offsets[j];
+    }
+    let mut next = offsets.clone();
+    let mut indices = vec![0u32; l.indices.len()];
+    let mut weights = vec![0.0; l.indices.len()];
+    for r in 0..l.len() {
+        let (idx, w) = l.row(r);
+        for (&j, &w) in idx.iter().zip(w) {
+            let s = &mut next[j as usize];
+            indices[*s] = r as u32;
+            weights[*s] = w;
+            *s += 1;
+        }
+    }
+    Laplacian {
+        offsets,
+        indices,
+        weights,
     }
 }
 

@@ -10,18 +10,20 @@ use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_subdiv::{sampling_operator, Options, SamplingOperator};
 use subfit_target::{FootPoint, Target};
 
+use crate::active::{sample_rows, ActiveSet, FixedErrors};
 use crate::assemble::{weighted_residuals, Pattern};
 use crate::error::{FitError, FitPhase};
 use crate::options::{FitOptions, Method, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
-use crate::solve::{CholeskySolver, SolveFailure};
+use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
 use crate::terms::{error_matrix, Mat3};
 
 /// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
 const MU_MAX: f64 = 1e16;
 
-/// Samples and foot points of one set of control points.
+/// Samples and foot points of one set of control points (all samples, or with an active set
+/// only the samples touching an active point; `stats` are always over all samples).
 #[derive(Clone, Debug, Default)]
 struct State {
     samples: Vec<[f64; 3]>,
@@ -45,6 +47,25 @@ pub struct Fitter<'t> {
     setup: Duration,
     /// Nearest data point of every sample at the last projection (warm start).
     hints: std::sync::Mutex<Vec<u32>>,
+    /// The umbrella Laplacian over all control points.
+    lap: Laplacian,
+    /// The active set and its sub-problem ([`Self::set_active`]); `None`: all points active.
+    active: Option<ActiveSet>,
+}
+
+/// The solver the options call for with `n` unknown points of block size `block`.
+fn make_solver(options: &FitOptions, n: usize, block: usize) -> NormalSolver {
+    use crate::options::LinearSolver;
+    let pcg = match options.linear_solver {
+        LinearSolver::Auto => n >= options.pcg_min_points && block == 3,
+        LinearSolver::Cholesky => false,
+        LinearSolver::Pcg => true,
+    };
+    if pcg {
+        NormalSolver::with_pcg(options.pcg_tolerance, options.pcg_max_iterations)
+    } else {
+        NormalSolver::with_ordering(options.fill_ordering)
+    }
 }
 
 impl<'t> Fitter<'t> {
@@ -77,22 +98,12 @@ impl<'t> Fitter<'t> {
             &Options::new(options.scheme),
             options.sample_level,
         )?;
-        use crate::options::LinearSolver;
         let lap = Laplacian::umbrella(faces, num_vertices);
         let block = if options.method == Method::Pdm { 1 } else { 3 };
         let pattern = Pattern::new(&op.position, &lap, block);
         let values = vec![0.0; pattern.nnz()];
         let bbox_diagonal = bbox_diagonal(target.points());
-        let pcg = match options.linear_solver {
-            LinearSolver::Auto => num_vertices >= options.pcg_min_points && block == 3,
-            LinearSolver::Cholesky => false,
-            LinearSolver::Pcg => true,
-        };
-        let mut solver = if pcg {
-            CholeskySolver::with_pcg(options.pcg_tolerance, options.pcg_max_iterations)
-        } else {
-            CholeskySolver::with_ordering(options.fill_ordering)
-        };
+        let mut solver: CholeskySolver = make_solver(options, num_vertices, block);
         solver
             .analyse(&pattern)
             .map_err(|e| FitError::Solver(format!("symbolic analysis: {e:?}")))?;
@@ -108,7 +119,70 @@ impl<'t> Fitter<'t> {
             bbox_diagonal,
             setup: t0.elapsed(),
             hints: std::sync::Mutex::new(Vec::new()),
+            lap,
+            active: None,
         })
+    }
+
+    /// Restricts the optimization to the control points with `active[i] == true`; the others
+    /// are held fixed by [`Self::run`] (their rows and columns are eliminated: the step solves
+    /// `H_aa δ_a = −g_a`). `None` makes every point active again (the full problem, whose
+    /// pattern and factorization were kept).
+    ///
+    /// Only the samples whose stencil touches an active point are sampled, projected and
+    /// assembled during [`Self::run`], so an iteration costs in proportion to the active
+    /// region. The other samples cannot move; their squared distances are measured once per
+    /// run start at which the fixed points changed (the first run after this call, or after the
+    /// caller moved a fixed point), and cached. So every [`ErrorStats`] reported by
+    /// [`Self::run`] (initial, per iteration) is still over the whole surface, exact: fresh
+    /// foot points for the active samples plus the cached distances of the fixed ones, and
+    /// the smoothing energy of all points. [`Self::evaluate`] always samples everything.
+    ///
+    /// Building an active set costs a pass over the sampling operator, the pattern of `H_aa`
+    /// and its symbolic analysis (a new active set is a new pattern); setting the same mask
+    /// again keeps all of it. The solver (Cholesky or PCG) is chosen by the options' rule for
+    /// the number of active points.
+    ///
+    /// Errors: a mask whose length is not the control-point count, or with no active point;
+    /// a failed symbolic analysis. On error the previous active set is kept.
+    pub fn set_active(&mut self, active: Option<Vec<bool>>) -> Result<(), FitError> {
+        let Some(mask) = active else {
+            self.active = None;
+            return Ok(());
+        };
+        let n = self.pattern.num_points();
+        if mask.len() != n {
+            return Err(FitError::BadInput(format!(
+                "active mask has {} entries, the mesh has {n} control points",
+                mask.len()
+            )));
+        }
+        if !mask.contains(&true) {
+            return Err(FitError::BadInput("no active control point".into()));
+        }
+        if self.active.as_ref().is_some_and(|a| a.mask == mask) {
+            return Ok(());
+        }
+        let n_a = mask.iter().filter(|&&b| b).count();
+        let block = self.pattern.block();
+        let solver = make_solver(&self.options, n_a, block);
+        let set = ActiveSet::new(mask, &self.op.position, &self.lap, block, solver)
+            .map_err(FitError::Solver)?;
+        self.active = Some(set);
+        Ok(())
+    }
+
+    /// The active mask set by [`Self::set_active`] (`None`: all points active).
+    pub fn active(&self) -> Option<&[bool]> {
+        self.active.as_ref().map(|a| &a.mask[..])
+    }
+
+    /// Number of samples a [`Self::run`] iteration samples, projects and assembles: those
+    /// touching an active point, or all `m` without an active set.
+    pub fn num_active_samples(&self) -> usize {
+        self.active
+            .as_ref()
+            .map_or(self.num_samples(), |a| a.samples.len())
     }
 
     /// The options in use.
@@ -150,10 +224,70 @@ impl<'t> Fitter<'t> {
     /// Cost: one `C·P` and `m` foot-point queries.
     pub fn evaluate(&self, control: &[[f64; 3]]) -> ErrorStats {
         let mut t = PhaseTimings::default();
-        self.state(control, &mut t).stats
+        self.full_state(control, &mut t).stats
     }
 
+    /// The state at `control`: all samples, or with an active set the active samples (the
+    /// stats adding the cached fixed ones, which must be valid for `control`).
     fn state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State {
+        let Some(a) = &self.active else {
+            return self.full_state(control, t);
+        };
+        let t0 = Instant::now();
+        let samples = sample_rows(&self.op.position, &a.samples, control);
+        let t1 = Instant::now();
+        let feet = self.project_rows(&a.samples, &samples);
+        let t2 = Instant::now();
+        let (sum, max) = sum_max_d2(&samples, &feet);
+        let (fs, fm) = a.fixed.as_ref().map_or((0.0, 0.0), |f| (f.sum, f.max));
+        let stats = self.stats(control, sum + fs, max.max(fm));
+        t.sample += t1 - t0;
+        t.project += t2 - t1;
+        t.evaluate += t2.elapsed();
+        State {
+            samples,
+            feet,
+            stats,
+        }
+    }
+
+    /// Foot points of the samples `rows` at positions `xs`, warm-started from (and updating)
+    /// their hints.
+    fn project_rows(&self, rows: &[u32], xs: &[[f64; 3]]) -> Vec<FootPoint> {
+        let mut hints = self
+            .hints
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        hints.resize(self.num_samples(), u32::MAX);
+        let mut sub: Vec<u32> = rows.iter().map(|&k| hints[k as usize]).collect();
+        let feet =
+            crate::feet::foot_points_hinted(self.target, self.options.foot_points, xs, &mut sub);
+        for (&k, &h) in rows.iter().zip(&sub) {
+            hints[k as usize] = h;
+        }
+        feet
+    }
+
+    /// Measures the fixed samples of the active set at `control` unless the cache holds.
+    fn ensure_fixed(&mut self, control: &[[f64; 3]]) {
+        let Some(a) = &self.active else { return };
+        if a.fixed_valid(control) {
+            return;
+        }
+        let xs = sample_rows(&self.op.position, &a.fixed_samples, control);
+        let feet = self.project_rows(&a.fixed_samples, &xs);
+        let (sum, max) = sum_max_d2(&xs, &feet);
+        if let Some(a) = &mut self.active {
+            a.fixed = Some(FixedErrors {
+                control: control.to_vec(),
+                sum,
+                max,
+            });
+        }
+    }
+
+    /// The state at `control` over all samples.
+    fn full_state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State {
         let t0 = Instant::now();
         let samples = self.op.position.apply(control);
         let t1 = Instant::now();
@@ -172,7 +306,8 @@ impl<'t> Fitter<'t> {
             )
         };
         let t2 = Instant::now();
-        let stats = self.stats(control, &samples, &feet);
+        let (sum, max) = sum_max_d2(&samples, &feet);
+        let stats = self.stats(control, sum, max);
         t.sample += t1 - t0;
         t.project += t2 - t1;
         t.evaluate += t2.elapsed();
@@ -183,21 +318,15 @@ impl<'t> Fitter<'t> {
         }
     }
 
-    fn stats(&self, control: &[[f64; 3]], s: &[[f64; 3]], feet: &[FootPoint]) -> ErrorStats {
-        // Squared distances in parallel, summed serially: deterministic for any thread count.
-        let d2: Vec<f64> = s
-            .par_iter()
-            .zip(feet.par_iter())
-            .map(|(s, f)| (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum::<f64>())
-            .collect();
-        let sum: f64 = d2.iter().sum();
-        let max = d2.iter().fold(0.0f64, |a, &b| a.max(b));
-        let m = s.len().max(1) as f64;
+    /// Error statistics over all `m` samples from the sum and maximum of their squared
+    /// distances, and the smoothing energy of `control`.
+    fn stats(&self, control: &[[f64; 3]], sum: f64, max: f64) -> ErrorStats {
+        let m = self.num_samples().max(1) as f64;
         let n = control.len().max(1) as f64;
         let e_rms = (sum / m).sqrt();
         let e_max = max.sqrt();
         let smooth = if self.options.lambda > 0.0 {
-            self.options.lambda / n * self.pattern.laplacian().energy(control)
+            self.options.lambda / n * self.lap.energy(control)
         } else {
             0.0
         };
@@ -237,6 +366,7 @@ impl<'t> Fitter<'t> {
             });
         }
         let opts = self.options.clone();
+        self.ensure_fixed(control);
         let mut cur = self.state(control, &mut PhaseTimings::default());
         check_finite(cur.stats.objective, 0, FitPhase::Evaluate, "objective")?;
         let mut report = FitReport {
@@ -259,7 +389,7 @@ impl<'t> Fitter<'t> {
         };
         let mut grad: Vec<[f64; 3]> = Vec::new();
         let mut stale = true;
-        let mut trial_p = vec![[0.0; 3]; n];
+        let mut trial_p = control.to_vec();
         for it in 1..=opts.max_iterations {
             let mut t = PhaseTimings::default();
             if stale {
@@ -381,8 +511,19 @@ impl<'t> Fitter<'t> {
         let mut step_length = 1.0;
         let mut backtracks = 0;
         loop {
-            for ((p, c), d) in trial_p.iter_mut().zip(control).zip(dir.delta) {
-                *p = std::array::from_fn(|a| c[a] + step_length * d[a]);
+            match &self.active {
+                None => {
+                    for ((p, c), d) in trial_p.iter_mut().zip(control).zip(dir.delta) {
+                        *p = std::array::from_fn(|a| c[a] + step_length * d[a]);
+                    }
+                }
+                Some(set) => {
+                    trial_p.copy_from_slice(control);
+                    for (&i, d) in set.points.iter().zip(dir.delta) {
+                        let (p, c) = (&mut trial_p[i as usize], control[i as usize]);
+                        *p = std::array::from_fn(|a| c[a] + step_length * d[a]);
+                    }
+                }
             }
             let trial = self.state(trial_p, t);
             check_finite(trial.stats.objective, it, FitPhase::Evaluate, "objective")?;
@@ -422,9 +563,10 @@ impl<'t> Fitter<'t> {
         (rms > 0.0 || max > 0.0) && (rms <= 0.0 || s.e_rms <= rms) && (max <= 0.0 || s.e_max <= max)
     }
 
-    /// Fills `H` (values and its diagonal copy) at the current state; returns `g`.
+    /// Fills `H` (values and its diagonal copy) at the current state; returns `g` — over the
+    /// active points (`H_aa`, `g_a`) when an active set is in use.
     fn assemble(&mut self, control: &[[f64; 3]], cur: &State) -> Vec<[f64; 3]> {
-        let m = cur.samples.len().max(1) as f64;
+        let m = self.num_samples().max(1) as f64;
         let n = control.len().max(1) as f64;
         let (w_e, w_s) = (1.0 / m, self.options.lambda / n);
         let method = self.options.method;
@@ -436,28 +578,38 @@ impl<'t> Fitter<'t> {
                 .zip(cur.feet.par_iter())
                 .for_each(|(q, f)| *q = error_matrix(method, f));
         }
-        self.pattern
-            .fill(&self.op.position, &self.q, w_e, w_s, &mut self.values);
-        self.hdiag = self
-            .pattern
-            .diag_slots()
-            .iter()
-            .map(|&s| self.values[s])
-            .collect();
+        let (op, pattern, values) = match &mut self.active {
+            Some(a) => (&a.op, &a.pattern, &mut a.values),
+            None => (&self.op.position, &self.pattern, &mut self.values),
+        };
+        pattern.fill(op, &self.q, w_e, w_s, values);
+        self.hdiag = pattern.diag_slots().iter().map(|&s| values[s]).collect();
         let v: Vec<[f64; 3]> = cur.feet.iter().map(|f| f.point).collect();
         let q = if coupled { Some(&self.q[..]) } else { None };
         let r = weighted_residuals(&cur.samples, &v, q);
-        self.pattern.gradient(&r, control, w_e, w_s)
+        match &self.active {
+            None => self.pattern.gradient(&r, control, w_e, w_s),
+            Some(a) => {
+                let zero = vec![[0.0; 3]; a.points.len()];
+                let mut g = a.pattern.gradient(&r, &zero, w_e, 0.0);
+                a.add_smoothing_gradient(&self.lap, control, w_s, &mut g);
+                g
+            }
+        }
     }
 
     /// Solves `(H + shift·I) δ = −g`.
     fn solve_step(&mut self, g: &[[f64; 3]], shift: f64) -> Result<Vec<[f64; 3]>, SolveFailure> {
-        for (&s, &h) in self.pattern.diag_slots().iter().zip(&self.hdiag) {
-            self.values[s] = h + shift;
+        let (pattern, solver, values) = match &mut self.active {
+            Some(a) => (&a.pattern, &mut a.solver, &mut a.values),
+            None => (&self.pattern, &mut self.solver, &mut self.values),
+        };
+        for (&s, &h) in pattern.diag_slots().iter().zip(&self.hdiag) {
+            values[s] = h + shift;
         }
         let n = g.len();
         let mut rhs = vec![0.0; 3 * n];
-        let coupled = self.pattern.block() == 3;
+        let coupled = pattern.block() == 3;
         for (i, gi) in g.iter().enumerate() {
             for (a, &ga) in gi.iter().enumerate() {
                 let idx = if coupled { 3 * i + a } else { a * n + i };
@@ -465,8 +617,7 @@ impl<'t> Fitter<'t> {
             }
         }
         let nrhs = if coupled { 1 } else { 3 };
-        self.solver
-            .solve(&self.pattern, &self.values, &mut rhs, nrhs)?;
+        solver.solve(pattern, values, &mut rhs, nrhs)?;
         Ok((0..n)
             .map(|i| {
                 std::array::from_fn(|a| {
@@ -511,6 +662,19 @@ impl Damping {
         self.mu *= self.nu;
         self.nu *= 2.0;
     }
+}
+
+/// `(Σ_k d_k², max_k d_k²)` with `d_k = ‖S_k − V_k‖`: squared distances in parallel, summed
+/// serially in sample order (deterministic for any thread count).
+fn sum_max_d2(s: &[[f64; 3]], feet: &[FootPoint]) -> (f64, f64) {
+    let d2: Vec<f64> = s
+        .par_iter()
+        .zip(feet.par_iter())
+        .map(|(s, f)| (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum::<f64>())
+        .collect();
+    let sum: f64 = d2.iter().sum();
+    let max = d2.iter().fold(0.0f64, |a, &b| a.max(b));
+    (sum, max)
 }
 
 fn check_finite(

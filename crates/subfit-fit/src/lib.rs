@@ -45,6 +45,7 @@
 //! assert_eq!(original.len(), 6);
 //! ```
 
+mod active;
 pub mod adapt;
 pub mod assemble;
 mod error;
