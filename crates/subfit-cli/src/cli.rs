@@ -186,6 +186,13 @@ pub struct FitArgs {
     /// Split a face of the initial cage at most this many times (levels of local refinement).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=12))]
     pub max_depth: u8,
+    /// After a refinement, optimize only the new control points and the faces around them
+    /// (`--local-rings` rings), holding the rest fixed: faster stages on large cages.
+    #[arg(long)]
+    pub local: bool,
+    /// Rings of faces around the refined region that `--local` also optimizes.
+    #[arg(long, default_value_t = 2, requires = "local")]
+    pub local_rings: u32,
     /// Error that maps to red in error.ply (unit-cube units) [default: the final E_max].
     #[arg(long)]
     pub error_scale: Option<f64>,

@@ -269,3 +269,57 @@ fn compare_measures_the_exact_limit_surface_of_a_cage() {
     ]);
     assert_eq!(r.status.code(), Some(2));
 }
+
+/// `--local`: stages after a refinement that touched a small region optimize only that region
+/// (their `active_points` in report.json), and the fit still reaches the tolerance.
+#[test]
+fn fit_local_optimizes_only_around_refinements() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = d.path().join("torus.ply");
+    save(&cloud, &Shape::DEFAULT_TORUS.sample(30_000, 0.0, 5));
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        cloud.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--control-points",
+        "300",
+        "--tolerance",
+        "0.00001",
+        "--max-control-points",
+        "1200",
+        "--sample-level",
+        "2",
+        "--local",
+        "--local-rings",
+        "1",
+    ]);
+    assert!(
+        matches!(r.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let rep = report(&out);
+    assert_eq!(rep["options"]["local"], true, "{}", rep["options"]);
+    let stages = rep["stages"].as_array().unwrap();
+    assert!(stages[0]["active_points"].is_null());
+    let local: Vec<(u64, u64)> = stages
+        .iter()
+        .filter_map(|s| {
+            let a = s["active_points"].as_u64()?;
+            Some((a, s["control_points"].as_u64().unwrap()))
+        })
+        .collect();
+    let summary: Vec<_> = stages
+        .iter()
+        .map(|s| (s["control_points"].clone(), s["active_points"].clone()))
+        .collect();
+    assert!(!local.is_empty(), "no local stage: {summary:?}");
+    assert!(local.iter().all(|&(a, n)| a > 0 && 2 * a <= n), "{local:?}");
+    let (e0, e1) = (
+        rep["initial"]["e_rms"].as_f64().unwrap(),
+        rep["final"]["e_rms"].as_f64().unwrap(),
+    );
+    assert!(e1 < e0, "{e0} -> {e1}");
+}

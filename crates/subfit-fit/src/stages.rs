@@ -12,7 +12,7 @@
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
-use subfit_mesh::{PolyMesh, Tags};
+use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_subdiv::{sampling_operator, Options};
 use subfit_target::Target;
 
@@ -62,6 +62,16 @@ pub struct StageOptions {
     /// where refinement does not lower the error (a foot point on the wrong side of a thin
     /// part, a sharp crease), it would otherwise only pile up control points.
     pub max_depth: u8,
+    /// After a stage changed the mesh (refinement, flips), optimize only the control points
+    /// near the change in the next stage — the new points, the points of every face touching
+    /// one or changed by a flip, and `local_rings` rings of faces around them — holding the
+    /// rest, which already fit, fixed (Cheng 2004 §4.6). Such a stage samples, projects and
+    /// solves only that region ([`Fitter::set_active`]); its reported errors are still over
+    /// the whole surface. A stage whose `λ` changed with nothing else, or whose region would
+    /// hold more than half of the points, is global.
+    pub local: bool,
+    /// Rings of faces added around the changed region by [`Self::local`].
+    pub local_rings: usize,
 }
 
 impl Default for StageOptions {
@@ -81,6 +91,8 @@ impl Default for StageOptions {
             growth: 0.6,
             edge_flips: true,
             max_depth: 3,
+            local: false,
+            local_rings: 2,
         }
     }
 }
@@ -148,8 +160,54 @@ pub struct StageReport {
     pub flips_kept: usize,
     /// Local refinement after the fit, if any.
     pub refine: Option<RefineStats>,
+    /// Control points optimized in this stage when it was local ([`StageOptions::local`]);
+    /// `None`: all of them.
+    pub active_points: Option<usize>,
     /// Wall time of the stage (fit, flips and refinement).
     pub time: Duration,
+}
+
+/// Marks the vertices of the faces a flip pass changed (flips keep face ids).
+fn mark_flipped(seed: &mut [bool], before: &Polygons, after: &Polygons) {
+    for (old, new) in before.iter().zip(after.iter()) {
+        if old != new {
+            for &v in new {
+                seed[v as usize] = true;
+            }
+        }
+    }
+}
+
+/// Extends `seed` (over the `old_n` points before a refinement) to the `new_n` points after it
+/// and marks the vertices of every face touching a new point (index `≥ old_n`): the split
+/// faces' corners, which a full split also moves to Loop vertex points.
+fn mark_refined(seed: &mut Vec<bool>, old_n: usize, faces: &Polygons, new_n: usize) {
+    seed.resize(new_n, false);
+    for face in faces.iter() {
+        if face.iter().any(|&v| v as usize >= old_n) {
+            for &v in face {
+                seed[v as usize] = true;
+            }
+        }
+    }
+}
+
+/// `seed` grown by `rings` rings of faces; `None` when it holds more than half of the points
+/// (then a global stage costs about the same and fits better).
+fn local_region(faces: &Polygons, mut seed: Vec<bool>, rings: usize) -> Option<Vec<bool>> {
+    for _ in 0..rings {
+        let mut next = seed.clone();
+        for face in faces.iter() {
+            if face.iter().any(|&v| seed[v as usize]) {
+                for &v in face {
+                    next[v as usize] = true;
+                }
+            }
+        }
+        seed = next;
+    }
+    let count = seed.iter().filter(|&&x| x).count();
+    (count > 0 && 2 * count <= seed.len()).then_some(seed)
 }
 
 /// Why the stage driver stopped.
@@ -236,6 +294,8 @@ pub fn fit_stages(
     let mut initial = None;
     let mut stop = StageStop::Limit;
     let mut used = 0;
+    // Vertices the last change touched, for a local stage.
+    let mut touched: Option<Vec<bool>> = None;
     for stage in 0..stages.max_stages {
         if used >= stages.max_iterations {
             break;
@@ -253,6 +313,13 @@ pub fn fit_stages(
         };
         let n = mesh.num_vertices();
         let mut fitter = Fitter::new(target, &mesh.faces, n, &tags, &opts)?;
+        let active = touched
+            .take()
+            .and_then(|seed| local_region(&mesh.faces, seed, stages.local_rings));
+        let active_points = active.as_ref().map(|a| a.iter().filter(|&&x| x).count());
+        if active.is_some() {
+            fitter.set_active(active)?;
+        }
         let fit = {
             let mut cb = |row: &IterationRow| {
                 if let Some(p) = progress.as_mut() {
@@ -273,6 +340,7 @@ pub fn fit_stages(
             flips_tried: 0,
             flips_kept: 0,
             refine: None,
+            active_points,
             time: Duration::ZERO,
         };
         let next_lambda = (lambda * stages.lambda_factor).max(stages.lambda_end);
@@ -282,12 +350,17 @@ pub fn fit_stages(
         } else if mesh.faces.is_triangles() && (stages.refine || stages.edge_flips) {
             let errors = sample_face_errors(target, &mesh, &fitter);
             drop(fitter);
+            let mut seed = stages.local.then(|| vec![false; n]);
             let errors = if stages.edge_flips {
+                let before = seed.is_some().then(|| mesh.faces.clone());
                 let (tried, kept, errs) =
                     flip_pass(target, &mut mesh, errors, stages, base, &last)?;
                 report.flips_tried = tried;
                 report.flips_kept = kept;
                 changed |= kept > 0;
+                if let (Some(seed), Some(before)) = (seed.as_mut(), before) {
+                    mark_flipped(seed, &before, &mesh.faces);
+                }
                 errs
             } else {
                 errors
@@ -299,6 +372,10 @@ pub fn fit_stages(
                     depth = d;
                     report.refine = Some(rs);
                 }
+            }
+            if let Some(mut seed) = seed {
+                mark_refined(&mut seed, n, &mesh.faces, mesh.num_vertices());
+                touched = seed.contains(&true).then_some(seed);
             }
         }
         report.time = ts.elapsed();

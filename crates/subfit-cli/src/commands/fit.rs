@@ -210,6 +210,8 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         refine: !a.no_refine,
         edge_flips: !(a.no_refine || a.no_flips),
         max_depth: a.max_depth,
+        local: a.local,
+        local_rings: a.local_rings as usize,
         ..StageOptions::default()
     };
     if !a.no_refine && scheme != Scheme::Loop {
@@ -342,6 +344,8 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
             "refine": stages.refine,
             "edge_flips": stages.edge_flips,
             "max_depth": stages.max_depth,
+            "local": stages.local,
+            "local_rings": stages.local_rings,
         },
         "control_points": fitted.num_vertices(),
         "control_faces": fitted.faces.len(),
@@ -437,6 +441,7 @@ fn stage_json(s: &StageReport) -> serde_json::Value {
         "setup_s": s.fit.setup.as_secs_f64(),
         "flips_tried": s.flips_tried,
         "flips_kept": s.flips_kept,
+        "active_points": s.active_points,
         "refine": s.refine.map(|r| json!({"marked": r.marked, "red": r.red, "green": r.green, "new_points": r.new_points})),
         "time_s": s.time.as_secs_f64(),
     })

@@ -1,0 +1,103 @@
+//! The stage driver's local option (issue 6: "optimize only the new and neighbouring control
+//! points when the rest already fits").
+
+mod common;
+
+use subfit_fit::adapt::refine_red_green;
+use subfit_fit::{fit_stages, FitOptions, Fitter, StageOptions};
+use subfit_mesh::Tags;
+
+use common::{ellipsoid_target, fourteen_vertex_mesh, normalized};
+
+/// With `local`, stages after a small refinement optimize only the region around it; the
+/// errors they report are still those of the whole surface, and the fit still improves.
+#[test]
+fn local_stages_optimize_a_region_and_report_whole_surface_errors() {
+    let target = ellipsoid_target(20_000);
+    // Two uniform 1-to-4 splits of the 14-point cage (194 points): large enough that a
+    // refinement touches a small part of it.
+    let mut mesh = normalized(&target, &fourteen_vertex_mesh());
+    for _ in 0..2 {
+        mesh = refine_red_green(&mesh, &vec![true; mesh.faces.len()])
+            .unwrap()
+            .0;
+    }
+    let base = FitOptions {
+        sample_level: 3,
+        ..FitOptions::default()
+    };
+    let stages = StageOptions {
+        tolerance_rms: 1e-5,
+        max_control_points: 400,
+        growth: 0.1,
+        max_stages: 10,
+        local: true,
+        local_rings: 1,
+        ..StageOptions::default()
+    };
+    let out = fit_stages(&target, &mesh, &base, &stages, None).unwrap();
+    let r = &out.report;
+    let local: Vec<(usize, usize)> = r
+        .stages
+        .iter()
+        .filter_map(|s| s.active_points.map(|a| (a, s.num_control_points)))
+        .collect();
+    let summary: Vec<_> = r
+        .stages
+        .iter()
+        .map(|s| (s.num_control_points, s.active_points))
+        .collect();
+    assert!(!local.is_empty(), "no stage was local: {summary:?}");
+    for &(active, all) in &local {
+        assert!(
+            active > 0 && 2 * active <= all,
+            "{active} of {all} points active"
+        );
+    }
+    // The first stage is always global (nothing changed before it).
+    assert!(r.stages[0].active_points.is_none());
+    // Every local stage's errors are over the whole surface: the final report equals a fresh
+    // full evaluation of the returned cage.
+    let lambda = r.stages.last().unwrap().lambda;
+    let opts = FitOptions { lambda, ..base };
+    let fresh = Fitter::new(
+        &target,
+        &out.mesh.faces,
+        out.mesh.num_vertices(),
+        &Tags::new(),
+        &opts,
+    )
+    .unwrap()
+    .evaluate(&out.mesh.positions);
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
+    assert!(
+        rel(r.last.e_rms, fresh.e_rms) < 1e-9,
+        "{:?} vs {fresh:?}",
+        r.last
+    );
+    assert!(
+        rel(r.last.e_max, fresh.e_max) < 1e-9,
+        "{:?} vs {fresh:?}",
+        r.last
+    );
+    assert!(
+        r.last.e_rms < 0.5 * r.initial.e_rms,
+        "{:?} → {:?}",
+        r.initial,
+        r.last
+    );
+}
+
+/// Without `local` no stage is restricted.
+#[test]
+fn stages_are_global_by_default() {
+    let target = ellipsoid_target(5_000);
+    let mesh = normalized(&target, &fourteen_vertex_mesh());
+    let stages = StageOptions {
+        max_control_points: 100,
+        max_stages: 4,
+        ..StageOptions::default()
+    };
+    let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
+    assert!(out.report.stages.iter().all(|s| s.active_points.is_none()));
+}
