@@ -11,7 +11,7 @@ use subfit_subdiv::{sampling_operator, Options, SamplingOperator};
 use subfit_target::{FootPoint, Target};
 
 use crate::active::{sample_rows, ActiveSet, FixedErrors};
-use crate::assemble::{weighted_residuals, Pattern};
+use crate::assemble::{weighted_residuals, FillScratch, Pattern};
 use crate::error::{FitError, FitPhase};
 use crate::options::{FitOptions, Method, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
@@ -51,6 +51,8 @@ pub struct Fitter<'t> {
     lap: Laplacian,
     /// The active set and its sub-problem ([`Self::set_active`]); `None`: all points active.
     active: Option<ActiveSet>,
+    /// Partial sums of the fill, reused.
+    scratch: FillScratch,
 }
 
 /// The solver the options call for with `n` unknown points of block size `block`.
@@ -121,6 +123,7 @@ impl<'t> Fitter<'t> {
             hints: std::sync::Mutex::new(Vec::new()),
             lap,
             active: None,
+            scratch: FillScratch::default(),
         })
     }
 
@@ -582,7 +585,7 @@ impl<'t> Fitter<'t> {
             Some(a) => (&a.op, &a.pattern, &mut a.values),
             None => (&self.op.position, &self.pattern, &mut self.values),
         };
-        pattern.fill(op, &self.q, w_e, w_s, values);
+        pattern.fill_with(op, &self.q, w_e, w_s, values, &mut self.scratch);
         self.hdiag = pattern.diag_slots().iter().map(|&s| values[s]).collect();
         let v: Vec<[f64; 3]> = cur.feet.iter().map(|f| f.point).collect();
         let q = if coupled { Some(&self.q[..]) } else { None };
