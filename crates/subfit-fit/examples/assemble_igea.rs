@@ -1,6 +1,7 @@
 //! CPU time of the assembly of one SDM iteration's normal equations on Igea (level-3 sampling,
 //! control meshes of about 1k and 10k vertices simplified by our QEM): the per-sample `Q_k`,
-//! the fill of `H`, the weighted residuals and the gradient, each repeated and timed.
+//! the fill of `H`, the weighted residuals, the gradient and a PCG solve to relative residual
+//! 1e-2 (the default), each repeated and timed.
 //! CPU time (user + system of the process, `/proc/self/stat`) is less sensitive than wall time
 //! to other work on a shared machine; run single-threaded to compare code, two-threaded to see
 //! the parallel speed-up.
@@ -17,6 +18,7 @@
 use std::time::{Duration, Instant};
 
 use subfit_fit::assemble::{weighted_residuals, FillScratch, Pattern};
+use subfit_fit::pcg::PcgSolver;
 use subfit_fit::smooth::Laplacian;
 use subfit_fit::terms::{error_matrix, Method};
 use subfit_fit::{FitOptions, Fitter, Variant};
@@ -112,10 +114,21 @@ fn main() {
         let tr = time(reps, || r = weighted_residuals(&s, &v, Some(&q)));
         let mut g = Vec::new();
         let tg = time(reps, || g = pattern.gradient(&r, &p, w_e, w_s));
+        let rhs: Vec<f64> = g.iter().flatten().map(|x| -x).collect();
+        let mut pcg = PcgSolver::new(&pattern);
+        let mut its = 0;
+        let ts = time(reps, || {
+            let mut x = rhs.clone();
+            its = pcg
+                .solve(&pattern, &values, &mut x, 1, 1e-2, 1000)
+                .expect("SPD")
+                .iterations;
+        });
         let checksum: f64 = values.iter().sum::<f64>() + g.iter().flatten().sum::<f64>();
         println!(
             "{} control points, {} samples: pattern {:.0} ms; per call wall/CPU ms — Q {:.1}/{:.1}, \
-             fill {:.1}/{:.1}, residuals {:.1}/{:.1}, gradient {:.1}/{:.1} (checksum {checksum:.6e})",
+             fill {:.1}/{:.1}, residuals {:.1}/{:.1}, gradient {:.1}/{:.1}; PCG to 1e-2 {:.1}/{:.1} \
+             ({its} iterations) (checksum {checksum:.6e})",
             p.len(),
             s.len(),
             build.as_secs_f64() * 1e3,
@@ -126,7 +139,9 @@ fn main() {
             tr.0,
             tr.1,
             tg.0,
-            tg.1
+            tg.1,
+            ts.0,
+            ts.1
         );
     }
 }

@@ -218,6 +218,15 @@ impl<'t> Fitter<'t> {
         self.solver.factor_len()
     }
 
+    /// Iterations and residual of the last PCG solve (`None` with the Cholesky solver or before
+    /// the first solve). With an active set, those of the active set's solver.
+    pub fn last_pcg(&self) -> Option<crate::pcg::PcgStats> {
+        match &self.active {
+            Some(a) => a.solver.last_pcg(),
+            None => self.solver.last_pcg(),
+        }
+    }
+
     /// Number of samples `m`.
     pub fn num_samples(&self) -> usize {
         self.op.position.nrows()
