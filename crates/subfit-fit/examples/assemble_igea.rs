@@ -1,6 +1,7 @@
 //! CPU time of the assembly of one SDM iteration's normal equations on Igea (level-3 sampling,
 //! control meshes of about 1k and 10k vertices simplified by our QEM): the per-sample `Q_k`,
-//! the fill of `H`, the weighted residuals, the gradient and a PCG solve to relative residual
+//! the fill of `H`, the weighted residuals, the gradient, the fused fill + gradient the fitter
+//! uses, and a PCG solve to relative residual
 //! 1e-2 (the default), each repeated and timed.
 //! CPU time (user + system of the process, `/proc/self/stat`) is less sensitive than wall time
 //! to other work on a shared machine; run single-threaded to compare code, two-threaded to see
@@ -114,6 +115,10 @@ fn main() {
         let tr = time(reps, || r = weighted_residuals(&s, &v, Some(&q)));
         let mut g = Vec::new();
         let tg = time(reps, || g = pattern.gradient(&r, &p, w_e, w_s));
+        let mut gf = Vec::new();
+        let tfg = time(reps, || {
+            gf = pattern.fill_with_gradient(op, &q, &r, &p, w_e, w_s, &mut values, &mut scratch)
+        });
         let rhs: Vec<f64> = g.iter().flatten().map(|x| -x).collect();
         let mut pcg = PcgSolver::new(&pattern);
         let mut its = 0;
@@ -124,10 +129,10 @@ fn main() {
                 .expect("SPD")
                 .iterations;
         });
-        let checksum: f64 = values.iter().sum::<f64>() + g.iter().flatten().sum::<f64>();
+        let checksum: f64 = values.iter().sum::<f64>() + gf.iter().flatten().sum::<f64>();
         println!(
             "{} control points, {} samples: pattern {:.0} ms; per call wall/CPU ms — Q {:.1}/{:.1}, \
-             fill {:.1}/{:.1}, residuals {:.1}/{:.1}, gradient {:.1}/{:.1}; PCG to 1e-2 {:.1}/{:.1} \
+             fill {:.1}/{:.1}, residuals {:.1}/{:.1}, gradient {:.1}/{:.1}, fused fill + gradient {:.1}/{:.1}; PCG to 1e-2 {:.1}/{:.1} \
              ({its} iterations) (checksum {checksum:.6e})",
             p.len(),
             s.len(),
@@ -140,6 +145,8 @@ fn main() {
             tr.1,
             tg.0,
             tg.1,
+            tfg.0,
+            tfg.1,
             ts.0,
             ts.1
         );

@@ -264,6 +264,78 @@ impl Pattern {
         values: &mut [f64],
         scratch: &mut FillScratch,
     ) {
+        self.fill_impl(position, q, w_e, w_s, values, scratch, None);
+    }
+
+    /// [`Self::fill_with`] and [`Self::gradient`]`(r, p, w_e, w_s)` in one pass over the
+    /// samples where the fill groups them (block size 3), else one after the other. Returns
+    /// the half-gradient `g` (`n by 3`).
+    ///
+    /// # Panics
+    /// As [`Self::fill`] and [`Self::gradient`].
+    #[allow(clippy::too_many_arguments)]
+    #[track_caller]
+    pub fn fill_with_gradient(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        r: &[[f64; 3]],
+        p: &[[f64; 3]],
+        w_e: f64,
+        w_s: f64,
+        values: &mut [f64],
+        scratch: &mut FillScratch,
+    ) -> Vec<[f64; 3]> {
+        assert_eq!(p.len(), self.n, "one control point per column");
+        assert_eq!(r.len(), position.nrows(), "one residual per sample");
+        if !self.fill_impl(position, q, w_e, w_s, values, scratch, Some(r)) {
+            return self.gradient(r, p, w_e, w_s);
+        }
+        let Some(groups) = self.groups.as_ref() else {
+            return self.gradient(r, p, w_e, w_s);
+        };
+        let vparts = &scratch.vparts[..];
+        let lp = if w_s != 0.0 {
+            self.lap.apply(p)
+        } else {
+            Vec::new()
+        };
+        (0..self.n)
+            .into_par_iter()
+            .map(|j| {
+                let mut g = [0.0; 3];
+                for &x in groups.vcontribs(j) {
+                    for (g, v) in g.iter_mut().zip(&vparts[x as usize]) {
+                        *g += v;
+                    }
+                }
+                if w_s != 0.0 {
+                    let (rs, lrj) = self.lap_t.row(j);
+                    for (&row, &l) in rs.iter().zip(lrj) {
+                        for a in 0..3 {
+                            g[a] += w_s * l * lp[row as usize][a];
+                        }
+                    }
+                }
+                g
+            })
+            .collect()
+    }
+
+    /// The fill; with `r`, also the gradient's parts when the grouped fill runs (returns
+    /// whether it did).
+    #[allow(clippy::too_many_arguments)]
+    #[track_caller]
+    fn fill_impl(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        w_e: f64,
+        w_s: f64,
+        values: &mut [f64],
+        scratch: &mut FillScratch,
+        r: Option<&[[f64; 3]]>,
+    ) -> bool {
         assert_eq!(values.len(), self.nnz(), "values length differs from nnz");
         if self.block == 3 {
             assert_eq!(q.len(), position.nrows(), "one Q per sample");
@@ -290,7 +362,14 @@ impl Pattern {
             // sums its parts (fixed order) and the smoothing term, column by column.
             let parts = &mut scratch.parts;
             parts.resize(groups.num_parts(), [0.0; 6]);
-            groups.fill_parts(q, w_e, parts);
+            let grad = match r {
+                Some(r) => {
+                    scratch.vparts.resize(groups.num_vparts(), [0.0; 3]);
+                    Some((r, &mut scratch.vparts[..]))
+                }
+                None => None,
+            };
+            groups.fill_parts(q, w_e, parts, grad);
             let parts = &parts[..];
             chunks
                 .into_par_iter()
@@ -315,6 +394,7 @@ impl Pattern {
                     }));
                     self.scatter_block_column(j, acc, chunk);
                 });
+            return r.is_some();
         } else {
             chunks.into_par_iter().enumerate().for_each_init(
                 || (vec![u32::MAX; self.n], Vec::new()),
@@ -323,6 +403,7 @@ impl Pattern {
                 },
             );
         }
+        false
     }
 
     /// Block column `j` of `H` for block size 1 (PD) into `chunk` (its value slice).
@@ -504,6 +585,7 @@ impl Pattern {
 #[derive(Clone, Debug, Default)]
 pub struct FillScratch {
     parts: Vec<[f64; 6]>,
+    vparts: Vec<[f64; 3]>,
 }
 
 /// `(LᵀL)_ij` for every block entry `(i, j)` of the pattern (block rows `brow` of each column),

@@ -57,6 +57,13 @@ pub(crate) struct Groups {
     /// `contrib[contrib_ptr[e]..contrib_ptr[e + 1]]` (in chunk order).
     contrib_ptr: Vec<usize>,
     contrib: Vec<u32>,
+    /// Per host point (indexed like the supports, `sup_ptr`), the slot of its control point in
+    /// the chunk's gradient parts; chunk `c` owns `vpart_ptr[c]..vpart_ptr[c + 1]`, and
+    /// control point `j` sums `vcontrib[vcontrib_ptr[j]..vcontrib_ptr[j + 1]]`.
+    vslot: Vec<u32>,
+    vpart_ptr: Vec<usize>,
+    vcontrib_ptr: Vec<usize>,
+    vcontrib: Vec<u32>,
     /// Rows and nonzeros of the operator the groups were built for.
     nrows: usize,
     nnz: usize,
@@ -216,6 +223,36 @@ impl Groups {
             }
             part_ptr.push(part_entry.len());
         }
+        // The same for the gradient's parts, one per control point touched by a chunk.
+        let mut vmark = vec![u32::MAX; n];
+        let mut vslot = vec![0u32; sup.len()];
+        let mut vpart_ptr = vec![0usize];
+        let mut vpart_vertex: Vec<u32> = Vec::new();
+        for w in chunk_host.windows(2) {
+            let base = vpart_vertex.len();
+            for x in sup_ptr[w[0]]..sup_ptr[w[1]] {
+                let j = sup[x] as usize;
+                if vmark[j] == u32::MAX || (vmark[j] as usize) < base {
+                    vmark[j] = vpart_vertex.len() as u32;
+                    vpart_vertex.push(j as u32);
+                }
+                vslot[x] = vmark[j] - base as u32;
+            }
+            vpart_ptr.push(vpart_vertex.len());
+        }
+        let mut vcontrib_ptr = vec![0usize; n + 1];
+        for &j in &vpart_vertex {
+            vcontrib_ptr[j as usize + 1] += 1;
+        }
+        for j in 0..n {
+            vcontrib_ptr[j + 1] += vcontrib_ptr[j];
+        }
+        let mut vfill = vcontrib_ptr.clone();
+        let mut vcontrib = vec![0u32; vpart_vertex.len()];
+        for (x, &j) in vpart_vertex.iter().enumerate() {
+            vcontrib[vfill[j as usize]] = x as u32;
+            vfill[j as usize] += 1;
+        }
         let mut contrib_ptr = vec![0usize; nblocks + 1];
         for &e in &part_entry {
             contrib_ptr[e as usize + 1] += 1;
@@ -242,6 +279,10 @@ impl Groups {
             part_ptr,
             contrib_ptr,
             contrib,
+            vslot,
+            vpart_ptr,
+            vcontrib_ptr,
+            vcontrib,
             nrows: m,
             nnz: c.nnz(),
         })
@@ -257,6 +298,16 @@ impl Groups {
         self.contrib.len()
     }
 
+    /// Number of gradient parts (`[f64; 3]` each).
+    pub fn num_vparts(&self) -> usize {
+        self.vcontrib.len()
+    }
+
+    /// Gradient parts of control point `j`.
+    pub fn vcontribs(&self, j: usize) -> &[u32] {
+        &self.vcontrib[self.vcontrib_ptr[j]..self.vcontrib_ptr[j + 1]]
+    }
+
     /// Parts of block entry `e`.
     pub fn contribs(&self, e: usize) -> &[u32] {
         &self.contrib[self.contrib_ptr[e]..self.contrib_ptr[e + 1]]
@@ -264,23 +315,80 @@ impl Groups {
 
     /// Fills `parts` (`num_parts`) with `w_e Σ_k c_ki c_kj Q_k` (6 upper components) per host
     /// pair, summed per chunk. Parallel over chunks; deterministic.
-    pub fn fill_parts(&self, q: &[Mat3], w_e: f64, parts: &mut [[f64; 6]]) {
-        let mut chunks: Vec<(usize, &mut [[f64; 6]])> = Vec::with_capacity(self.chunk_host.len());
+    ///
+    /// With `grad = Some((r, vparts))` also fills `vparts` (`num_vparts`) with the gradient's
+    /// `w_e Σ_k c_kj r_k` per host point, summed per chunk (`r`: per-sample weighted residuals,
+    /// `m by 3`).
+    pub fn fill_parts(
+        &self,
+        q: &[Mat3],
+        w_e: f64,
+        parts: &mut [[f64; 6]],
+        grad: Option<(&[[f64; 3]], &mut [[f64; 3]])>,
+    ) {
+        let nc = self.chunk_host.len() - 1;
+        let mut chunks: Vec<(usize, &mut [[f64; 6]], &mut [[f64; 3]])> = Vec::with_capacity(nc);
+        let (r, mut vrest): (Option<&[[f64; 3]]>, &mut [[f64; 3]]) = match grad {
+            Some((r, v)) => (Some(r), v),
+            None => (None, &mut []),
+        };
         let mut rest = parts;
-        for (ci, w) in self.part_ptr.windows(2).enumerate() {
-            let (head, tail) = rest.split_at_mut(w[1] - w[0]);
-            chunks.push((ci, head));
+        for ci in 0..nc {
+            let (head, tail) = rest.split_at_mut(self.part_ptr[ci + 1] - self.part_ptr[ci]);
             rest = tail;
+            let vlen = if r.is_some() {
+                self.vpart_ptr[ci + 1] - self.vpart_ptr[ci]
+            } else {
+                0
+            };
+            let (vhead, vtail) = std::mem::take(&mut vrest).split_at_mut(vlen);
+            vrest = vtail;
+            chunks.push((ci, head, vhead));
         }
         chunks.into_par_iter().for_each_init(
             || [Vec::new(), Vec::new(), Vec::new()],
-            |scratch, (ci, part)| {
+            |scratch, (ci, part, vpart)| {
                 part.fill([0.0; 6]);
+                vpart.fill([0.0; 3]);
                 for h in self.chunk_host[ci]..self.chunk_host[ci + 1] {
                     self.host_block(q, w_e, h, scratch, part);
+                    if let Some(r) = r {
+                        self.host_gradient(r, w_e, h, &scratch[0], vpart);
+                    }
                 }
             },
         );
+    }
+
+    /// Adds host `h`'s gradient `w_e Σ_k c_kp r_k` into its chunk's `vpart`, with `bt` the
+    /// host's weights as left by [`Self::host_block`].
+    fn host_gradient(
+        &self,
+        r: &[[f64; 3]],
+        w_e: f64,
+        h: usize,
+        bt: &[f64],
+        vpart: &mut [[f64; 3]],
+    ) {
+        let s = self.sup_ptr[h + 1] - self.sup_ptr[h];
+        let samples = &self.smp[self.smp_ptr[h]..self.smp_ptr[h + 1]];
+        let mut gl = [[0.0; 3]; MAX_HOST];
+        let gl = &mut gl[..s];
+        for (&k, btcol) in samples.iter().zip(bt.chunks_exact(s)) {
+            let rk = r[k as usize];
+            for (g, &c) in gl.iter_mut().zip(btcol) {
+                for a in 0..3 {
+                    g[a] += c * rk[a];
+                }
+            }
+        }
+        let slots = &self.vslot[self.sup_ptr[h]..self.sup_ptr[h + 1]];
+        for (g, &x) in gl.iter().zip(slots) {
+            let d = &mut vpart[x as usize];
+            for a in 0..3 {
+                d[a] += w_e * g[a];
+            }
+        }
     }
 
     /// Adds host `h`'s dense block into its chunk's `part`: with `Bᵀ` (`s × K`) the host's
