@@ -29,6 +29,12 @@ pub(crate) const MAX_HOST: usize = 48;
 /// Samples per chunk of hosts (a unit of parallel work with its own part buffer).
 const CHUNK_SAMPLES: usize = 2048;
 
+/// Per-sample weighted residuals (`m by 3`) and the gradient parts to fill.
+pub(crate) type GradientParts<'a> = (&'a [[f64; 3]], &'a mut [[f64; 3]]);
+
+/// One chunk's index with its slices of the block parts and of the gradient parts.
+type ChunkParts<'a> = (usize, &'a mut [[f64; 6]], &'a mut [[f64; 3]]);
+
 /// Samples grouped under host supports, with the map from each host's pairs of points to the
 /// block entries of `H`.
 #[derive(Clone, Debug)]
@@ -324,10 +330,10 @@ impl Groups {
         q: &[Mat3],
         w_e: f64,
         parts: &mut [[f64; 6]],
-        grad: Option<(&[[f64; 3]], &mut [[f64; 3]])>,
+        grad: Option<GradientParts<'_>>,
     ) {
         let nc = self.chunk_host.len() - 1;
-        let mut chunks: Vec<(usize, &mut [[f64; 6]], &mut [[f64; 3]])> = Vec::with_capacity(nc);
+        let mut chunks: Vec<ChunkParts<'_>> = Vec::with_capacity(nc);
         let (r, mut vrest): (Option<&[[f64; 3]]>, &mut [[f64; 3]]) = match grad {
             Some((r, v)) => (Some(r), v),
             None => (None, &mut []),
