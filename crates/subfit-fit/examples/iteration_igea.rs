@@ -191,6 +191,12 @@ fn main() {
                 ms(t.evaluate)
             );
         }
+        if let Some(st) = fitter.last_pcg() {
+            println!(
+                "last PCG solve: {} iterations, relative residual {:.1e}",
+                st.iterations, st.relative_residual
+            );
+        }
         let k = report.iterations.len().max(1) as f64;
         println!(
             "mean per iteration: {:.1} ms wall, {:.1} ms CPU (whole run incl. initial evaluation: \

@@ -14,13 +14,19 @@
 //! system separates into one scalar system with three right-hand sides).
 //!
 //! The [`Pattern`] (union of the `c_k c_kᵀ` and `LᵀL` patterns) is built once per control-mesh
-//! topology; each iteration [`Pattern::fill`] writes values in place, in parallel over block
-//! columns (each rayon task owns one column's slice of the value array and scatters through a
-//! per-thread index map), so there is no triplet re-assembly and nothing dense of size `n²`.
+//! topology; each iteration [`Pattern::fill`] writes values in place, so there is no triplet
+//! re-assembly and nothing dense of size `n²`. With 3×3 blocks the samples are grouped by
+//! shared support (`groups`: all samples of a control face share one), each group's dense
+//! block is one small matrix product added once into per-chunk partial sums, and every block
+//! entry then sums its parts in a fixed order — parallel, lock-free and bitwise identical for
+//! any thread count. PD (and any operator whose supports are too wide to group) uses the
+//! column-wise fill: each rayon task owns one block column's slice of the value array and
+//! scatters through a per-thread index map.
 
 use rayon::prelude::*;
 use subfit_subdiv::StencilMatrix;
 
+use crate::groups::Groups;
 use crate::smooth::Laplacian;
 use crate::terms::{mul, Mat3};
 
@@ -45,6 +51,10 @@ pub struct Pattern {
     samp: Vec<SampleRef>,
     lap: Laplacian,
     lap_t: Laplacian,
+    /// Samples grouped by shared support (block size 3; `None`: column-wise fill).
+    groups: Option<Groups>,
+    /// `(LᵀL)_ij` per block entry (block rows of every column), for the grouped fill.
+    ltl: Vec<f64>,
 }
 
 impl Pattern {
@@ -143,6 +153,13 @@ impl Pattern {
                 col_ptr.push(row_idx.len());
             }
         }
+        let (groups, ltl) = if block == 3 {
+            let groups = Groups::new(position, &bcol_ptr, &brow);
+            let ltl = smoothing_blocks(lap, &lap_t, &bcol_ptr, &brow);
+            (groups, ltl)
+        } else {
+            (None, Vec::new())
+        };
         Self {
             n,
             block,
@@ -155,6 +172,8 @@ impl Pattern {
             samp,
             lap: lap.clone(),
             lap_t,
+            groups,
+            ltl,
         }
     }
 
@@ -208,8 +227,13 @@ impl Pattern {
     /// For block size 1 the `Q_k` are ignored (taken as `I`; PD). Typically `w_e = 1/m`,
     /// `w_s = λ/n`. The `Q_k` must be symmetric: only their upper triangles are read.
     ///
-    /// Cost: O(Σ_k s_k² · b²), parallel over block columns; no allocation besides one index map
-    /// of `n` entries per rayon thread.
+    /// `position` must be the operator the pattern was built with (for block size 3 a
+    /// different operator of another shape or nonzero count falls back to the column-wise
+    /// fill; one of the same shape and count but other columns is not detected).
+    ///
+    /// Cost: O(Σ_groups 6·s²·K) for block size 3 (`K` samples sharing a support of `s` points)
+    /// or O(Σ_k s_k² · b²) column-wise, parallel; allocates partial sums of about the size of
+    /// the blocks of `H` (see [`Self::fill_with`] to reuse them).
     ///
     /// # Panics
     /// If `values.len() != nnz`, or (block 3) `q.len()` is not the sample count.
@@ -222,6 +246,96 @@ impl Pattern {
         w_s: f64,
         values: &mut [f64],
     ) {
+        self.fill_with(position, q, w_e, w_s, values, &mut FillScratch::default());
+    }
+
+    /// [`Self::fill`] reusing `scratch` between calls (the fitter keeps one: with block size 3
+    /// it holds partial sums of about the size of `H`'s blocks, which are not reallocated).
+    ///
+    /// # Panics
+    /// As [`Self::fill`].
+    #[track_caller]
+    pub fn fill_with(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        w_e: f64,
+        w_s: f64,
+        values: &mut [f64],
+        scratch: &mut FillScratch,
+    ) {
+        self.fill_impl(position, q, w_e, w_s, values, scratch, None);
+    }
+
+    /// [`Self::fill_with`] and [`Self::gradient`]`(r, p, w_e, w_s)` in one pass over the
+    /// samples where the fill groups them (block size 3), else one after the other. Returns
+    /// the half-gradient `g` (`n by 3`).
+    ///
+    /// # Panics
+    /// As [`Self::fill`] and [`Self::gradient`].
+    #[allow(clippy::too_many_arguments)]
+    #[track_caller]
+    pub fn fill_with_gradient(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        r: &[[f64; 3]],
+        p: &[[f64; 3]],
+        w_e: f64,
+        w_s: f64,
+        values: &mut [f64],
+        scratch: &mut FillScratch,
+    ) -> Vec<[f64; 3]> {
+        assert_eq!(p.len(), self.n, "one control point per column");
+        assert_eq!(r.len(), position.nrows(), "one residual per sample");
+        if !self.fill_impl(position, q, w_e, w_s, values, scratch, Some(r)) {
+            return self.gradient(r, p, w_e, w_s);
+        }
+        let Some(groups) = self.groups.as_ref() else {
+            return self.gradient(r, p, w_e, w_s);
+        };
+        let vparts = &scratch.vparts[..];
+        let lp = if w_s != 0.0 {
+            self.lap.apply(p)
+        } else {
+            Vec::new()
+        };
+        (0..self.n)
+            .into_par_iter()
+            .map(|j| {
+                let mut g = [0.0; 3];
+                for &x in groups.vcontribs(j) {
+                    for (g, v) in g.iter_mut().zip(&vparts[x as usize]) {
+                        *g += v;
+                    }
+                }
+                if w_s != 0.0 {
+                    let (rs, lrj) = self.lap_t.row(j);
+                    for (&row, &l) in rs.iter().zip(lrj) {
+                        for a in 0..3 {
+                            g[a] += w_s * l * lp[row as usize][a];
+                        }
+                    }
+                }
+                g
+            })
+            .collect()
+    }
+
+    /// The fill; with `r`, also the gradient's parts when the grouped fill runs (returns
+    /// whether it did).
+    #[allow(clippy::too_many_arguments)]
+    #[track_caller]
+    fn fill_impl(
+        &self,
+        position: &StencilMatrix,
+        q: &[Mat3],
+        w_e: f64,
+        w_s: f64,
+        values: &mut [f64],
+        scratch: &mut FillScratch,
+        r: Option<&[[f64; 3]]>,
+    ) -> bool {
         assert_eq!(values.len(), self.nnz(), "values length differs from nnz");
         if self.block == 3 {
             assert_eq!(q.len(), position.nrows(), "one Q per sample");
@@ -243,6 +357,44 @@ impl Pattern {
                 || vec![u32::MAX; self.n],
                 |pos, (j, chunk)| self.fill_scalar_column(position, w_e, w_s, j, pos, chunk),
             );
+        } else if let Some(groups) = self.groups.as_ref().filter(|g| g.fits(position)) {
+            // Per host the dense block once, summed per chunk of hosts; then every block entry
+            // sums its parts (fixed order) and the smoothing term, column by column.
+            let parts = &mut scratch.parts;
+            parts.resize(groups.num_parts(), [0.0; 6]);
+            let grad = match r {
+                Some(r) => {
+                    scratch.vparts.resize(groups.num_vparts(), [0.0; 3]);
+                    Some((r, &mut scratch.vparts[..]))
+                }
+                None => None,
+            };
+            groups.fill_parts(q, w_e, parts, grad);
+            let parts = &parts[..];
+            chunks
+                .into_par_iter()
+                .enumerate()
+                .for_each_init(Vec::new, |acc, (j, chunk)| {
+                    acc.clear();
+                    let first = self.bcol_ptr[j];
+                    let rows = self.block_col(j);
+                    acc.extend(rows.iter().enumerate().map(|(p, _)| {
+                        let e = first + p;
+                        let mut a = [0.0; 6];
+                        for &x in groups.contribs(e) {
+                            for (a, v) in a.iter_mut().zip(&parts[x as usize]) {
+                                *a += v;
+                            }
+                        }
+                        let v = w_s * self.ltl[e];
+                        a[0] += v;
+                        a[3] += v;
+                        a[5] += v;
+                        a
+                    }));
+                    self.scatter_block_column(j, acc, chunk);
+                });
+            return r.is_some();
         } else {
             chunks.into_par_iter().enumerate().for_each_init(
                 || (vec![u32::MAX; self.n], Vec::new()),
@@ -251,6 +403,7 @@ impl Pattern {
                 },
             );
         }
+        false
     }
 
     /// Block column `j` of `H` for block size 1 (PD) into `chunk` (its value slice).
@@ -348,8 +501,18 @@ impl Pattern {
                 }
             }
         }
-        // Scatter: column 3j + c holds rows 3p + a of each off-diagonal block row p, then the
-        // diagonal rows a ≤ c.
+        for &i in rows {
+            pos[i as usize] = u32::MAX;
+        }
+        self.scatter_block_column(j, acc, chunk);
+    }
+
+    /// Writes the upper blocks of block column `j` (`acc`: 6 upper entries per block row)
+    /// into its CSC value slice `chunk`.
+    fn scatter_block_column(&self, j: usize, acc: &[[f64; 6]], chunk: &mut [f64]) {
+        let nb = acc.len();
+        // Column 3j + c holds rows 3p + a of each off-diagonal block row p, then the diagonal
+        // rows a ≤ c.
         const SYM: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
         let base = self.col_ptr[3 * j];
         for c in 0..3 {
@@ -364,9 +527,6 @@ impl Pattern {
             for a in 0..=c {
                 col[3 * (nb - 1) + a] = d[SYM[a][c]];
             }
-        }
-        for &i in rows {
-            pos[i as usize] = u32::MAX;
         }
     }
 
@@ -419,6 +579,46 @@ impl Pattern {
         }
         out
     }
+}
+
+/// Scratch of [`Pattern::fill_with`], reused between fills.
+#[derive(Clone, Debug, Default)]
+pub struct FillScratch {
+    parts: Vec<[f64; 6]>,
+    vparts: Vec<[f64; 3]>,
+}
+
+/// `(LᵀL)_ij` for every block entry `(i, j)` of the pattern (block rows `brow` of each column),
+/// summed in the order of the column-wise fill. Cost: O(Σ_j Σ_{r ∋ j} |row r|).
+fn smoothing_blocks(
+    lap: &Laplacian,
+    lap_t: &Laplacian,
+    bcol_ptr: &[usize],
+    brow: &[u32],
+) -> Vec<f64> {
+    let n = bcol_ptr.len() - 1;
+    let mut out = vec![0.0; brow.len()];
+    let mut pos = vec![u32::MAX; n];
+    for j in 0..n {
+        let rows = &brow[bcol_ptr[j]..bcol_ptr[j + 1]];
+        for (p, &i) in rows.iter().enumerate() {
+            pos[i as usize] = p as u32;
+        }
+        let col = &mut out[bcol_ptr[j]..bcol_ptr[j + 1]];
+        let (rs, lrj) = lap_t.row(j);
+        for (&r, &lrj) in rs.iter().zip(lrj) {
+            let (idx, wts) = lap.row(r as usize);
+            for (&i, &lri) in idx.iter().zip(wts) {
+                if i as usize <= j {
+                    col[pos[i as usize] as usize] += lri * lrj;
+                }
+            }
+        }
+        for &i in rows {
+            pos[i as usize] = u32::MAX;
+        }
+    }
+    out
 }
 
 /// The transpose of a CSR operator with `rows` rows over `ncols` columns: `ncols` rows, the

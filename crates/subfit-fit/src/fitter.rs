@@ -11,13 +11,13 @@ use subfit_subdiv::{sampling_operator, Options, SamplingOperator};
 use subfit_target::{FootPoint, Target};
 
 use crate::active::{sample_rows, ActiveSet, FixedErrors};
-use crate::assemble::{weighted_residuals, Pattern};
+use crate::assemble::{FillScratch, Pattern};
 use crate::error::{FitError, FitPhase};
 use crate::options::{FitOptions, Method, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
 use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
-use crate::terms::{error_matrix, Mat3};
+use crate::terms::{error_matrix, mul, Mat3};
 
 /// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
 const MU_MAX: f64 = 1e16;
@@ -51,6 +51,8 @@ pub struct Fitter<'t> {
     lap: Laplacian,
     /// The active set and its sub-problem ([`Self::set_active`]); `None`: all points active.
     active: Option<ActiveSet>,
+    /// Partial sums of the fill, reused.
+    scratch: FillScratch,
 }
 
 /// The solver the options call for with `n` unknown points of block size `block`.
@@ -121,6 +123,7 @@ impl<'t> Fitter<'t> {
             hints: std::sync::Mutex::new(Vec::new()),
             lap,
             active: None,
+            scratch: FillScratch::default(),
         })
     }
 
@@ -213,6 +216,15 @@ impl<'t> Fitter<'t> {
     /// Stored values of the Cholesky factor (fill-in measure; `None` before the first solve).
     pub fn factor_len(&self) -> Option<usize> {
         self.solver.factor_len()
+    }
+
+    /// Iterations and residual of the last PCG solve (`None` with the Cholesky solver or before
+    /// the first solve). With an active set, those of the active set's solver.
+    pub fn last_pcg(&self) -> Option<crate::pcg::PcgStats> {
+        match &self.active {
+            Some(a) => a.solver.last_pcg(),
+            None => self.solver.last_pcg(),
+        }
     }
 
     /// Number of samples `m`.
@@ -571,31 +583,59 @@ impl<'t> Fitter<'t> {
         let (w_e, w_s) = (1.0 / m, self.options.lambda / n);
         let method = self.options.method;
         let coupled = self.pattern.block() == 3;
-        if coupled {
+        // Q_k and the weighted residuals r_k = Q_k (S_k − V_k) (PD: S_k − V_k) in one pass.
+        let r: Vec<[f64; 3]> = if coupled {
             self.q.resize(cur.feet.len(), [[0.0; 3]; 3]);
             self.q
                 .par_iter_mut()
                 .zip(cur.feet.par_iter())
-                .for_each(|(q, f)| *q = error_matrix(method, f));
-        }
-        let (op, pattern, values) = match &mut self.active {
-            Some(a) => (&a.op, &a.pattern, &mut a.values),
-            None => (&self.op.position, &self.pattern, &mut self.values),
+                .zip(cur.samples.par_iter())
+                .map(|((q, f), s)| {
+                    *q = error_matrix(method, f);
+                    mul(q, std::array::from_fn(|a| s[a] - f.point[a]))
+                })
+                .collect()
+        } else {
+            cur.samples
+                .par_iter()
+                .zip(cur.feet.par_iter())
+                .map(|(s, f)| std::array::from_fn(|a| s[a] - f.point[a]))
+                .collect()
         };
-        pattern.fill(op, &self.q, w_e, w_s, values);
-        self.hdiag = pattern.diag_slots().iter().map(|&s| values[s]).collect();
-        let v: Vec<[f64; 3]> = cur.feet.iter().map(|f| f.point).collect();
-        let q = if coupled { Some(&self.q[..]) } else { None };
-        let r = weighted_residuals(&cur.samples, &v, q);
-        match &self.active {
-            None => self.pattern.gradient(&r, control, w_e, w_s),
-            Some(a) => {
-                let zero = vec![[0.0; 3]; a.points.len()];
-                let mut g = a.pattern.gradient(&r, &zero, w_e, 0.0);
-                a.add_smoothing_gradient(&self.lap, control, w_s, &mut g);
-                g
+        let (g, pattern, values) = match &mut self.active {
+            None => {
+                let g = self.pattern.fill_with_gradient(
+                    &self.op.position,
+                    &self.q,
+                    &r,
+                    control,
+                    w_e,
+                    w_s,
+                    &mut self.values,
+                    &mut self.scratch,
+                );
+                (g, &self.pattern, &self.values)
             }
-        }
+            Some(a) => {
+                // The smoothing gradient needs the fixed points too: the fill's own is taken
+                // at P_a = 0 (where it vanishes) and the true one added.
+                let zero = vec![[0.0; 3]; a.points.len()];
+                let mut g = a.pattern.fill_with_gradient(
+                    &a.op,
+                    &self.q,
+                    &r,
+                    &zero,
+                    w_e,
+                    w_s,
+                    &mut a.values,
+                    &mut self.scratch,
+                );
+                a.add_smoothing_gradient(&self.lap, control, w_s, &mut g);
+                (g, &a.pattern, &a.values)
+            }
+        };
+        self.hdiag = pattern.diag_slots().iter().map(|&s| values[s]).collect();
+        g
     }
 
     /// Solves `(H + shift·I) δ = −g`.

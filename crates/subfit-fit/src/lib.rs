@@ -51,6 +51,7 @@ pub mod assemble;
 mod error;
 pub mod feet;
 mod fitter;
+mod groups;
 mod options;
 pub mod ordering;
 pub mod pcg;

@@ -1,0 +1,468 @@
+//! Samples grouped by shared support, for the fill of the normal matrix (issue #5, assembly
+//! speed; DESIGN.md §3.3).
+//!
+//! `H = w_e Σ_k (c_k c_kᵀ) ⊗ Q_k` is a sum of small dense blocks. Most samples share their
+//! support with many others (all level-`l` samples inside one control face depend on the same
+//! control points, those on an edge or at a vertex on a subset of them), so the samples are
+//! grouped under a *host* support that contains each of theirs. Per host the dense
+//! `s × s` block (6 upper components per pair of points) is a product of a `K × s` matrix of
+//! stencil weights with itself, weighted by the `Q_k`: contiguous dot products that vectorize.
+//! Each block is then added once into a *part* buffer of its chunk of hosts; every entry of
+//! `H` finally sums its parts in a fixed order. Nothing depends on the thread count, so the
+//! fill is bitwise deterministic across thread counts; no locks.
+//!
+//! The grouping is generic: a sample's support becomes a host unless a host containing it
+//! already exists (supports visited largest first), so no assumption on the scheme or the
+//! topology is made — a worse grouping only costs time.
+
+use std::collections::HashMap;
+
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
+use rayon::prelude::*;
+use subfit_subdiv::StencilMatrix;
+
+use crate::terms::Mat3;
+
+/// Hosts larger than this fall back to the column-wise fill (dense blocks would grow as s²).
+pub(crate) const MAX_HOST: usize = 48;
+/// Samples per chunk of hosts (a unit of parallel work with its own part buffer).
+const CHUNK_SAMPLES: usize = 2048;
+
+/// Per-sample weighted residuals (`m by 3`) and the gradient parts to fill.
+pub(crate) type GradientParts<'a> = (&'a [[f64; 3]], &'a mut [[f64; 3]]);
+
+/// One chunk's index with its slices of the block parts and of the gradient parts.
+type ChunkParts<'a> = (usize, &'a mut [[f64; 6]], &'a mut [[f64; 3]]);
+
+/// Samples grouped under host supports, with the map from each host's pairs of points to the
+/// block entries of `H`.
+#[derive(Clone, Debug)]
+pub(crate) struct Groups {
+    /// Host `h` has `sup_ptr[h + 1] − sup_ptr[h]` control points (its support, increasing, is
+    /// only needed while building).
+    sup_ptr: Vec<usize>,
+    /// Host `h`'s samples: `smp[smp_ptr[h]..smp_ptr[h + 1]]`.
+    smp_ptr: Vec<usize>,
+    smp: Vec<u32>,
+    /// The nonzeros of the samples in host order (`smp`): sample `smp[x]` has the weights
+    /// `wts[nz_ptr[x]..nz_ptr[x + 1]]` at the positions `local[..]` of its host's support.
+    /// A copy of the operator's values, so that a host's samples are read contiguously.
+    nz_ptr: Vec<usize>,
+    wts: Vec<f64>,
+    local: Vec<u8>,
+    /// Per host, for its pairs `p ≤ q` (row-major over the upper triangle), the slot of the
+    /// block entry in the host's chunk of parts: `pair_slot[pair_ptr[h]..pair_ptr[h + 1]]`.
+    pair_ptr: Vec<usize>,
+    pair_slot: Vec<u32>,
+    /// Chunk `c` holds hosts `chunk_host[c]..chunk_host[c + 1]` and parts
+    /// `part_ptr[c]..part_ptr[c + 1]`.
+    chunk_host: Vec<usize>,
+    part_ptr: Vec<usize>,
+    /// Block entry `e` of `H` (index into the pattern's block rows) sums the parts
+    /// `contrib[contrib_ptr[e]..contrib_ptr[e + 1]]` (in chunk order).
+    contrib_ptr: Vec<usize>,
+    contrib: Vec<u32>,
+    /// Per host point (indexed like the supports, `sup_ptr`), the slot of its control point in
+    /// the chunk's gradient parts; chunk `c` owns `vpart_ptr[c]..vpart_ptr[c + 1]`, and
+    /// control point `j` sums `vcontrib[vcontrib_ptr[j]..vcontrib_ptr[j + 1]]`.
+    vslot: Vec<u32>,
+    vpart_ptr: Vec<usize>,
+    vcontrib_ptr: Vec<usize>,
+    vcontrib: Vec<u32>,
+    /// Rows and nonzeros of the operator the groups were built for.
+    nrows: usize,
+    nnz: usize,
+}
+
+/// Whether the sorted list `a` is contained in the sorted list `b`.
+fn is_subset(a: &[u32], b: &[u32]) -> bool {
+    let mut it = b.iter();
+    a.iter().all(|x| it.by_ref().any(|y| y == x))
+}
+
+impl Groups {
+    /// Groups the samples of `c` (`m × n`) for the pattern with block rows `brow` per block
+    /// column (`bcol_ptr`, `n + 1`). `None` when a host would exceed [`MAX_HOST`] points or a
+    /// pair misses the pattern (then the caller keeps the column-wise fill).
+    /// Cost: O(nnz(C) + Σ_hosts s² log) time, O(nnz(C) + Σ_hosts s²) memory.
+    pub fn new(c: &StencilMatrix, bcol_ptr: &[usize], brow: &[u32]) -> Option<Self> {
+        let (m, n) = (c.nrows(), c.ncols());
+        // Distinct supports, then hosts: largest first, each joins the first host containing it.
+        let mut distinct: HashMap<&[u32], u32> = HashMap::new();
+        let mut dist_of = Vec::with_capacity(m);
+        let mut supports: Vec<&[u32]> = Vec::new();
+        for k in 0..m {
+            let idx = c.row(k).0;
+            let next = supports.len() as u32;
+            let d = *distinct.entry(idx).or_insert(next);
+            if d == next {
+                supports.push(idx);
+            }
+            dist_of.push(d);
+        }
+        drop(distinct);
+        let mut order: Vec<u32> = (0..supports.len() as u32).collect();
+        order.sort_by(|&a, &b| {
+            let (a, b) = (supports[a as usize], supports[b as usize]);
+            b.len().cmp(&a.len()).then(a.cmp(b))
+        });
+        let mut host_of_dist = vec![u32::MAX; supports.len()];
+        let mut host_sup: Vec<&[u32]> = Vec::new();
+        let mut by_vertex: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for &d in &order {
+            let s = supports[d as usize];
+            let Some(&first) = s.first() else {
+                continue;
+            };
+            let found = by_vertex[first as usize]
+                .iter()
+                .copied()
+                .find(|&h| is_subset(s, host_sup[h as usize]));
+            host_of_dist[d as usize] = match found {
+                Some(h) => h,
+                None => {
+                    if s.len() > MAX_HOST {
+                        return None;
+                    }
+                    let h = host_sup.len() as u32;
+                    host_sup.push(s);
+                    for &v in s {
+                        by_vertex[v as usize].push(h);
+                    }
+                    h
+                }
+            };
+        }
+        drop(by_vertex);
+        // Hosts ordered by their first control point (locality of the touched columns).
+        let mut hosts: Vec<u32> = (0..host_sup.len() as u32).collect();
+        hosts.sort_by_key(|&h| (host_sup[h as usize][0], h));
+        let mut rank = vec![0u32; hosts.len()];
+        for (r, &h) in hosts.iter().enumerate() {
+            rank[h as usize] = r as u32;
+        }
+        let nh = hosts.len();
+        let mut sup_ptr = Vec::with_capacity(nh + 1);
+        let mut sup = Vec::new();
+        sup_ptr.push(0);
+        for &h in &hosts {
+            sup.extend_from_slice(host_sup[h as usize]);
+            sup_ptr.push(sup.len());
+        }
+        // Samples per host (increasing k); empty rows belong to no host.
+        let host_of = |k: usize| -> Option<usize> {
+            let h = host_of_dist[dist_of[k] as usize];
+            (h != u32::MAX).then(|| rank[h as usize] as usize)
+        };
+        let mut smp_ptr = vec![0usize; nh + 1];
+        for k in 0..m {
+            if let Some(h) = host_of(k) {
+                smp_ptr[h + 1] += 1;
+            }
+        }
+        for h in 0..nh {
+            smp_ptr[h + 1] += smp_ptr[h];
+        }
+        let mut next = smp_ptr.clone();
+        let mut smp = vec![0u32; smp_ptr[nh]];
+        for k in 0..m {
+            let Some(h) = host_of(k) else { continue };
+            smp[next[h]] = k as u32;
+            next[h] += 1;
+        }
+        let mut nz_ptr = Vec::with_capacity(smp.len() + 1);
+        let mut wts = Vec::with_capacity(c.nnz());
+        let mut local = Vec::with_capacity(c.nnz());
+        nz_ptr.push(0);
+        for h in 0..nh {
+            let hs = &sup[sup_ptr[h]..sup_ptr[h + 1]];
+            for &k in &smp[smp_ptr[h]..smp_ptr[h + 1]] {
+                let (idx, w) = c.row(k as usize);
+                let mut p = 0;
+                for &i in idx {
+                    while hs[p] != i {
+                        p += 1;
+                    }
+                    local.push(p as u8);
+                }
+                wts.extend_from_slice(w);
+                nz_ptr.push(wts.len());
+            }
+        }
+        // Chunks, part slots of the pairs, and the reduction map.
+        let mut chunk_host = vec![0usize];
+        let mut count = 0;
+        for h in 0..nh {
+            count += smp_ptr[h + 1] - smp_ptr[h];
+            if count >= CHUNK_SAMPLES {
+                chunk_host.push(h + 1);
+                count = 0;
+            }
+        }
+        if *chunk_host.last().unwrap_or(&0) != nh {
+            chunk_host.push(nh);
+        }
+        let nblocks = brow.len();
+        let mut mark = vec![u32::MAX; nblocks];
+        let mut pair_ptr = Vec::with_capacity(nh + 1);
+        let mut pair_slot = Vec::new();
+        let mut part_ptr = vec![0usize];
+        let mut part_entry: Vec<u32> = Vec::new();
+        pair_ptr.push(0);
+        for w in chunk_host.windows(2) {
+            let base = part_entry.len();
+            for h in w[0]..w[1] {
+                let hs = &sup[sup_ptr[h]..sup_ptr[h + 1]];
+                for (p, &i) in hs.iter().enumerate() {
+                    for &j in &hs[p..] {
+                        let col = &brow[bcol_ptr[j as usize]..bcol_ptr[j as usize + 1]];
+                        let e = bcol_ptr[j as usize] + col.binary_search(&i).ok()?;
+                        if mark[e] == u32::MAX || (mark[e] as usize) < base {
+                            mark[e] = part_entry.len() as u32;
+                            part_entry.push(e as u32);
+                        }
+                        pair_slot.push(mark[e] - base as u32);
+                    }
+                }
+                pair_ptr.push(pair_slot.len());
+            }
+            part_ptr.push(part_entry.len());
+        }
+        // The same for the gradient's parts, one per control point touched by a chunk.
+        let mut vmark = vec![u32::MAX; n];
+        let mut vslot = vec![0u32; sup.len()];
+        let mut vpart_ptr = vec![0usize];
+        let mut vpart_vertex: Vec<u32> = Vec::new();
+        for w in chunk_host.windows(2) {
+            let base = vpart_vertex.len();
+            for x in sup_ptr[w[0]]..sup_ptr[w[1]] {
+                let j = sup[x] as usize;
+                if vmark[j] == u32::MAX || (vmark[j] as usize) < base {
+                    vmark[j] = vpart_vertex.len() as u32;
+                    vpart_vertex.push(j as u32);
+                }
+                vslot[x] = vmark[j] - base as u32;
+            }
+            vpart_ptr.push(vpart_vertex.len());
+        }
+        let mut vcontrib_ptr = vec![0usize; n + 1];
+        for &j in &vpart_vertex {
+            vcontrib_ptr[j as usize + 1] += 1;
+        }
+        for j in 0..n {
+            vcontrib_ptr[j + 1] += vcontrib_ptr[j];
+        }
+        let mut vfill = vcontrib_ptr.clone();
+        let mut vcontrib = vec![0u32; vpart_vertex.len()];
+        for (x, &j) in vpart_vertex.iter().enumerate() {
+            vcontrib[vfill[j as usize]] = x as u32;
+            vfill[j as usize] += 1;
+        }
+        let mut contrib_ptr = vec![0usize; nblocks + 1];
+        for &e in &part_entry {
+            contrib_ptr[e as usize + 1] += 1;
+        }
+        for e in 0..nblocks {
+            contrib_ptr[e + 1] += contrib_ptr[e];
+        }
+        let mut fill = contrib_ptr.clone();
+        let mut contrib = vec![0u32; part_entry.len()];
+        for (x, &e) in part_entry.iter().enumerate() {
+            contrib[fill[e as usize]] = x as u32;
+            fill[e as usize] += 1;
+        }
+        Some(Self {
+            sup_ptr,
+            smp_ptr,
+            smp,
+            nz_ptr,
+            wts,
+            local,
+            pair_ptr,
+            pair_slot,
+            chunk_host,
+            part_ptr,
+            contrib_ptr,
+            contrib,
+            vslot,
+            vpart_ptr,
+            vcontrib_ptr,
+            vcontrib,
+            nrows: m,
+            nnz: c.nnz(),
+        })
+    }
+
+    /// Whether `c` has the shape and nonzero count the groups were built for.
+    pub fn fits(&self, c: &StencilMatrix) -> bool {
+        c.nrows() == self.nrows && c.nnz() == self.nnz
+    }
+
+    /// Number of part buffers' entries (`[f64; 6]` each).
+    pub fn num_parts(&self) -> usize {
+        self.contrib.len()
+    }
+
+    /// Number of gradient parts (`[f64; 3]` each).
+    pub fn num_vparts(&self) -> usize {
+        self.vcontrib.len()
+    }
+
+    /// Gradient parts of control point `j`.
+    pub fn vcontribs(&self, j: usize) -> &[u32] {
+        &self.vcontrib[self.vcontrib_ptr[j]..self.vcontrib_ptr[j + 1]]
+    }
+
+    /// Parts of block entry `e`.
+    pub fn contribs(&self, e: usize) -> &[u32] {
+        &self.contrib[self.contrib_ptr[e]..self.contrib_ptr[e + 1]]
+    }
+
+    /// Fills `parts` (`num_parts`) with `w_e Σ_k c_ki c_kj Q_k` (6 upper components) per host
+    /// pair, summed per chunk. Parallel over chunks; deterministic.
+    ///
+    /// With `grad = Some((r, vparts))` also fills `vparts` (`num_vparts`) with the gradient's
+    /// `w_e Σ_k c_kj r_k` per host point, summed per chunk (`r`: per-sample weighted residuals,
+    /// `m by 3`).
+    pub fn fill_parts(
+        &self,
+        q: &[Mat3],
+        w_e: f64,
+        parts: &mut [[f64; 6]],
+        grad: Option<GradientParts<'_>>,
+    ) {
+        let nc = self.chunk_host.len() - 1;
+        let mut chunks: Vec<ChunkParts<'_>> = Vec::with_capacity(nc);
+        let (r, mut vrest): (Option<&[[f64; 3]]>, &mut [[f64; 3]]) = match grad {
+            Some((r, v)) => (Some(r), v),
+            None => (None, &mut []),
+        };
+        let mut rest = parts;
+        for ci in 0..nc {
+            let (head, tail) = rest.split_at_mut(self.part_ptr[ci + 1] - self.part_ptr[ci]);
+            rest = tail;
+            let vlen = if r.is_some() {
+                self.vpart_ptr[ci + 1] - self.vpart_ptr[ci]
+            } else {
+                0
+            };
+            let (vhead, vtail) = std::mem::take(&mut vrest).split_at_mut(vlen);
+            vrest = vtail;
+            chunks.push((ci, head, vhead));
+        }
+        chunks.into_par_iter().for_each_init(
+            || [Vec::new(), Vec::new(), Vec::new()],
+            |scratch, (ci, part, vpart)| {
+                part.fill([0.0; 6]);
+                vpart.fill([0.0; 3]);
+                for h in self.chunk_host[ci]..self.chunk_host[ci + 1] {
+                    self.host_block(q, w_e, h, scratch, part);
+                    if let Some(r) = r {
+                        self.host_gradient(r, w_e, h, &scratch[0], vpart);
+                    }
+                }
+            },
+        );
+    }
+
+    /// Adds host `h`'s gradient `w_e Σ_k c_kp r_k` into its chunk's `vpart`, with `bt` the
+    /// host's weights as left by [`Self::host_block`].
+    fn host_gradient(
+        &self,
+        r: &[[f64; 3]],
+        w_e: f64,
+        h: usize,
+        bt: &[f64],
+        vpart: &mut [[f64; 3]],
+    ) {
+        let s = self.sup_ptr[h + 1] - self.sup_ptr[h];
+        let samples = &self.smp[self.smp_ptr[h]..self.smp_ptr[h + 1]];
+        let mut gl = [[0.0; 3]; MAX_HOST];
+        let gl = &mut gl[..s];
+        for (&k, btcol) in samples.iter().zip(bt.chunks_exact(s)) {
+            let rk = r[k as usize];
+            for (g, &c) in gl.iter_mut().zip(btcol) {
+                for a in 0..3 {
+                    g[a] += c * rk[a];
+                }
+            }
+        }
+        let slots = &self.vslot[self.sup_ptr[h]..self.sup_ptr[h + 1]];
+        for (g, &x) in gl.iter().zip(slots) {
+            let d = &mut vpart[x as usize];
+            for a in 0..3 {
+                d[a] += w_e * g[a];
+            }
+        }
+    }
+
+    /// Adds host `h`'s dense block into its chunk's `part`: with `Bᵀ` (`s × K`) the host's
+    /// samples' stencil weights (a column per sample) and `Y` (`6s × K`) the rows
+    /// `Y[t·s + p, k] = Bᵀ[p, k] w_e Q_k[t]` (`t` over the 6 upper components), `R = Y B`
+    /// holds every pair's 6 sums: one small dense product (`faer`, SIMD). Scratch: `bt`, `y`,
+    /// `r` (grown, never shrunk).
+    fn host_block(
+        &self,
+        q: &[Mat3],
+        w_e: f64,
+        h: usize,
+        scratch: &mut [Vec<f64>; 3],
+        part: &mut [[f64; 6]],
+    ) {
+        let [bt, y, r] = scratch;
+        let s = self.sup_ptr[h + 1] - self.sup_ptr[h];
+        let samples = &self.smp[self.smp_ptr[h]..self.smp_ptr[h + 1]];
+        let kk = samples.len();
+        let rows = 6 * s;
+        for (v, len) in [
+            (&mut *bt, s * kk),
+            (&mut *y, rows * kk),
+            (&mut *r, rows * s),
+        ] {
+            if v.len() < len {
+                v.resize(len, 0.0);
+            }
+        }
+        let bt = &mut bt[..s * kk];
+        bt.fill(0.0);
+        let y = &mut y[..rows * kk];
+        let r = &mut r[..rows * s];
+        let x0 = self.smp_ptr[h];
+        for (col, ((&k, btcol), ycol)) in samples
+            .iter()
+            .zip(bt.chunks_exact_mut(s))
+            .zip(y.chunks_exact_mut(rows))
+            .enumerate()
+        {
+            let nz = self.nz_ptr[x0 + col]..self.nz_ptr[x0 + col + 1];
+            for (&p, &w) in self.local[nz.clone()].iter().zip(&self.wts[nz]) {
+                btcol[p as usize] = w;
+            }
+            let qk = &q[k as usize];
+            let comps = [qk[0][0], qk[0][1], qk[0][2], qk[1][1], qk[1][2], qk[2][2]];
+            for (yt, &v) in ycol.chunks_exact_mut(s).zip(&comps) {
+                let v = w_e * v;
+                for (yv, &b) in yt.iter_mut().zip(btcol.iter()) {
+                    *yv = b * v;
+                }
+            }
+        }
+        let btm = MatRef::from_column_major_slice(&bt[..], s, kk);
+        let ym = MatRef::from_column_major_slice(&y[..], rows, kk);
+        let rm = MatMut::from_column_major_slice_mut(&mut r[..], rows, s);
+        matmul(rm, Accum::Replace, ym, btm.transpose(), 1.0, Par::Seq);
+        let slots = &self.pair_slot[self.pair_ptr[h]..self.pair_ptr[h + 1]];
+        let mut pair = 0;
+        for p in 0..s {
+            for qi in p..s {
+                let rq = &r[qi * rows..(qi + 1) * rows];
+                let dst = &mut part[slots[pair] as usize];
+                for (t, d) in dst.iter_mut().enumerate() {
+                    *d += rq[t * s + p];
+                }
+                pair += 1;
+            }
+        }
+    }
+}
