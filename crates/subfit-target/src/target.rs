@@ -240,6 +240,7 @@ impl Target {
             }
             stats.flipped_normals = o.flipped.iter().filter(|&&f| f).count();
             stats.orientation_components = o.components;
+            stats.winding_flips = o.winding_flips;
         }
         let descent =
             NeighborGraph::new(&points, prefix_rows(&graph, stride, DESCENT_K), DESCENT_K);
