@@ -89,7 +89,7 @@ fn report(name: &str, t: &Target) {
     let s = t.stats();
     let tm = &s.timings;
     println!(
-        "{name}: {} points: total {:.3} s (validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh {:.3}); merged {}, flipped {}, ambiguous {}, components {}",
+        "{name}: {} points: total {:.3} s (validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh {:.3}); merged {}, flipped {} (winding check {}), ambiguous {}, components {}",
         t.len(),
         tm.total.as_secs_f64(),
         tm.validate.as_secs_f64(),
@@ -101,6 +101,7 @@ fn report(name: &str, t: &Target) {
         tm.mesh_index.as_secs_f64(),
         s.merged_duplicates,
         s.flipped_normals,
+        s.winding_flips,
         s.ambiguous_normals,
         s.orientation_components,
     );

@@ -40,6 +40,7 @@ pub mod project;
 pub mod quadric;
 mod target;
 mod vec3;
+mod winding;
 
 pub use closest::{MeshClosestPoint, TriangleBvh};
 pub use error::TargetError;

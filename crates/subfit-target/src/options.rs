@@ -150,6 +150,9 @@ pub struct TargetStats {
     pub ambiguous_normals: usize,
     /// Points whose quadric fit was damped or reduced to a plane (degenerate neighbourhood).
     pub degenerate_fits: usize,
+    /// Flips made by the global winding-number check of the orientation (see
+    /// [`crate::orient`]; included in the net effect counted by `flipped_normals`).
+    pub winding_flips: usize,
     /// Connected components of the orientation graph (0 when no orientation was needed).
     pub orientation_components: usize,
     /// Smallest, mean and largest neighbourhood size (points, the point itself included).

@@ -17,15 +17,20 @@
 //! 3. **Consensus pass.** A point whose normal disagrees with the weighted majority of its
 //!    neighbours (weights `|n_i·n_j|` times the in-plane fraction of the edge, lower for
 //!    ambiguous neighbours) is flipped; repeated until stable (a few sweeps).
+//! 4. **Global check on closed components** ([`crate::winding`]; Barill et al. 2018): a normal
+//!    pointing up the generalized winding number of the rest of the shape (its neighbourhood
+//!    left out) points inward and is flipped; a few passes. This repairs whole regions that the
+//!    tree oriented across a thin part, which no local rule sees.
 //!
 //! Points with a prescribed (fixed) normal keep it and orient their components: they are merged
 //! into one tree root before Kruskal's algorithm. Cost O(E log E) for E = #P·k edges (parallel
-//! sort), the rest O(E).
+//! sort), the winding check O(P log P) per pass, the rest O(E).
 
 use rayon::prelude::*;
 
 use crate::neighbors::morton_order;
 use crate::vec3::{add, dot, norm, normalize, scale, sub};
+use crate::winding::{self, WindingInput};
 
 /// Outcome of [`orient_normals`].
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -34,6 +39,9 @@ pub struct Orientation {
     pub flipped: Vec<bool>,
     /// Number of connected components of the graph (each seeded separately).
     pub components: usize,
+    /// Flips made by the global winding-number check on closed-looking components (after
+    /// propagation and consensus; a point flipped twice counts twice).
+    pub winding_flips: usize,
 }
 
 /// The k-nearest-neighbour graph: row `i` is `targets[i * stride .. (i + 1) * stride]`, padded
@@ -63,6 +71,9 @@ pub struct OrientInput<'a> {
 const AMBIGUOUS_PENALTY: f64 = 1.0;
 /// A component is treated as closed when `|Σ a n| ≤ this · Σ a`.
 const MAX_FLUX: f64 = 0.25;
+/// The ball left out of a point's winding-number field: this × the distance to its farthest
+/// graph neighbour.
+const EXCLUDE_WIDEN: f64 = 1.0 + 1e-9;
 /// Maximum number of consensus sweeps.
 const CONSENSUS_SWEEPS: usize = 8;
 /// The volume sum decides a component's sign when `|Σ a n·(p−c)| ≥ this · Σ a |n·(p−c)|`.
@@ -112,8 +123,42 @@ pub fn orient_normals(
         tangent_penalty: input.tangent_penalty,
     };
     let tree = spanning_tree(&pts, &nrm, graph, &input);
-    let components = propagate(&pts, &mut nrm, &tree, &input);
+    let mut closed = vec![false; n];
+    let components = propagate(&pts, &mut nrm, &tree, &input, &mut closed);
     consensus(&pts, &mut nrm, graph, &input);
+    let eligible: Vec<bool> = closed
+        .iter()
+        .zip(input.fixed)
+        .map(|(&c, &f)| c && !f)
+        .collect();
+    // Per point, from its k graph neighbours (d_k the distance to the farthest): the area
+    // π d_k² / k for the winding number, and d_k (slightly widened) as the radius left out.
+    let (wn_area, exclude): (Vec<f64>, Vec<f64>) = targets
+        .par_chunks(k)
+        .zip(pts.par_iter())
+        .map(|(row, &p)| {
+            let (cnt, d2) =
+                row.iter()
+                    .filter(|&&j| j != u32::MAX)
+                    .fold((0usize, 0.0f64), |(c, m), &j| {
+                        let d = sub(pts[j as usize], p);
+                        (c + 1, m.max(dot(d, d)))
+                    });
+            let a = std::f64::consts::PI * d2 / cnt.max(1) as f64;
+            (a, d2.sqrt() * EXCLUDE_WIDEN)
+        })
+        .unzip();
+    let winding_flips = winding::refine(
+        &mut nrm,
+        &WindingInput {
+            points: &pts,
+            area: &wn_area,
+            exclude: &exclude,
+            targets: &targets,
+            stride: k,
+            eligible: &eligible,
+        },
+    );
     let flipped = normals
         .par_iter_mut()
         .zip(rank.par_iter())
@@ -127,6 +172,7 @@ pub fn orient_normals(
     Orientation {
         flipped,
         components,
+        winding_flips,
     }
 }
 
@@ -250,6 +296,7 @@ fn propagate(
     normals: &mut [[f64; 3]],
     tree: &Tree,
     inp: &OrientInput<'_>,
+    closed: &mut [bool],
 ) -> usize {
     let n = points.len();
     let mut visited = vec![false; n];
@@ -304,8 +351,10 @@ fn propagate(
                     .then(b.cmp(&a))
             })
             .unwrap_or(start);
-        if !component_sign(points, normals, &members, seed as usize, inp) {
-            for &m in &members {
+        let (keep, is_closed) = component_sign(points, normals, &members, seed as usize, inp);
+        for &m in &members {
+            closed[m as usize] = is_closed;
+            if !keep {
                 normals[m as usize] = scale(normals[m as usize], -1.0);
             }
         }
@@ -313,14 +362,15 @@ fn propagate(
     components
 }
 
-/// Whether a free component's current orientation is to be kept (see the module doc).
+/// Whether a free component's current orientation is to be kept (see the module doc), and
+/// whether it looks closed (sign decided by the enclosed volume).
 fn component_sign(
     points: &[[f64; 3]],
     normals: &[[f64; 3]],
     members: &[u32],
     seed: usize,
     inp: &OrientInput<'_>,
-) -> bool {
+) -> (bool, bool) {
     let mut c = [0.0; 3];
     let mut wsum = 0.0;
     for &m in members {
@@ -346,7 +396,7 @@ fn component_sign(
         // surface), not flat, and one sign dominating. Open patches use the seed rule.
         let closed = norm(flux) <= MAX_FLUX * wsum;
         if closed && a > 1e-3 * spread && s.abs() >= VOLUME_DECISIVE * a {
-            return s > 0.0;
+            return (s > 0.0, true);
         }
     }
     let nz = normals[seed];
@@ -357,7 +407,7 @@ fn component_sign(
     } else {
         nz[1]
     };
-    key >= 0.0
+    (key >= 0.0, false)
 }
 
 /// Flips points that disagree with the weighted majority of their neighbours, until stable.

@@ -138,28 +138,32 @@ impl Target {
         self.foot_point_from(x, None).0
     }
 
-    /// The data point nearest to `x`: by greedy descent over the neighbour graph from `start`
-    /// when given (see `NeighborGraph::descend`), else, or when the descent cannot certify its
-    /// result, by the kd-tree. Exact either way (up to ties). (A kd-tree radius query bounded by
-    /// the descent's distance was tried for the fallback: no faster on Igea, and much slower
-    /// when the start is poor, as the radius then holds many points.)
+    /// The slot (see `QueryLayout`) of the data point nearest to `x`: by greedy descent over
+    /// the neighbour graph from slot `start` when given (see `NeighborGraph::descend`), else, or
+    /// when the descent cannot certify its result, by the kd-tree. Exact either way (up to
+    /// ties). (A kd-tree radius query bounded by the descent's distance was tried for the
+    /// fallback: no faster on Igea, and much slower when the start is poor, as the radius then
+    /// holds many points.)
     #[inline]
     fn nearest_from(&self, x: &[f64; 3], start: Option<u32>) -> u32 {
-        match start.and_then(|s| self.descent_graph().descend(self.points(), x, s)) {
+        let l = self.layout();
+        match start.and_then(|s| l.descent.descend(&l.points, x, s)) {
             Some((c, true)) => c.index,
-            _ => self.index().nearest(x).index,
+            _ => l.slot[self.index().nearest(x).index as usize],
         }
     }
 
-    /// [`Self::foot_point`] with the nearest-point search started at `start`; also returns the
-    /// data point nearest to `x`. Same result as [`Self::foot_point`] (up to distance ties).
+    /// [`Self::foot_point`] with the nearest-point search started at slot `start`; also returns
+    /// the slot of the data point nearest to `x`. Same result as [`Self::foot_point`] (up to
+    /// distance ties).
     #[inline]
     fn foot_point_from(&self, x: [f64; 3], start: Option<u32>) -> (FootPoint, u32) {
+        let l = self.layout();
         let i = self.nearest_from(&x, start);
-        let pi = self.points()[i as usize];
-        let f = foot_point_on(&self.quadrics()[i as usize], pi, x, i);
+        let pi = l.points[i as usize];
+        let f = foot_point_on(&l.quadrics[i as usize], pi, x, l.point[i as usize]);
         let d = sub(f.point, pi);
-        let h = 0.5 * self.foot_shortcut_diameters()[i as usize];
+        let h = 0.5 * l.shortcut[i as usize];
         if dot(d, d) < h * h {
             return (f, i);
         }
@@ -170,10 +174,10 @@ impl Target {
             return (f, i);
         }
         let g = foot_point_on(
-            &self.quadrics()[j as usize],
-            self.points()[j as usize],
+            &l.quadrics[j as usize],
+            l.points[j as usize],
             x,
-            j,
+            l.point[j as usize],
         );
         (g, i)
     }
@@ -258,10 +262,15 @@ impl Target {
             .zip(hints.par_chunks_mut(CHAIN))
             .for_each(|((o, x), h)| {
                 let mut prev = None;
+                let l = self.layout();
                 for ((o, &x), h) in o.iter_mut().zip(x).zip(h.iter_mut()) {
-                    let start = if *h < n { Some(*h) } else { prev };
+                    let start = if *h < n {
+                        Some(l.slot[*h as usize])
+                    } else {
+                        prev
+                    };
                     let (f, i) = self.foot_point_from(x, start);
-                    (*o, *h, prev) = (f, i, Some(i));
+                    (*o, *h, prev) = (f, l.point[i as usize], Some(i));
                 }
             });
         out

@@ -12,7 +12,7 @@ use crate::error::TargetError;
 use crate::estimate::{
     estimate_all, graph_stride, EstimateParams, Neighborhood, PointEstimate, DESCENT_K,
 };
-use crate::neighbors::{NeighborGraph, PointIndex};
+use crate::neighbors::{morton_order, NeighborGraph, PointIndex};
 use crate::normalize::Normalization;
 use crate::options::{
     NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
@@ -43,8 +43,9 @@ pub struct Target {
     normals: Vec<[f64; 3]>,
     quadrics: Vec<LocalQuadric>,
     index: PointIndex,
-    /// The 16-nearest-neighbour graph for warm-started nearest queries.
-    descent: NeighborGraph,
+    /// Copies of the per-point data of foot-point queries in Morton order (memory locality),
+    /// with the 16-nearest-neighbour graph for warm-started nearest queries.
+    layout: QueryLayout,
     bvh: Option<TriangleBvh>,
     input_to_point: Vec<u32>,
     /// Per point: the larger of the distance to the nearest other point and
@@ -240,9 +241,14 @@ impl Target {
             }
             stats.flipped_normals = o.flipped.iter().filter(|&&f| f).count();
             stats.orientation_components = o.components;
+            stats.winding_flips = o.winding_flips;
         }
-        let descent =
-            NeighborGraph::new(&points, prefix_rows(&graph, stride, DESCENT_K), DESCENT_K);
+        let layout = QueryLayout::new(
+            &points,
+            &quadrics,
+            &nn_dist,
+            &prefix_rows(&graph, stride, DESCENT_K),
+        );
         drop(graph);
         stats.timings.orient = t.elapsed();
         report(Phase::Orient, np, np);
@@ -278,7 +284,7 @@ impl Target {
             normals,
             quadrics,
             index,
-            descent,
+            layout,
             bvh,
             input_to_point,
             nn_dist,
@@ -344,9 +350,9 @@ impl Target {
         &self.index
     }
 
-    /// The nearest-neighbour graph used for warm-started nearest queries.
-    pub(crate) fn descent_graph(&self) -> &NeighborGraph {
-        &self.descent
+    /// The Morton-ordered query data (points, quadrics, shortcut diameters, descent graph).
+    pub(crate) fn layout(&self) -> &QueryLayout {
+        &self.layout
     }
 
     /// The triangle BVH (normalized coordinates, distinct-point indices) for mesh targets.
@@ -393,6 +399,62 @@ impl Target {
             k2: frames.iter().map(|f| f.1).collect(),
             t1: frames.iter().map(|f| f.2).collect(),
             t2: frames.iter().map(|f| f.3).collect(),
+        }
+    }
+}
+
+/// The data read by foot-point queries, copied into Morton (Z-curve) order of the points: "slot"
+/// `s` holds point `point[s]`, and `slot[i]` is the slot of point `i`. The target's public arrays
+/// keep the input order; queries read these copies, so that spatially coherent queries (batches
+/// are processed in Morton order) touch contiguous memory: on a million points in random input
+/// order, cache misses otherwise dominate. Memory: `#P · (4·16 + 8 + 24 + 8 + 8 + 128)` bytes.
+#[derive(Debug)]
+pub(crate) struct QueryLayout {
+    /// Slot of each point, `#P`.
+    pub slot: Vec<u32>,
+    /// Point of each slot, `#P`.
+    pub point: Vec<u32>,
+    /// Positions by slot.
+    pub points: Vec<[f64; 3]>,
+    /// Quadrics by slot.
+    pub quadrics: Vec<LocalQuadric>,
+    /// Foot-point shortcut diameters by slot (see [`Target::foot_shortcut_diameters`]).
+    pub shortcut: Vec<f64>,
+    /// The `DESCENT_K`-nearest-neighbour graph over slots.
+    pub descent: NeighborGraph,
+}
+
+impl QueryLayout {
+    /// `rows`: the `DESCENT_K` nearest neighbours of each point (point indices, `u32::MAX`
+    /// padding), sorted by distance. O(P log P).
+    fn new(points: &[[f64; 3]], quadrics: &[LocalQuadric], shortcut: &[f64], rows: &[u32]) -> Self {
+        let point = morton_order(points);
+        let mut slot = vec![0u32; points.len()];
+        for (s, &i) in point.iter().enumerate() {
+            slot[i as usize] = s as u32;
+        }
+        let k = DESCENT_K;
+        let targets: Vec<u32> = point
+            .par_iter()
+            .flat_map_iter(|&i| {
+                rows[i as usize * k..(i as usize + 1) * k].iter().map(|&j| {
+                    if j == u32::MAX {
+                        j
+                    } else {
+                        slot[j as usize]
+                    }
+                })
+            })
+            .collect();
+        let spoints: Vec<[f64; 3]> = point.par_iter().map(|&i| points[i as usize]).collect();
+        let descent = NeighborGraph::new(&spoints, targets, k);
+        Self {
+            quadrics: point.par_iter().map(|&i| quadrics[i as usize]).collect(),
+            shortcut: point.par_iter().map(|&i| shortcut[i as usize]).collect(),
+            points: spoints,
+            slot,
+            point,
+            descent,
         }
     }
 }
