@@ -417,7 +417,11 @@ impl Groups {
         let kk = samples.len();
         // Columns of Y padded so that every 8-wide window starting below 6s is in bounds.
         let rows = 6 * s + W;
-        for (v, len) in [(&mut *bt, s * kk), (&mut *y, rows * kk), (&mut *r, rows)] {
+        for (v, len) in [
+            (&mut *bt, s * kk),
+            (&mut *y, rows * kk),
+            (&mut *r, 2 * rows),
+        ] {
             if v.len() < len {
                 v.resize(len, 0.0);
             }
@@ -425,7 +429,7 @@ impl Groups {
         let bt = &mut bt[..s * kk];
         bt.fill(0.0);
         let y = &mut y[..rows * kk];
-        let r = &mut r[..rows];
+        let r = &mut r[..2 * rows];
         let x0 = self.smp_ptr[h];
         for (col, ((&k, btcol), ycol)) in samples
             .iter()
@@ -448,28 +452,37 @@ impl Groups {
         }
         let slots = &self.pair_slot[self.pair_ptr[h]..self.pair_ptr[h + 1]];
         let mut pair = 0;
-        for qi in 0..s {
-            let len = 6 * (qi + 1);
+        // Two columns q at a time share the loads of Y (the second is absent for odd s).
+        let (r0, r1) = r.split_at_mut(rows);
+        for q0 in (0..s).step_by(2) {
+            let q1 = (q0 + 1 < s).then_some(q0 + 1);
+            let len = 6 * (q1.unwrap_or(q0) + 1);
             for c0 in (0..len).step_by(W) {
-                let mut acc = [0.0f64; W];
+                let (mut a0, mut a1) = ([0.0f64; W], [0.0f64; W]);
                 for (ycol, btcol) in y.chunks_exact(rows).zip(bt.chunks_exact(s)) {
-                    let c = btcol[qi];
-                    if c == 0.0 {
+                    let c = btcol[q0];
+                    let d = q1.map_or(0.0, |q1| btcol[q1]);
+                    if c == 0.0 && d == 0.0 {
                         continue;
                     }
                     let yw: &[f64; W] = ycol[c0..c0 + W].try_into().expect("8-wide window");
-                    for (a, &v) in acc.iter_mut().zip(yw) {
+                    for ((a, b), &v) in a0.iter_mut().zip(a1.iter_mut()).zip(yw) {
                         *a += c * v;
+                        *b += d * v;
                     }
                 }
-                r[c0..c0 + W].copy_from_slice(&acc);
+                r0[c0..c0 + W].copy_from_slice(&a0);
+                r1[c0..c0 + W].copy_from_slice(&a1);
             }
-            for p in 0..=qi {
-                let dst = &mut part[slots[pair] as usize];
-                for (d, &v) in dst.iter_mut().zip(&r[6 * p..6 * p + 6]) {
-                    *d += v;
+            for (qi, rq) in [(Some(q0), &*r0), (q1, &*r1)] {
+                let Some(qi) = qi else { continue };
+                for p in 0..=qi {
+                    let dst = &mut part[slots[pair] as usize];
+                    for (d, &v) in dst.iter_mut().zip(&rq[6 * p..6 * p + 6]) {
+                        *d += v;
+                    }
+                    pair += 1;
                 }
-                pair += 1;
             }
         }
     }
