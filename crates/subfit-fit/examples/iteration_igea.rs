@@ -19,12 +19,17 @@
 //! the process's user + system time from `/proc/self/stat` (Linux only; 0 elsewhere). The
 //! machine is shared: run with `RAYON_NUM_THREADS=2` and note `uptime`'s load with the figures.
 //!
-//! Measured 2026-11-22 (2 rayon threads on a 2-core machine shared with four other builds,
-//! load 2–3; SDMLM, λ = 1e-3, defaults otherwise), wall per iteration:
-//! 1k control points (64k samples, Cholesky): ~175 ms — project 70–100, assemble 40–60,
-//! solve 30–60; 10k (640k samples, PCG): ~1.45 s — project 740–820, assemble 380–630,
-//! solve 130–190, sample ~20, evaluate ~15. Before (Cholesky, scalar AMD, old fill): 10k
-//! ~1.95 s at load 3 with solve 0.72–1.23 s; the old fill cost 2.7× the new one's CPU time.
+//! Measured 2026-11-22 06:30 UTC, branch `fitspeed` against its base 053cd26 (same data,
+//! both binaries run alternately three times; 2 rayon threads on the 2-core machine shared
+//! with other builds, load 3.9–4.7; SDMLM, λ = 1e-3, defaults otherwise), wall per iteration:
+//! 10k control points (640k samples, PCG): best run 0.64 s mean (iterations 0.62–0.68 s:
+//! project 313–329 ms, assemble 182–250, solve 82–90, sample 15–23, evaluate 9–11), median of
+//! the three runs' means 1.13 s, CPU 1.32–1.36 s per iteration. Base in the same conditions:
+//! best run 1.24 s mean (iterations 0.89–1.53 s: assemble 346–656, solve 173–313), median
+//! 1.46 s, CPU 1.69–1.89 s. 1k control points (64k samples, Cholesky): best run 108 ms mean
+//! (base 189 ms).
+//! The assembly is the grouped fill of `subfit_fit::assemble` (see `examples/assemble_igea.rs`
+//! for its CPU time alone); projection is `subfit-target`'s and dominates what is left.
 #![allow(clippy::print_stdout)]
 
 use std::time::{Duration, Instant};
