@@ -15,16 +15,23 @@
 //! (comma-separated control-point counts, default `1000,10000`), `SUBFIT_ITERS` (default 3),
 //! `SUBFIT_SAMPLE_LEVEL` (default 3), `SUBFIT_LAMBDA` (default 1e-3), `SUBFIT_SOLVER`
 //! (`auto`, `cholesky` or `pcg`; default `auto`), `SUBFIT_ORDERING` (`scalar-amd`,
-//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-2). CPU time is
+//! `block-amd` or `nd`; default `block-amd`), `SUBFIT_PCG_TOL` (default 1e-2),
+//! `SUBFIT_ACTIVE` (a fraction in (0, 1]: fit only that first fraction of the control points
+//! with [`Fitter::set_active`]; default: all, the normal path). CPU time is
 //! the process's user + system time from `/proc/self/stat` (Linux only; 0 elsewhere). The
 //! machine is shared: run with `RAYON_NUM_THREADS=2` and note `uptime`'s load with the figures.
 //!
-//! Measured 2026-11-22 (2 rayon threads on a 2-core machine shared with four other builds,
-//! load 2–3; SDMLM, λ = 1e-3, defaults otherwise), wall per iteration:
-//! 1k control points (64k samples, Cholesky): ~175 ms — project 70–100, assemble 40–60,
-//! solve 30–60; 10k (640k samples, PCG): ~1.45 s — project 740–820, assemble 380–630,
-//! solve 130–190, sample ~20, evaluate ~15. Before (Cholesky, scalar AMD, old fill): 10k
-//! ~1.95 s at load 3 with solve 0.72–1.23 s; the old fill cost 2.7× the new one's CPU time.
+//! Measured 2026-11-22 06:30 UTC, branch `fitspeed` against its base 053cd26 (same data,
+//! both binaries run alternately three times; 2 rayon threads on the 2-core machine shared
+//! with other builds, load 3.9–4.7; SDMLM, λ = 1e-3, defaults otherwise), wall per iteration:
+//! 10k control points (640k samples, PCG): best run 0.64 s mean (iterations 0.62–0.68 s:
+//! project 313–329 ms, assemble 182–250, solve 82–90, sample 15–23, evaluate 9–11), median of
+//! the three runs' means 1.13 s, CPU 1.32–1.36 s per iteration. Base in the same conditions:
+//! best run 1.24 s mean (iterations 0.89–1.53 s: assemble 346–656, solve 173–313), median
+//! 1.46 s, CPU 1.69–1.89 s. 1k control points (64k samples, Cholesky): best run 108 ms mean
+//! (base 189 ms).
+//! The assembly is the grouped fill of `subfit_fit::assemble` (see `examples/assemble_igea.rs`
+//! for its CPU time alone); projection is `subfit-target`'s and dominates what is left.
 #![allow(clippy::print_stdout)]
 
 use std::time::{Duration, Instant};
@@ -76,6 +83,10 @@ fn main() {
     let level = env("SUBFIT_SAMPLE_LEVEL", 3usize);
     let lambda = env("SUBFIT_LAMBDA", 1e-3f64);
     let pcg_tol = env("SUBFIT_PCG_TOL", 1e-2f64);
+    let active = std::env::var("SUBFIT_ACTIVE")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|f| *f > 0.0 && *f <= 1.0);
     let solver = match std::env::var("SUBFIT_SOLVER").as_deref() {
         Ok("cholesky") => LinearSolver::Cholesky,
         Ok("pcg") => LinearSolver::Pcg,
@@ -158,6 +169,20 @@ fn main() {
             ms(setup),
             ms(setup_cpu)
         );
+        if let Some(frac) = active {
+            // The first fraction of the control points (QEM keeps the order spatially local).
+            let k = (frac * positions.len() as f64).ceil() as usize;
+            let mask: Vec<bool> = (0..positions.len()).map(|i| i < k).collect();
+            let t = Instant::now();
+            fitter.set_active(Some(mask)).expect("active set");
+            println!(
+                "active set: {k} of {} control points, {} of {} samples, built in {:.0} ms",
+                positions.len(),
+                fitter.num_active_samples(),
+                fitter.num_samples(),
+                ms(t.elapsed())
+            );
+        }
         let mut p = positions.clone();
         let (c0, t) = (cpu_time(), Instant::now());
         let report = fitter.run(&mut p, None).expect("fit");
