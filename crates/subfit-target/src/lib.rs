@@ -28,6 +28,7 @@
 // `!(x > 0.0)` is used deliberately: it is true for NaN, which must take the fallback branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod blend;
 pub mod closest;
 mod error;
 pub mod estimate;

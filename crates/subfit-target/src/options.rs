@@ -153,6 +153,10 @@ pub struct TargetStats {
     /// Flips made by the global winding-number check of the orientation (see
     /// [`crate::orient`]; included in the net effect counted by `flipped_normals`).
     pub winding_flips: usize,
+    /// Points whose quadric disagrees with its neighbours' (creases, scanner debris): foot
+    /// points next to them are blended over the neighbouring quadrics (see
+    /// [`crate::Target::foot_point`]).
+    pub untrusted_quadrics: usize,
     /// Connected components of the orientation graph (0 when no orientation was needed).
     pub orientation_components: usize,
     /// Smallest, mean and largest neighbourhood size (points, the point itself included).

@@ -6,6 +6,10 @@
 //! certified greedy descent over the 16-nearest-neighbour graph from a nearby point, with the
 //! kd-tree as fallback: same result, fewer tree traversals), then the closest point on that
 //! point's local quadric (Newton on the height function, [`LocalQuadric::project_local`]).
+//! Where that one quadric is not to be trusted — next to a point whose quadric disagrees with
+//! its neighbours' (creases, scanner debris), or over a sampling gap — the foot point is
+//! instead blended over the quadrics of the 16 nearest data points (`blend` module; Ohtake et
+//! al. 2003's partition of unity of local quadrics).
 //!
 //! Signs, quoting Cheng 2007 §II-D3: "If the sample point S_k is on the side of Γ_T pointed to by
 //! N, i.e., N·(S_k⁰ − V_k⁰) > 0, then d > 0; otherwise, d ≤ 0. Similarly, if the curvature center
@@ -16,6 +20,7 @@
 
 use rayon::prelude::*;
 
+use crate::blend::{blended, needs_blend, BLEND_K};
 use crate::closest::MeshClosestPoint;
 use crate::quadric::LocalQuadric;
 use crate::target::Target;
@@ -134,6 +139,13 @@ impl Target {
     /// skipped when the foot point lies within half the nearest-neighbour spacing of the data
     /// point (then no other data point can be nearer to it: triangle inequality), so the result
     /// is the same as with the second query.
+    ///
+    /// Next to an untrusted quadric ([`crate::TargetStats::untrusted_quadrics`]) or when `x`
+    /// lies over a sampling gap (its offset from the nearest data point, tangential to the foot
+    /// point's normal, above 0.4 of that point's neighbourhood radius), the signed distances
+    /// and normals of the projections on the 16 nearest points' quadrics are blended instead
+    /// (weights `exp(−|x − p_j|² / (R_j/2)²)`, points of an opposite-facing sheet left out);
+    /// this costs one 16-nearest query and 16 projections more.
     pub fn foot_point(&self, x: [f64; 3]) -> FootPoint {
         self.foot_point_from(x, None).0
     }
@@ -160,6 +172,24 @@ impl Target {
     fn foot_point_from(&self, x: [f64; 3], start: Option<u32>) -> (FootPoint, u32) {
         let l = self.layout();
         let i = self.nearest_from(&x, start);
+        let (f, j) = self.nearest_quadric_foot(x, i);
+        if !(l.untrusted[j as usize] || needs_blend(l, x, i as usize, &f)) {
+            return (f, i);
+        }
+        let near = self
+            .index()
+            .k_nearest(&x, BLEND_K)
+            .into_iter()
+            .map(|n| l.slot[n.index as usize] as usize);
+        (blended(l, x, near, f), i)
+    }
+
+    /// The foot point of `x` on the quadric of its nearest data point (slot `i`), redone on
+    /// the quadric of the data point nearest to that foot point when it is another one; also
+    /// returns the slot whose quadric was used.
+    #[inline]
+    fn nearest_quadric_foot(&self, x: [f64; 3], i: u32) -> (FootPoint, u32) {
+        let l = self.layout();
         let pi = l.points[i as usize];
         let f = foot_point_on(&l.quadrics[i as usize], pi, x, l.point[i as usize]);
         let d = sub(f.point, pi);
@@ -179,7 +209,7 @@ impl Target {
             x,
             l.point[j as usize],
         );
-        (g, i)
+        (g, j)
     }
 
     /// [`Self::foot_point`] for many points, in parallel (rayon); `#Q` results in order.

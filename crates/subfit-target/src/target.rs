@@ -243,12 +243,15 @@ impl Target {
             stats.orientation_components = o.components;
             stats.winding_flips = o.winding_flips;
         }
+        let radius: Vec<f64> = estimates.iter().map(|e| e.radius).collect();
         let layout = QueryLayout::new(
             &points,
             &quadrics,
             &nn_dist,
+            &radius,
             &prefix_rows(&graph, stride, DESCENT_K),
         );
+        stats.untrusted_quadrics = layout.untrusted.iter().filter(|&&u| u).count();
         drop(graph);
         stats.timings.orient = t.elapsed();
         report(Phase::Orient, np, np);
@@ -420,6 +423,10 @@ pub(crate) struct QueryLayout {
     pub quadrics: Vec<LocalQuadric>,
     /// Foot-point shortcut diameters by slot (see [`Target::foot_shortcut_diameters`]).
     pub shortcut: Vec<f64>,
+    /// Neighbourhood radius of each slot's quadric fit.
+    pub radius: Vec<f64>,
+    /// Whether each slot's quadric disagrees with its neighbours' (see `blend::untrusted`).
+    pub untrusted: Vec<bool>,
     /// The `DESCENT_K`-nearest-neighbour graph over slots.
     pub descent: NeighborGraph,
 }
@@ -427,7 +434,13 @@ pub(crate) struct QueryLayout {
 impl QueryLayout {
     /// `rows`: the `DESCENT_K` nearest neighbours of each point (point indices, `u32::MAX`
     /// padding), sorted by distance. O(P log P).
-    fn new(points: &[[f64; 3]], quadrics: &[LocalQuadric], shortcut: &[f64], rows: &[u32]) -> Self {
+    fn new(
+        points: &[[f64; 3]],
+        quadrics: &[LocalQuadric],
+        shortcut: &[f64],
+        radius: &[f64],
+        rows: &[u32],
+    ) -> Self {
         let point = morton_order(points);
         let mut slot = vec![0u32; points.len()];
         for (s, &i) in point.iter().enumerate() {
@@ -447,10 +460,22 @@ impl QueryLayout {
             })
             .collect();
         let spoints: Vec<[f64; 3]> = point.par_iter().map(|&i| points[i as usize]).collect();
+        let squadrics: Vec<LocalQuadric> =
+            point.par_iter().map(|&i| quadrics[i as usize]).collect();
+        let sradius: Vec<f64> = point.par_iter().map(|&i| radius[i as usize]).collect();
+        let untrusted = (0..point.len())
+            .into_par_iter()
+            .map(|s| {
+                let row = &targets[s * k..(s + 1) * k];
+                crate::blend::untrusted(&spoints, &squadrics, sradius[s], s, row)
+            })
+            .collect();
         let descent = NeighborGraph::new(&spoints, targets, k);
         Self {
-            quadrics: point.par_iter().map(|&i| quadrics[i as usize]).collect(),
+            quadrics: squadrics,
             shortcut: point.par_iter().map(|&i| shortcut[i as usize]).collect(),
+            radius: sradius,
+            untrusted,
             points: spoints,
             slot,
             point,

@@ -24,6 +24,8 @@ struct Summary {
     flipped_normals: usize,
     ambiguous_normals: usize,
     degenerate_fits: usize,
+    /// Points whose quadric disagrees with its neighbours' (foot points blended there).
+    untrusted_quadrics: usize,
     orientation_components: usize,
     neighborhood_size: [f64; 3],
     neighborhood_radius: [f64; 3],
@@ -126,6 +128,7 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         flipped_normals: s.flipped_normals,
         ambiguous_normals: s.ambiguous_normals,
         degenerate_fits: s.degenerate_fits,
+        untrusted_quadrics: s.untrusted_quadrics,
         orientation_components: s.orientation_components,
         neighborhood_size: [
             s.neighborhood_size.0 as f64,
@@ -205,6 +208,10 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
     println!(
         "normals       {}; {} flipped by orientation, {} ambiguous, {} degenerate fits, {} orientation component(s)",
         s.normal_origin, s.flipped_normals, s.ambiguous_normals, s.degenerate_fits, s.orientation_components
+    );
+    println!(
+        "quadrics      {} disagree with their neighbours' (foot points blended next to them)",
+        s.untrusted_quadrics
     );
     println!(
         "neighbours    k min/mean/max {:.0}/{:.1}/{:.0}; radius min/median/max {:.5}/{:.5}/{:.5}",
