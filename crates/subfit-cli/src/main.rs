@@ -2,12 +2,13 @@
 //!
 //! Argument parsing (clap) turns argv into a typed [`cli::Command`]; every flag is validated
 //! before any file is touched. Exit codes: 0 success, 1 failure to fit within the budget,
-//! 2 bad input or usage (one line on stderr).
+//! 2 bad input or usage (one line on stderr), 130 interrupted (no partial output left).
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
 mod cli;
 mod commands;
+mod interrupt;
 mod plot;
 mod progress;
 
@@ -28,6 +29,7 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
+    interrupt::install();
     match commands::run(args) {
         Ok(code) => code,
         Err(e) => {

@@ -188,6 +188,7 @@ fn write_points(out: &std::path::Path, at: &subfit::target::PointAttributes) -> 
         encoding: Encoding::BinaryLittleEndian,
         single_precision: false,
     };
+    crate::interrupt::watch_dir(out);
     subfit::io::write_ply_with_properties(out, &cloud, &props, &opts)?;
     Ok(())
 }

@@ -194,6 +194,7 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
             reports.push((label.clone(), report));
         }
         let base = a.output.join(format!("example{}", ex.number));
+        crate::interrupt::watch_dir(&base.with_extension("csv"));
         subfit::io::write_atomic(&base.with_extension("csv"), csv(&reports).as_bytes())?;
         let svg = log_chart(
             ex.title,
@@ -202,10 +203,12 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
             &series,
             Some(TOLERANCE),
         );
+        crate::interrupt::watch_dir(&base.with_extension("svg"));
         subfit::io::write_atomic(&base.with_extension("svg"), svg.as_bytes())?;
     }
     bar.finish_and_clear();
     let doc = json!({ "tolerance": TOLERANCE, "points": a.points, "runs": summary });
+    crate::interrupt::watch_dir(&a.output.join("summary.json"));
     subfit::io::write_atomic(
         &a.output.join("summary.json"),
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),

@@ -186,6 +186,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
         println!("{r}");
     }
     println!("(errors in unit-cube units; `met`: the row's tolerance and budget were met)");
+    crate::interrupt::watch_dir(&a.output.join("summary.json"));
     subfit::io::write_atomic(
         &a.output.join("summary.json"),
         (serde_json::to_string_pretty(&json!({

@@ -52,6 +52,7 @@ pub fn run(a: ConvertArgs) -> anyhow::Result<ExitCode> {
         encoding,
         single_precision: a.single,
     };
+    crate::interrupt::watch_dir(&a.output);
     subfit::io::write_file(&a.output, &mesh, &wopts)?;
     eprintln!(
         "{} ({} {:?}) -> {} ({} {:?}): {} vertices, {} faces",

@@ -35,6 +35,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
     for (name, shape) in Shape::builtin() {
         let cloud = shape.sample(a.points as usize, a.noise, a.seed);
         let path = a.output.join(format!("{name}.ply"));
+        crate::interrupt::watch_dir(&path);
         subfit::io::write_file(&path, &cloud, &opts)?;
         if a.no_fit {
             rows.push(format!(

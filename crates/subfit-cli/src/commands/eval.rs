@@ -65,12 +65,14 @@ pub fn run(a: EvalArgs) -> anyhow::Result<ExitCode> {
             encoding: Encoding::BinaryLittleEndian,
             single_precision: false,
         };
+        crate::interrupt::watch_dir(&a.output);
         subfit::io::write_ply_with_properties(&a.output, &cloud, &props, &opts)?;
     } else {
         let opts = WriteOptions {
             format: Some(format),
             ..WriteOptions::default()
         };
+        crate::interrupt::watch_dir(&a.output);
         subfit::io::write_file(&a.output, &cloud, &opts)?;
     }
     eprintln!(

@@ -31,6 +31,16 @@ const MAX_TESSELLATION_LEVEL: usize = 6;
 /// Largest tessellation (vertices) written to `limit.ply`.
 const MAX_TESSELLATION_VERTICES: usize = 1_000_000;
 
+/// The files `subfit fit` writes, in the order they are moved into place (the report last).
+const OUTPUTS: [&str; 6] = [
+    "control.obj",
+    "control.usda",
+    "limit.ply",
+    "error.ply",
+    "log.csv",
+    "report.json",
+];
+
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let out = execute(&a)?;
     println!("{}", out.summary);
@@ -238,10 +248,10 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
     let fitted = &result.mesh;
     let last = report.last;
 
-    // Outputs, in the target's original coordinates; every file is written to a temporary
-    // name and renamed.
+    // Outputs, in the target's original coordinates: written into a staging directory inside
+    // the output directory, then moved into place together (an interruption leaves none).
     let t_out = Instant::now();
-    std::fs::create_dir_all(&a.output)
+    let stage = crate::interrupt::Staging::new(&a.output)
         .with_context(|| format!("{}: cannot create directory", a.output.display()))?;
     let cage = PolyMesh::new(
         fitted
@@ -256,13 +266,13 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         encoding: Encoding::Ascii,
         single_precision: false,
     };
-    subfit::io::write_file(&a.output.join("control.obj"), &cage, &obj)?;
+    subfit::io::write_file(&stage.path("control.obj"), &cage, &obj)?;
     let usd_scheme = match scheme {
         Scheme::Loop => UsdScheme::Loop,
         _ => UsdScheme::CatmullClark,
     };
     subfit::io::write_usda_file(
-        &a.output.join("control.usda"),
+        &stage.path("control.usda"),
         &cage,
         &Tags::new(),
         usd_scheme,
@@ -296,7 +306,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         encoding: Encoding::BinaryLittleEndian,
         single_precision: false,
     };
-    subfit::io::write_file(&a.output.join("limit.ply"), &limit, &ply)?;
+    subfit::io::write_file(&stage.path("limit.ply"), &limit, &ply)?;
     let to_original = target.normalization().length_to_original(1.0);
     let error_original: Vec<f64> = local.iter().map(|e| e * to_original).collect();
     let colored = PolyMesh {
@@ -304,7 +314,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         ..limit
     };
     subfit::io::write_ply_with_properties(
-        &a.output.join("error.ply"),
+        &stage.path("error.ply"),
         &colored,
         &[
             VertexProperty {
@@ -318,7 +328,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         ],
         &ply,
     )?;
-    subfit::io::write_atomic(&a.output.join("log.csv"), log_csv(report).as_bytes())?;
+    subfit::io::write_atomic(&stage.path("log.csv"), log_csv(report).as_bytes())?;
     let reached = stages.reached(&last);
     let output_time = t_out.elapsed();
     let doc = json!({
@@ -367,9 +377,12 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         },
     });
     subfit::io::write_atomic(
-        &a.output.join("report.json"),
+        &stage.path("report.json"),
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
+    stage
+        .commit(&OUTPUTS)
+        .with_context(|| format!("{}: cannot move the outputs into place", a.output.display()))?;
     let summary = format!(
         "{} → {} control points, {} stages, {} iterations ({:?}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (unit cube); {:.1} s; wrote {}",
         control.num_vertices(),

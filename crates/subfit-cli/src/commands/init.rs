@@ -108,6 +108,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         encoding: Encoding::Ascii,
         single_precision: false,
     };
+    crate::interrupt::watch_dir(&a.output);
     subfit::io::write_file(&a.output, &out, &wopts)?;
     let write_time = t.elapsed();
 

@@ -88,6 +88,7 @@ pub fn run(a: SubdivideArgs) -> anyhow::Result<ExitCode> {
         encoding,
         single_precision: false,
     };
+    crate::interrupt::watch_dir(&a.output);
     subfit::io::write_file(&a.output, &result, &opts)?;
     eprintln!(
         "{} ({:?}, {} level(s){}) -> {}: {} vertices, {} faces",
