@@ -278,8 +278,14 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         usd_scheme,
         UsdBoundary::EdgeOnly,
     )?;
-    let (limit, level, chord) =
-        limit_tessellation(&fitted.faces, &fitted.positions, scheme, last.e_rms)?;
+    let (limit, level, chord) = limit_tessellation(
+        &fitted.faces,
+        &fitted.positions,
+        scheme,
+        last.e_rms,
+        last.e_max,
+    )?;
+    let limit_vertices = limit.positions.len();
     // Local error of every limit vertex: its distance to the target (unit-cube units).
     let local: Vec<f64> =
         subfit::fit::feet::foot_points(&target, options.foot_points, &limit.positions)
@@ -365,7 +371,13 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         "tolerance_reached": reached,
         "stages": report.stages.iter().map(stage_json).collect::<Vec<_>>(),
         "iterations": report.stages.iter().flat_map(|s| s.fit.iterations.iter().map(move |r| row_json(s.stage, r))).collect::<Vec<_>>(),
-        "limit_tessellation": { "level": level, "predicted_chordal_error": chord },
+        "limit_tessellation": {
+            "level": level,
+            "vertices": limit_vertices,
+            "predicted_chordal_error": { "max": chord.max, "rms": chord.rms },
+            "goal": { "max": 0.1 * last.e_max, "rms": 0.1 * last.e_rms },
+            "goal_met": chord.max <= 0.1 * last.e_max && chord.rms <= 0.1 * last.e_rms,
+        },
         "error_color_scale_unit_cube": scale,
         "timings_s": {
             "read": read_time.as_secs_f64(),
@@ -546,11 +558,31 @@ pub fn log_csv(r: &StagesReport) -> String {
     s
 }
 
-/// The limit surface tessellated at the coarsest level whose chordal error is at most a tenth
-/// of `e_rms` — or the finest level with at most [`MAX_TESSELLATION_VERTICES`] vertices (up
-/// to level [`MAX_TESSELLATION_LEVEL`]). The chordal error of level 1 is measured (the largest
-/// distance between the level-2 limit point of an edge and the midpoint of the limit points of
-/// its ends) and divided by 4 per level, as it shrinks with the square of the edge length on a
+/// Chordal error of a tessellation (normalized units): the largest and the RMS, over its
+/// edges, of the distance from the limit point of the edge's midpoint to the chord.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Chordal {
+    /// Largest over the edges.
+    pub max: f64,
+    /// Root mean square over the edges.
+    pub rms: f64,
+}
+
+impl Chordal {
+    fn scaled(self, s: f64) -> Self {
+        Self {
+            max: self.max * s,
+            rms: self.rms * s,
+        }
+    }
+}
+
+/// The limit surface tessellated at the coarsest level whose chordal error is below a tenth of
+/// the fitting error in the same norm — RMS chordal error ≤ `e_rms / 10` and largest chordal
+/// error ≤ `e_max / 10` — or the finest level with at most [`MAX_TESSELLATION_VERTICES`]
+/// vertices (up to level [`MAX_TESSELLATION_LEVEL`]). The chordal error of level 1 is measured
+/// (between the level-2 limit point of each edge and the midpoint of the limit points of its
+/// ends) and divided by 4 per level, as it shrinks with the square of the edge length on a
 /// smooth surface; so only levels 1, 2 and the chosen one are built. Returns the mesh
 /// (positions, limit normals, faces), the level and the predicted chordal error.
 pub fn limit_tessellation(
@@ -558,17 +590,19 @@ pub fn limit_tessellation(
     control: &[[f64; 3]],
     scheme: Scheme,
     e_rms: f64,
-) -> anyhow::Result<(PolyMesh, usize, f64)> {
+    e_max: f64,
+) -> anyhow::Result<(PolyMesh, usize, Chordal)> {
     let opts = Options::new(scheme);
     let tags = Tags::new();
-    let goal = 0.1 * e_rms;
     let one = sampling_operator(faces, control.len(), &tags, &opts, 1)?;
     let two = sampling_operator(faces, control.len(), &tags, &opts, 2)?;
     let chord1 = chordal_estimate(&one.faces, one.num_vertices, &two.position.apply(control));
+    let at = |level: usize| chord1.scaled(0.25f64.powi(level as i32 - 1));
+    let fine_enough = |c: Chordal| c.rms <= 0.1 * e_rms && c.max <= 0.1 * e_max;
     let mut level = 1;
     let mut vertices = one.num_vertices;
     while level < MAX_TESSELLATION_LEVEL
-        && chord1 / 4f64.powi(level as i32 - 1) > goal
+        && !fine_enough(at(level))
         && vertices.saturating_mul(4) <= MAX_TESSELLATION_VERTICES
     {
         level += 1;
@@ -586,27 +620,65 @@ pub fn limit_tessellation(
         colors: None,
         faces: op.faces,
     };
-    Ok((mesh, level, chord1 / 4f64.powi(level as i32 - 1)))
+    Ok((mesh, level, at(level)))
 }
 
-/// Largest `|fine[V + e] − (fine[a] + fine[b]) / 2|` over the edges `e = (a, b)` of the coarse
-/// faces, numbered in order of first appearance (the refinement's child order: vertex points
-/// keep their ids, then one edge point per edge).
-fn chordal_estimate(faces: &Polygons, nv: usize, fine: &[[f64; 3]]) -> f64 {
+/// Largest and RMS `|fine[V + e] − (fine[a] + fine[b]) / 2|` over the edges `e = (a, b)` of
+/// the coarse faces, numbered in order of first appearance (the refinement's child order:
+/// vertex points keep their ids, then one edge point per edge).
+fn chordal_estimate(faces: &Polygons, nv: usize, fine: &[[f64; 3]]) -> Chordal {
     let mut ids: HashMap<(u32, u32), usize> = HashMap::with_capacity(faces.indices().len());
-    let mut worst: f64 = 0.0;
+    let (mut worst, mut sum2): (f64, f64) = (0.0, 0.0);
     for f in faces.iter() {
         for i in 0..f.len() {
             let (a, b) = (f[i], f[(i + 1) % f.len()]);
             let key = (a.min(b), a.max(b));
             let next = ids.len();
             let e = *ids.entry(key).or_insert(next);
+            if e != next {
+                continue; // seen from the other side
+            }
             let (pa, pb, pe) = (fine[a as usize], fine[b as usize], fine[nv + e]);
             let d2: f64 = (0..3)
                 .map(|k| (pe[k] - 0.5 * (pa[k] + pb[k])).powi(2))
                 .sum();
             worst = worst.max(d2.sqrt());
+            sum2 += d2;
         }
     }
-    worst
+    Chordal {
+        max: worst,
+        rms: (sum2 / ids.len().max(1) as f64).sqrt(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subfit::mesh::shapes::torus_mesh;
+
+    /// The chordal error predicted from level 1 (÷ 4 per level) against the one measured at
+    /// level 3 (level-3 chords against level-4 limit points), on a torus cage.
+    #[test]
+    fn predicted_chordal_error_matches_the_measured_one() {
+        let cage = torus_mesh(1.0, 0.4, 12, 8, true);
+        let (faces, p) = (&cage.faces, &cage.positions);
+        let opts = Options::new(Scheme::Loop);
+        let op = |l| sampling_operator(faces, p.len(), &Tags::new(), &opts, l).unwrap();
+        let (one, two, three, four) = (op(1), op(2), op(3), op(4));
+        let c1 = chordal_estimate(&one.faces, one.num_vertices, &two.position.apply(p));
+        let c3 = chordal_estimate(&three.faces, three.num_vertices, &four.position.apply(p));
+        let predicted = c1.scaled(1.0 / 16.0);
+        for (m, q) in [(c3.max, predicted.max), (c3.rms, predicted.rms)] {
+            assert!(
+                m > 0.0 && (m / q - 1.0).abs() < 0.25,
+                "measured {m}, predicted {q}"
+            );
+        }
+        // RMS below max; the tessellation goal picks the first level meeting both norms.
+        assert!(c1.rms < c1.max);
+        let (_, level, chord) = limit_tessellation(faces, p, Scheme::Loop, c1.rms, c1.max).unwrap();
+        assert_eq!(level, 3);
+        assert!(chord.rms <= 0.1 * c1.rms && chord.max <= 0.1 * c1.max);
+    }
 }
