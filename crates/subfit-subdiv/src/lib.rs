@@ -24,6 +24,8 @@ pub mod scheme;
 pub mod stencil;
 pub mod topology;
 
+mod child;
+
 pub use error::SubdivError;
 pub use limit::{limit_stencils, LimitStencils};
 pub use mask::{EdgeMask, FaceWeights, Mask};

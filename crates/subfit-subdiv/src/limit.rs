@@ -18,9 +18,10 @@
 //! `Limit` applied at level 0 instead weights "the vertex two corners away" in an `n`-gon, which
 //! is not the limit; it documents that it needs one refinement to remove `n`-gons.)
 
+use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
-use crate::refine::{neighborhoods, refine_topology, sharp_edges, topology_for};
+use crate::refine::{classify, neighborhoods, refine_topology, sharp_edges, topology_for};
 use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
 use crate::stencil::{compose_rows, MultiRows, Stacked, StencilMatrix};
@@ -72,13 +73,15 @@ struct LimitMasks {
 }
 
 /// Appends the limit row of vertex `v` (position and two tangent weights per entry; repeated
-/// columns possible) to `row`.
+/// columns possible) to `row`: `ring` holds the far ends of its ring edges and `diagonal(i)` is
+/// the vertex two corners away from `v` in its ring face `i` (the quad's diagonal).
 fn push_limit_row(
-    topo: &Topology,
     scheme: Scheme,
     hood: &Neighborhood,
     cache: &mut LimitMasks,
     v: u32,
+    ring: &[u32],
+    diagonal: impl Fn(usize) -> u32,
     row: &mut Vec<(u32, [f64; 3])>,
 ) {
     if cache.hood.as_ref() != Some(hood) {
@@ -88,16 +91,28 @@ fn push_limit_row(
     }
     let [p, a, b] = &cache.masks;
     row.push((v, [p.vertex, a.vertex, b.vertex]));
-    for (i, &u) in topo.vertex_ring(v).iter().enumerate() {
+    for (i, &u) in ring.iter().enumerate() {
         row.push((u, [p.edges[i], a.edges[i], b.edges[i]]));
     }
     let nf = p.faces.len().max(a.faces.len()).max(b.faces.len());
     let get = |m: &Mask, i: usize| m.faces.get(i).copied().unwrap_or(0.0);
-    for (i, &c) in topo.vertex_corners(v).iter().enumerate().take(nf) {
-        // The vertex two corners away (the quad's diagonal).
-        let d = topo.corner_vertex(topo.corner_next(topo.corner_next(c)));
-        row.push((d, [get(p, i), get(a, i), get(b, i)]));
+    for i in 0..nf.min(hood.num_faces) {
+        row.push((diagonal(i), [get(p, i), get(a, i), get(b, i)]));
     }
+}
+
+/// [`push_limit_row`] for vertex `v` of `topo`.
+fn push_topology_limit_row(
+    topo: &Topology,
+    scheme: Scheme,
+    hood: &Neighborhood,
+    cache: &mut LimitMasks,
+    v: u32,
+    row: &mut Vec<(u32, [f64; 3])>,
+) {
+    let corners = topo.vertex_corners(v);
+    let diagonal = |i: usize| topo.corner_vertex(topo.corner_next(topo.corner_next(corners[i])));
+    push_limit_row(scheme, hood, cache, v, topo.vertex_ring(v), diagonal, row);
 }
 
 fn needs_refinement(topo: &Topology, options: &Options) -> bool {
@@ -124,7 +139,7 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     let mut row = Vec::new();
     for (v, hood) in hoods.iter().enumerate() {
         row.clear();
-        push_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
+        push_topology_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
         for &(c, w) in &row {
             rows.cols.push(c);
             rows.weights.push(w);
@@ -134,24 +149,43 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     rows
 }
 
-/// The three products `L · rhs` (limit position, tangent 1, tangent 2 of every vertex of
-/// `topo`, times `rhs` with `#V` rows), generating the limit rows on the fly (never stored).
-pub(crate) fn limit_compose(
-    topo: &Topology,
-    tags: &Tags,
+/// The three products `L · rhs` (limit position, tangent 1, tangent 2 of every vertex of the
+/// once-refined child of `parent`, whose crease and corner tags are `child_tags`, times `rhs`
+/// with one row per child vertex), generating the limit rows on the fly (never stored) and
+/// reading the child's adjacency off the parent's ([`crate::child`]) instead of building it.
+///
+/// # Panics
+/// If `rhs.nrows()` is not the child's vertex count.
+#[track_caller]
+pub(crate) fn limit_compose_child(
+    parent: &Topology,
+    child_tags: &Tags,
     options: &Options,
     rhs: &StencilMatrix,
 ) -> [StencilMatrix; 3] {
-    if needs_refinement(topo, options) {
-        return limit_rows(topo, tags, options).compose(rhs);
-    }
-    let sharp = sharp_edges(topo, tags);
-    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
+    let child = ChildCorners::new(parent, options.scheme);
+    assert_eq!(rhs.nrows(), child.num_vertices(), "inner dimensions differ");
+    let tagged = !child_tags.is_empty();
     compose_rows(
-        topo.num_vertices(),
+        child.num_vertices(),
         Stacked::one(rhs),
-        LimitMasks::default,
-        |masks, v, row| push_limit_row(topo, options.scheme, &hoods[v], masks, v as u32, row),
+        <(LimitMasks, ChildRing)>::default,
+        |(masks, ring), w, row| {
+            let w = w as u32;
+            child.ring(w, ring);
+            // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
+            // tagged infinitely sharp.
+            let sharp = ring
+                .verts
+                .iter()
+                .zip(&ring.boundary)
+                .map(|(&u, &b)| b || (tagged && child_tags.is_sharp_edge(w, u)));
+            let corner_tag = tagged && child_tags.is_corner(w);
+            let hood = classify(sharp, ring.corners.len(), corner_tag, options.boundary);
+            let corners = &ring.corners;
+            let diagonal = |i: usize| child.vertex(child.next(child.next(corners[i])));
+            push_limit_row(options.scheme, &hood, masks, w, &ring.verts, diagonal, row);
+        },
     )
 }
 

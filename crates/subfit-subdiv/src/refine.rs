@@ -80,35 +80,54 @@ pub(crate) fn neighborhoods(
     (0..topo.num_vertices() as u32)
         .map(|v| {
             let edges = topo.vertex_edges(v);
+            let corner_tag = !tags.is_empty() && tags.is_corner(v);
             let num_faces = topo.vertex_corners(v).len();
-            let mut ends = [0usize; 2];
-            let mut nsharp = 0;
-            for (i, &e) in edges.iter().enumerate() {
-                if sharp[e as usize] {
-                    if nsharp < 2 {
-                        ends[nsharp] = i;
-                    }
-                    nsharp += 1;
-                }
-            }
-            let corner = edges.is_empty()
-                || nsharp > 2
-                || (!tags.is_empty() && tags.is_corner(v))
-                || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && edges.len() == 2);
-            let rule = match (corner, nsharp) {
-                (true, _) => VertexRule::Corner,
-                (false, 2) => VertexRule::Crease,
-                (false, 1) => VertexRule::Dart,
-                _ => VertexRule::Smooth,
-            };
-            Neighborhood {
-                num_edges: edges.len(),
+            classify(
+                edges.iter().map(|&e| sharp[e as usize]),
                 num_faces,
-                rule,
-                crease_ends: ends,
-            }
+                corner_tag,
+                boundary,
+            )
         })
         .collect()
+}
+
+/// The [`Neighborhood`] of a vertex from the sharpness of its ring edges (in ring order), its
+/// face count and whether it carries a corner tag. Cost O(valence).
+#[inline]
+pub(crate) fn classify(
+    edge_sharp: impl ExactSizeIterator<Item = bool>,
+    num_faces: usize,
+    corner_tag: bool,
+    boundary: BoundaryRule,
+) -> Neighborhood {
+    let num_edges = edge_sharp.len();
+    let mut ends = [0usize; 2];
+    let mut nsharp = 0;
+    for (i, sharp) in edge_sharp.enumerate() {
+        if sharp {
+            if nsharp < 2 {
+                ends[nsharp] = i;
+            }
+            nsharp += 1;
+        }
+    }
+    let corner = num_edges == 0
+        || nsharp > 2
+        || corner_tag
+        || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && num_edges == 2);
+    let rule = match (corner, nsharp) {
+        (true, _) => VertexRule::Corner,
+        (false, 2) => VertexRule::Crease,
+        (false, 1) => VertexRule::Dart,
+        _ => VertexRule::Smooth,
+    };
+    Neighborhood {
+        num_edges,
+        num_faces,
+        rule,
+        crease_ends: ends,
+    }
 }
 
 /// Refines `faces` (over `num_vertices` vertices, with crease/corner `tags`) by one level of

@@ -5,9 +5,13 @@
 //! [`crate::limit`] at level `l`. Products are accumulated right to left
 //! (`P_k = M_k · P_{k−1}`, then `L_l · P_l`), so every intermediate row is over the control
 //! points and stays short (its support is the control-mesh neighbourhood of the vertex).
+//!
+//! The adjacency of each level is built from its face list ([`Topology::new`]) except the
+//! last's: the limit rows of the level-`l` vertices read their rings off level `l − 1`
+//! ([`crate::child`]), so no adjacency with one entry per corner of the finest mesh is built.
 
 use crate::error::SubdivError;
-use crate::limit::{limit_compose, limit_rows};
+use crate::limit::{limit_compose_child, limit_rows};
 use crate::refine::{refine_compose, refine_topology, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
@@ -50,7 +54,7 @@ pub struct LimitSamples {
 /// refinement `level`.
 ///
 /// Errors: bad topology, or non-triangles for Loop (see [`SubdivError`]).
-/// Cost: `l` adjacency builds (parallel) and `l` parallel sparse products whose left rows are
+/// Cost: `l − 1` adjacency builds (parallel) and `l` parallel sparse products whose left rows are
 /// generated on the fly (refinement rows for `P_k = M_k · P_{k−1}`, Catmull-Clark face points
 /// first and then reused as single rows; limit rows for the last, fused product giving the three
 /// matrices); memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15 (Catmull-Clark)
@@ -68,29 +72,31 @@ pub fn sampling_operator(
     level: usize,
 ) -> Result<SamplingOperator, SubdivError> {
     let mut topo = topology_for(faces, num_vertices, options.scheme)?;
-    let mut level_faces = faces.clone();
-    let mut level_tags = tags.clone();
-    let mut product: Option<StencilMatrix> = None;
-    for _ in 0..level {
-        let r = match &product {
-            None => refine_topology(&topo, &level_tags, options),
-            Some(p) => refine_compose(&topo, &level_tags, options, p),
-        };
-        product = Some(r.matrix);
+    if level == 0 {
+        let [position, tangent1, tangent2] = limit_rows(&topo, tags, options).split();
+        return Ok(SamplingOperator {
+            level,
+            faces: faces.clone(),
+            num_vertices,
+            tags: tags.clone(),
+            position,
+            tangent1,
+            tangent2,
+        });
+    }
+    let mut r = refine_topology(&topo, tags, options);
+    for _ in 1..level {
         topo = Topology::new(&r.faces, r.num_vertices)
             .expect("the refinement of a valid mesh is valid");
-        level_faces = r.faces;
-        level_tags = r.tags;
+        r = refine_compose(&topo, &r.tags, options, &r.matrix);
     }
-    let [position, tangent1, tangent2] = match &product {
-        None => limit_rows(&topo, &level_tags, options).split(),
-        Some(p) => limit_compose(&topo, &level_tags, options, p),
-    };
+    // `topo` is the parent of the level-`l` mesh, whose adjacency is read off it.
+    let [position, tangent1, tangent2] = limit_compose_child(&topo, &r.tags, options, &r.matrix);
     Ok(SamplingOperator {
         level,
-        faces: level_faces,
-        num_vertices: topo.num_vertices(),
-        tags: level_tags,
+        faces: r.faces,
+        num_vertices: r.num_vertices,
+        tags: r.tags,
         position,
         tangent1,
         tangent2,

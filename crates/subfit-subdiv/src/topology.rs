@@ -339,6 +339,24 @@ impl Topology {
         self.next_vertex[c as usize]
     }
 
+    /// The edge of corner `c` (joining its vertex to the next vertex of its face).
+    #[inline]
+    pub(crate) fn corner_edge(&self, c: u32) -> u32 {
+        self.corner_edge[c as usize]
+    }
+
+    /// The twin of corner `c`: the corner of the opposite directed edge, `u32::MAX` on a
+    /// boundary.
+    #[inline]
+    pub(crate) fn corner_twin(&self, c: u32) -> u32 {
+        let [a, b] = self.edge_corners[self.corner_edge[c as usize] as usize];
+        if a == c {
+            b
+        } else {
+            a
+        }
+    }
+
     /// End vertices of edge `e`, in the direction of the first face that uses it.
     #[inline]
     pub fn edge_vertices(&self, e: u32) -> [u32; 2] {

@@ -1,0 +1,337 @@
+//! The adjacency of a once-refined mesh, read off its parent's [`Topology`] without building the
+//! child's.
+//!
+//! Uniform refinement replaces every parent element by a fixed pattern of child elements, so
+//! every child corner, its successor in its face and its twin are closed-form functions of
+//! the parent's corners, edges and twins — the construction of OpenSubdiv's
+//! `Vtr::QuadRefinement` / `Vtr::TriRefinement`, which derive each child level from its parent
+//! instead of searching for twins. With the child face order of [`crate::refine`]:
+//!
+//! * Catmull-Clark: the child quad of parent corner `c` (vertex `v`, face `f`, edges `e_c`
+//!   leaving and `e_p` entering `v`) has index `c` and corners `4c … 4c+3` at the vertex point
+//!   of `v`, the edge points of `e_c`, the face point of `f`, the edge point of `e_p`.
+//! * Loop: parent triangle `f` with corners `3f + k` and edges `e_k` has children `4f + k`
+//!   `= (v_k, e_k, e_{k−1})` and `4f + 3 = (e_0, e_1, e_2)`; child corner `3(4f + j) + i`.
+//!
+//! Rings are then walked exactly as [`Topology::new`] walks them (counter-clockwise from the
+//! leading boundary edge, or from the vertex's lowest-numbered corner), so a child ring here
+//! equals the ring of the child [`Topology`], entry for entry (checked by the tests below).
+//! The last level of the sampling operator uses this instead of building a [`Topology`] with
+//! one entry per corner of the finest mesh, which it would read only once.
+//!
+//! Cost: each query O(1) parent look-ups; a ring O(valence). Nothing is allocated but the
+//! caller's [`ChildRing`] buffers.
+
+use crate::scheme::Scheme;
+use crate::topology::Topology;
+
+const NONE: u32 = u32::MAX;
+
+/// Corner algebra of the child of `topo` under one step of `scheme`.
+///
+/// The parent must suit the scheme (Loop: triangles only). Child corners are numbered as
+/// positions in the child face list's indices; child vertices as in [`crate::refine`].
+#[derive(Clone, Copy)]
+pub(crate) struct ChildCorners<'a> {
+    topo: &'a Topology,
+    scheme: Scheme,
+    nv: u32,
+    ne: u32,
+}
+
+/// The ring of one child vertex, as [`Topology::vertex_ring`] and [`Topology::vertex_corners`]
+/// of the child mesh would give it, with whether each ring edge is a boundary edge. Buffers are
+/// reused from vertex to vertex.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ChildRing {
+    /// The vertex's corners, counter-clockwise (one per incident face).
+    pub(crate) corners: Vec<u32>,
+    /// Far ends of the ring edges (one more than `corners` at a boundary vertex).
+    pub(crate) verts: Vec<u32>,
+    /// Whether each ring edge has a single face.
+    pub(crate) boundary: Vec<bool>,
+    outgoing: Vec<u32>,
+}
+
+impl<'a> ChildCorners<'a> {
+    /// The child of `topo` (which must suit `scheme`).
+    pub(crate) fn new(topo: &'a Topology, scheme: Scheme) -> Self {
+        debug_assert!(
+            scheme == Scheme::CatmullClark
+                || (0..topo.num_faces()).all(|f| topo.face(f).len() == 3)
+        );
+        Self {
+            topo,
+            scheme,
+            nv: topo.num_vertices() as u32,
+            ne: topo.num_edges() as u32,
+        }
+    }
+
+    /// Number of child vertices.
+    pub(crate) fn num_vertices(&self) -> usize {
+        let t = self.topo;
+        t.num_vertices()
+            + t.num_edges()
+            + match self.scheme {
+                Scheme::CatmullClark => t.num_faces(),
+                Scheme::Loop => 0,
+            }
+    }
+
+    /// The child vertex of child corner `x`.
+    #[inline]
+    pub(crate) fn vertex(&self, x: u32) -> u32 {
+        let t = self.topo;
+        match self.scheme {
+            Scheme::CatmullClark => {
+                let c = x / 4;
+                match x % 4 {
+                    0 => t.corner_vertex(c),
+                    1 => self.nv + t.corner_edge(c),
+                    2 => self.nv + self.ne + t.corner_face(c),
+                    _ => self.nv + t.corner_edge(t.corner_prev(c)),
+                }
+            }
+            Scheme::Loop => {
+                let (f, j, i) = (x / 12, (x % 12) / 3, x % 3);
+                match (j, i) {
+                    (3, i) => self.nv + t.corner_edge(3 * f + i),
+                    (j, 0) => t.corner_vertex(3 * f + j),
+                    (j, 1) => self.nv + t.corner_edge(3 * f + j),
+                    (j, _) => self.nv + t.corner_edge(3 * f + (j + 2) % 3),
+                }
+            }
+        }
+    }
+
+    /// The corner after child corner `x` in its (child) face.
+    #[inline]
+    pub(crate) fn next(&self, x: u32) -> u32 {
+        match self.scheme {
+            Scheme::CatmullClark => (x & !3) | ((x + 1) & 3),
+            Scheme::Loop => x - x % 3 + (x + 1) % 3,
+        }
+    }
+
+    /// The corner before child corner `x` in its face.
+    #[inline]
+    pub(crate) fn prev(&self, x: u32) -> u32 {
+        match self.scheme {
+            Scheme::CatmullClark => (x & !3) | ((x + 3) & 3),
+            Scheme::Loop => x - x % 3 + (x + 2) % 3,
+        }
+    }
+
+    /// The twin of child corner `x` (the corner of the opposite directed edge), `u32::MAX` on a
+    /// boundary.
+    #[inline]
+    pub(crate) fn twin(&self, x: u32) -> u32 {
+        let t = self.topo;
+        match self.scheme {
+            Scheme::CatmullClark => {
+                let c = x / 4;
+                match x % 4 {
+                    // Vertex point → edge point of e_c: back along e_c in the other face.
+                    0 => match t.corner_twin(c) {
+                        NONE => NONE,
+                        o => 4 * t.corner_next(o) + 3,
+                    },
+                    1 => 4 * t.corner_next(c) + 2,
+                    2 => 4 * t.corner_prev(c) + 1,
+                    _ => match t.corner_twin(t.corner_prev(c)) {
+                        NONE => NONE,
+                        o => 4 * o,
+                    },
+                }
+            }
+            Scheme::Loop => {
+                let (f, j, i) = (x / 12, (x % 12) / 3, x % 3);
+                match (j, i) {
+                    (3, i) => 12 * f + 3 * ((i + 1) % 3) + 1,
+                    (j, 0) => match t.corner_twin(3 * f + j) {
+                        NONE => NONE,
+                        o => 12 * (o / 3) + 3 * ((o % 3 + 1) % 3) + 2,
+                    },
+                    (j, 1) => 12 * f + 9 + (j + 2) % 3,
+                    (j, _) => match t.corner_twin(3 * f + (j + 2) % 3) {
+                        NONE => NONE,
+                        o => 12 * (o / 3) + 3 * (o % 3),
+                    },
+                }
+            }
+        }
+    }
+
+    /// Appends the child corners of child vertex `w` (any order) to `out`.
+    fn outgoing(&self, w: u32, out: &mut Vec<u32>) {
+        let t = self.topo;
+        let (nv, ne) = (self.nv, self.ne);
+        if w < nv {
+            let first = |c: u32| match self.scheme {
+                Scheme::CatmullClark => 4 * c,
+                Scheme::Loop => 12 * (c / 3) + 3 * (c % 3),
+            };
+            out.extend(t.vertex_corners(w).iter().map(|&c| first(c)));
+        } else if w < nv + ne {
+            for c in t.edge_corners(w - nv) {
+                if c == NONE {
+                    continue;
+                }
+                match self.scheme {
+                    Scheme::CatmullClark => {
+                        out.extend([4 * c + 1, 4 * t.corner_next(c) + 3]);
+                    }
+                    Scheme::Loop => {
+                        let (f, k) = (c / 3, c % 3);
+                        out.extend([
+                            12 * f + 3 * k + 1,
+                            12 * f + 3 * ((k + 1) % 3) + 2,
+                            12 * f + 9 + k,
+                        ]);
+                    }
+                }
+            }
+        } else {
+            let f = (w - nv - ne) as usize;
+            let c0 = t.face_first_corner(f) as u32;
+            out.extend((c0..c0 + t.face(f).len() as u32).map(|c| 4 * c + 2));
+        }
+    }
+
+    /// The ring of child vertex `w` into `ring` (cleared first), as [`Topology::new`] would
+    /// build it for the child mesh. Cost O(valence).
+    pub(crate) fn ring(&self, w: u32, ring: &mut ChildRing) {
+        ring.corners.clear();
+        ring.verts.clear();
+        ring.boundary.clear();
+        ring.outgoing.clear();
+        self.outgoing(w, &mut ring.outgoing);
+        let Some(&min) = ring.outgoing.iter().min() else {
+            return;
+        };
+        // At most one outgoing corner of a manifold vertex lacks a twin: the leading boundary
+        // edge.
+        let start = ring
+            .outgoing
+            .iter()
+            .copied()
+            .find(|&x| self.twin(x) == NONE)
+            .unwrap_or(min);
+        let mut cur = start;
+        loop {
+            ring.corners.push(cur);
+            ring.verts.push(self.vertex(self.next(cur)));
+            ring.boundary.push(self.twin(cur) == NONE);
+            let pc = self.prev(cur);
+            match self.twin(pc) {
+                NONE => {
+                    ring.verts.push(self.vertex(pc));
+                    ring.boundary.push(true);
+                    break;
+                }
+                x if x == start => break,
+                x => cur = x,
+            }
+            debug_assert!(ring.corners.len() <= ring.outgoing.len());
+        }
+        debug_assert_eq!(ring.corners.len(), ring.outgoing.len());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::refine::refine;
+    use crate::scheme::Options;
+    use subfit_mesh::{Polygons, Tags};
+
+    /// An open grid of `n × n` quads (or triangles) with one vertex left out of all faces.
+    fn grid(n: u32, tris: bool) -> (usize, Polygons) {
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        let mut faces = Polygons::new();
+        for i in 0..n {
+            for j in 0..n {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if tris {
+                    faces.push(&[q[0], q[1], q[2]]);
+                    faces.push(&[q[0], q[2], q[3]]);
+                } else {
+                    faces.push(&q);
+                }
+            }
+        }
+        (((n + 1) * (n + 1) + 1) as usize, faces)
+    }
+
+    /// A closed cube-like mesh with a pentagon, a triangle and valence-3 and -5 vertices (an
+    /// octahedron for Loop).
+    fn closed(tris: bool) -> (usize, Polygons) {
+        if tris {
+            let f = [
+                [0, 1, 2],
+                [0, 2, 3],
+                [0, 3, 4],
+                [0, 4, 1],
+                [5, 2, 1],
+                [5, 3, 2],
+                [5, 4, 3],
+                [5, 1, 4],
+            ];
+            return (6, Polygons::from_triangles(&f));
+        }
+        // A cube with a vertex added on one edge (two pentagons) and a side split in two
+        // triangles.
+        let mut p = Polygons::new();
+        p.push(&[0, 3, 2, 1]);
+        p.push(&[0, 1, 5]);
+        p.push(&[0, 5, 4]);
+        p.push(&[1, 2, 6, 5]);
+        p.push(&[2, 3, 7, 8, 6]);
+        p.push(&[3, 0, 4, 7]);
+        p.push(&[4, 5, 6, 8, 7]);
+        (9, p)
+    }
+
+    #[test]
+    fn child_corners_and_rings_equal_the_child_topology() {
+        for scheme in [Scheme::Loop, Scheme::CatmullClark] {
+            let tris = scheme == Scheme::Loop;
+            for (nv, faces) in [grid(3, tris), closed(tris)] {
+                let o = Options::new(scheme);
+                let parent = Topology::new(&faces, nv).unwrap();
+                let r = refine(&faces, nv, &Tags::new(), &o).unwrap();
+                // Two levels: the second parent has only regular faces.
+                let child_topo = Topology::new(&r.faces, r.num_vertices).unwrap();
+                let r2 = refine(&r.faces, r.num_vertices, &Tags::new(), &o).unwrap();
+                let grandchild = Topology::new(&r2.faces, r2.num_vertices).unwrap();
+                for (p, c, faces) in [
+                    (&parent, &child_topo, &r.faces),
+                    (&child_topo, &grandchild, &r2.faces),
+                ] {
+                    let k = ChildCorners::new(p, scheme);
+                    assert_eq!(k.num_vertices(), c.num_vertices());
+                    let nc = faces.indices().len() as u32;
+                    for x in 0..nc {
+                        assert_eq!(k.vertex(x), c.corner_vertex(x), "{scheme:?} corner {x}");
+                        assert_eq!(k.next(x), c.corner_next(x));
+                        assert_eq!(k.prev(x), c.corner_prev(x));
+                        assert_eq!(k.twin(x), c.corner_twin(x), "{scheme:?} twin of {x}");
+                    }
+                    let mut ring = ChildRing::default();
+                    for w in 0..c.num_vertices() as u32 {
+                        k.ring(w, &mut ring);
+                        assert_eq!(ring.verts, c.vertex_ring(w), "{scheme:?} ring of {w}");
+                        assert_eq!(ring.corners, c.vertex_corners(w));
+                        let b: Vec<bool> = c
+                            .vertex_edges(w)
+                            .iter()
+                            .map(|&e| c.is_boundary_edge(e))
+                            .collect();
+                        assert_eq!(ring.boundary, b);
+                    }
+                }
+            }
+        }
+    }
+}
