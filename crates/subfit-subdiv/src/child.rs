@@ -50,7 +50,9 @@ pub(crate) struct ChildRing {
     pub(crate) verts: Vec<u32>,
     /// Whether each ring edge has a single face.
     pub(crate) boundary: Vec<bool>,
-    outgoing: Vec<u32>,
+    /// Catmull-Clark: the vertex two corners away in each ring face (the quad's diagonal);
+    /// empty for Loop.
+    pub(crate) diagonals: Vec<u32>,
 }
 
 impl<'a> ChildCorners<'a> {
@@ -80,6 +82,7 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The child vertex of child corner `x`.
+    #[cfg(test)]
     #[inline]
     pub(crate) fn vertex(&self, x: u32) -> u32 {
         let t = self.topo;
@@ -106,6 +109,7 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The corner after child corner `x` in its (child) face.
+    #[cfg(test)]
     #[inline]
     pub(crate) fn next(&self, x: u32) -> u32 {
         match self.scheme {
@@ -115,6 +119,7 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The corner before child corner `x` in its face.
+    #[cfg(test)]
     #[inline]
     pub(crate) fn prev(&self, x: u32) -> u32 {
         match self.scheme {
@@ -125,6 +130,7 @@ impl<'a> ChildCorners<'a> {
 
     /// The twin of child corner `x` (the corner of the opposite directed edge), `u32::MAX` on a
     /// boundary.
+    #[cfg(test)]
     #[inline]
     pub(crate) fn twin(&self, x: u32) -> u32 {
         let t = self.topo;
@@ -164,6 +170,7 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// Appends the child corners of child vertex `w` (any order) to `out`.
+    #[cfg(test)]
     fn outgoing(&self, w: u32, out: &mut Vec<u32>) {
         let t = self.topo;
         let (nv, ne) = (self.nv, self.ne);
@@ -200,20 +207,112 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The ring of child vertex `w` into `ring` (cleared first), as [`Topology::new`] would
-    /// build it for the child mesh. Cost O(valence).
+    /// build it for the child mesh, in closed form from the parent's ring, edge or face (the
+    /// walk of [`Self::ring_by_walk`], worked out per kind of child vertex). Cost O(valence).
     pub(crate) fn ring(&self, w: u32, ring: &mut ChildRing) {
-        ring.corners.clear();
-        ring.verts.clear();
-        ring.boundary.clear();
-        ring.outgoing.clear();
-        self.outgoing(w, &mut ring.outgoing);
-        let Some(&min) = ring.outgoing.iter().min() else {
+        ring.clear();
+        let t = self.topo;
+        let (nv, ne) = (self.nv, self.ne);
+        let scheme = self.scheme;
+        if w < nv {
+            // Vertex point: the parent ring, edge for edge (the lowest child corner and the
+            // boundary corner are those of the parent's lowest and boundary corners).
+            for &c in t.vertex_corners(w) {
+                match scheme {
+                    Scheme::CatmullClark => {
+                        ring.corners.push(4 * c);
+                        ring.diagonals.push(nv + ne + t.corner_face(c));
+                    }
+                    Scheme::Loop => ring.corners.push(12 * (c / 3) + 3 * (c % 3)),
+                }
+            }
+            for &e in t.vertex_edges(w) {
+                ring.verts.push(nv + e);
+                ring.boundary.push(t.is_boundary_edge(e));
+            }
+        } else if w < nv + ne {
+            let [c0, c1] = t.edge_corners(w - nv);
+            match scheme {
+                Scheme::CatmullClark => {
+                    // Per side (corner c of the edge, n = next(c)): the child edges toward
+                    // the vertex point of n's vertex and toward the face point.
+                    let side = |c: u32| {
+                        let n = t.corner_next(c);
+                        [
+                            (4 * n + 3, t.corner_vertex(n), nv + t.corner_edge(n)),
+                            (
+                                4 * c + 1,
+                                nv + ne + t.corner_face(c),
+                                nv + t.corner_edge(t.corner_prev(c)),
+                            ),
+                        ]
+                    };
+                    if c1 == NONE {
+                        ring.push_rotated(&side(c0), false);
+                        ring.verts.push(t.corner_vertex(c0));
+                        ring.boundary[0] = true;
+                        ring.boundary.push(true);
+                    } else {
+                        let ([a, b], [c, d]) = (side(c0), side(c1));
+                        ring.push_rotated(&[a, b, c, d], true);
+                    }
+                }
+                Scheme::Loop => {
+                    // Per side (corner 3f + k of the edge): the child edges toward the vertex
+                    // point of v_{k+1} and the edge points of e_{k+1} and e_{k+2}.
+                    let side = |c: u32| {
+                        let (f, k) = (c / 3, c % 3);
+                        let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
+                        [
+                            (12 * f + 3 * k1 + 2, t.corner_vertex(3 * f + k1), NONE),
+                            (12 * f + 9 + k, nv + t.corner_edge(3 * f + k1), NONE),
+                            (12 * f + 3 * k + 1, nv + t.corner_edge(3 * f + k2), NONE),
+                        ]
+                    };
+                    if c1 == NONE {
+                        ring.push_rotated(&side(c0), false);
+                        ring.verts.push(t.corner_vertex(c0));
+                        ring.boundary[0] = true;
+                        ring.boundary.push(true);
+                    } else {
+                        let ([a, b, c], [d, e, f]) = (side(c0), side(c1));
+                        ring.push_rotated(&[a, b, c, d, e, f], true);
+                    }
+                }
+            }
+        } else {
+            // Face point (Catmull-Clark): one child edge per parent edge, starting at the
+            // face's first corner.
+            let f = (w - nv - ne) as usize;
+            let c0 = t.face_first_corner(f) as u32;
+            let n = t.face(f).len() as u32;
+            for i in 0..n {
+                let c = c0 + i;
+                ring.corners.push(4 * c + 2);
+                ring.verts.push(nv + t.corner_edge(c0 + (i + n - 1) % n));
+                ring.boundary.push(false);
+                ring.diagonals.push(t.corner_vertex(c));
+            }
+        }
+        if scheme == Scheme::Loop {
+            ring.diagonals.clear();
+        }
+    }
+
+    /// The ring of child vertex `w` by walking the child corners, as [`Topology::new`] does:
+    /// from the leading boundary corner or else the lowest-numbered corner, to the twin of the
+    /// previous corner, until the start or a boundary. The reference for [`Self::ring`].
+    #[cfg(test)]
+    pub(crate) fn ring_by_walk(&self, w: u32, ring: &mut ChildRing) {
+        ring.clear();
+        let mut outgoing = Vec::new();
+        self.outgoing(w, &mut outgoing);
+        let Some(&min) = outgoing.iter().min() else {
             return;
         };
         // At most one outgoing corner of a manifold vertex lacks a twin: the leading boundary
         // edge.
-        let start = ring
-            .outgoing
+        let start = outgoing
             .iter()
             .copied()
             .find(|&x| self.twin(x) == NONE)
@@ -223,6 +322,9 @@ impl<'a> ChildCorners<'a> {
             ring.corners.push(cur);
             ring.verts.push(self.vertex(self.next(cur)));
             ring.boundary.push(self.twin(cur) == NONE);
+            if self.scheme == Scheme::CatmullClark {
+                ring.diagonals.push(self.vertex(self.next(self.next(cur))));
+            }
             let pc = self.prev(cur);
             match self.twin(pc) {
                 NONE => {
@@ -233,9 +335,38 @@ impl<'a> ChildCorners<'a> {
                 x if x == start => break,
                 x => cur = x,
             }
-            debug_assert!(ring.corners.len() <= ring.outgoing.len());
+            assert!(ring.corners.len() <= outgoing.len());
         }
-        debug_assert_eq!(ring.corners.len(), ring.outgoing.len());
+        assert_eq!(ring.corners.len(), outgoing.len());
+    }
+}
+
+impl ChildRing {
+    fn clear(&mut self) {
+        self.corners.clear();
+        self.verts.clear();
+        self.boundary.clear();
+        self.diagonals.clear();
+    }
+
+    /// Appends `(corner, far end, diagonal)` triples in cyclic order, starting at the lowest
+    /// corner when `rotate` (an interior vertex) or at the first.
+    #[inline]
+    fn push_rotated(&mut self, entries: &[(u32, u32, u32)], rotate: bool) {
+        let start = if rotate {
+            (0..entries.len())
+                .min_by_key(|&i| entries[i].0)
+                .expect("entries")
+        } else {
+            0
+        };
+        for i in (start..entries.len()).chain(0..start) {
+            let (c, v, d) = entries[i];
+            self.corners.push(c);
+            self.verts.push(v);
+            self.boundary.push(false);
+            self.diagonals.push(d);
+        }
     }
 }
 
@@ -320,15 +451,31 @@ mod tests {
                     }
                     let mut ring = ChildRing::default();
                     for w in 0..c.num_vertices() as u32 {
-                        k.ring(w, &mut ring);
-                        assert_eq!(ring.verts, c.vertex_ring(w), "{scheme:?} ring of {w}");
-                        assert_eq!(ring.corners, c.vertex_corners(w));
                         let b: Vec<bool> = c
                             .vertex_edges(w)
                             .iter()
                             .map(|&e| c.is_boundary_edge(e))
                             .collect();
-                        assert_eq!(ring.boundary, b);
+                        let d: Vec<u32> = match scheme {
+                            Scheme::CatmullClark => c
+                                .vertex_corners(w)
+                                .iter()
+                                .map(|&x| c.corner_vertex(c.corner_next(c.corner_next(x))))
+                                .collect(),
+                            Scheme::Loop => Vec::new(),
+                        };
+                        for walk in [false, true] {
+                            if walk {
+                                k.ring_by_walk(w, &mut ring);
+                            } else {
+                                k.ring(w, &mut ring);
+                            }
+                            let what = format!("{scheme:?} vertex {w} (walk: {walk})");
+                            assert_eq!(ring.verts, c.vertex_ring(w), "{what}");
+                            assert_eq!(ring.corners, c.vertex_corners(w), "{what}");
+                            assert_eq!(ring.boundary, b, "{what}");
+                            assert_eq!(ring.diagonals, d, "{what}");
+                        }
                     }
                 }
             }

@@ -8,6 +8,7 @@
 //! * [`stencil`] — [`StencilMatrix`], CSR rows of weights over control points.
 //! * [`topology`] — the edge and vertex-ring adjacency the rules need.
 //! * [`refine`] — one level of uniform refinement as a matrix, with a documented child order.
+//! * `child` (internal) — the adjacency of a refined mesh read off its parent's.
 //! * [`limit`] — limit position and tangent stencils at every vertex.
 //! * [`sample`] — the sampling operator `C = L_l · M_l ⋯ M_1` (DESIGN §3.1).
 //!

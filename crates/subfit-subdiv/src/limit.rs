@@ -21,7 +21,10 @@
 use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
-use crate::refine::{classify, neighborhoods, refine_topology, sharp_edges, topology_for};
+use crate::refine::{
+    classify, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
+    VertexMaskCache,
+};
 use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
 use crate::stencil::{compose_rows, MultiRows, Stacked, StencilMatrix};
@@ -149,29 +152,50 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     rows
 }
 
-/// The three products `L · rhs` (limit position, tangent 1, tangent 2 of every vertex of the
-/// once-refined child of `parent`, whose crease and corner tags are `child_tags`, times `rhs`
-/// with one row per child vertex), generating the limit rows on the fly (never stored) and
-/// reading the child's adjacency off the parent's ([`crate::child`]) instead of building it.
+/// The three products `L' · M · rhs`: `M` one step of refinement of `parent` (with crease and
+/// corner tags `parent_tags`), `L'` the limit stencils (position, tangent 1, tangent 2) of the
+/// child mesh (tags `child_tags`), `rhs` with one row per parent vertex. Neither `L'`, `M` nor
+/// `M · rhs` is stored: each child vertex's limit row is built from its ring, read off the
+/// parent's adjacency ([`crate::child`]); each of its entries is expanded by the refinement row
+/// of that child vertex into parent vertices (repeats summed in a small per-worker table); and
+/// the resulting row over the parent vertices (9–16 entries in regular regions) is multiplied
+/// by `rhs`. Rows in the child vertex order of [`crate::refine`].
+///
+/// Cost O(Σ_child rows (|L' row| · |M row| + |L'M row| · |rhs row|)); per worker scratch one
+/// `u32` per parent vertex and one dense row of `rhs.ncols`.
 ///
 /// # Panics
-/// If `rhs.nrows()` is not the child's vertex count.
+/// If `rhs.nrows()` is not the parent's vertex count.
 #[track_caller]
-pub(crate) fn limit_compose_child(
+pub(crate) fn limit_refine_compose(
     parent: &Topology,
+    parent_tags: &Tags,
     child_tags: &Tags,
     options: &Options,
     rhs: &StencilMatrix,
 ) -> [StencilMatrix; 3] {
+    assert_eq!(
+        rhs.nrows(),
+        parent.num_vertices(),
+        "inner dimensions differ"
+    );
     let child = ChildCorners::new(parent, options.scheme);
-    assert_eq!(rhs.nrows(), child.num_vertices(), "inner dimensions differ");
+    let refine = RefineRows::new(parent, parent_tags, options);
     let tagged = !child_tags.is_empty();
+    let nv = parent.num_vertices();
     compose_rows(
         child.num_vertices(),
         Stacked::one(rhs),
-        <(LimitMasks, ChildRing)>::default,
-        |(masks, ring), w, row| {
+        || LimitRefineScratch::new(nv + parent.num_faces()),
+        |st, w, row| {
             let w = w as u32;
+            let LimitRefineScratch {
+                masks,
+                ring,
+                child_row,
+                vertex_masks,
+                sum,
+            } = st;
             child.ring(w, ring);
             // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
             // tagged infinitely sharp.
@@ -182,11 +206,113 @@ pub(crate) fn limit_compose_child(
                 .map(|(&u, &b)| b || (tagged && child_tags.is_sharp_edge(w, u)));
             let corner_tag = tagged && child_tags.is_corner(w);
             let hood = classify(sharp, ring.corners.len(), corner_tag, options.boundary);
-            let corners = &ring.corners;
-            let diagonal = |i: usize| child.vertex(child.next(child.next(corners[i])));
-            push_limit_row(options.scheme, &hood, masks, w, &ring.verts, diagonal, row);
+            let diagonals = &ring.diagonals;
+            let diagonal = |i: usize| diagonals[i];
+            child_row.clear();
+            push_limit_row(
+                options.scheme,
+                &hood,
+                masks,
+                w,
+                &ring.verts,
+                diagonal,
+                child_row,
+            );
+            // Face centres are summed as columns `nv + f` and expanded once per face.
+            for &(j, l) in child_row.iter() {
+                refine.row(vertex_masks, j as usize, Some(nv as u32), |k, m| {
+                    sum.add(k, [l[0] * m, l[1] * m, l[2] * m]);
+                });
+            }
+            sum.expand_faces(nv as u32, |f| parent.face(f as usize));
+            sum.drain_into(row);
         },
     )
+}
+
+/// Per-worker state of [`limit_refine_compose`].
+struct LimitRefineScratch {
+    masks: LimitMasks,
+    ring: ChildRing,
+    child_row: Vec<(u32, [f64; 3])>,
+    vertex_masks: VertexMaskCache,
+    sum: SparseSum,
+}
+
+impl LimitRefineScratch {
+    /// Scratch for rows over `ncols` columns (parent vertices, then parent faces).
+    fn new(ncols: usize) -> Self {
+        Self {
+            masks: LimitMasks::default(),
+            ring: ChildRing::default(),
+            child_row: Vec::with_capacity(32),
+            vertex_masks: VertexMaskCache::default(),
+            sum: SparseSum {
+                slot: vec![u32::MAX; ncols],
+                entries: Vec::with_capacity(64),
+            },
+        }
+    }
+}
+
+/// A short sparse row of 3-weights being summed: `slot[c]` is the position of column `c` in
+/// `entries` (`u32::MAX` if absent).
+struct SparseSum {
+    slot: Vec<u32>,
+    entries: Vec<(u32, [f64; 3])>,
+}
+
+impl SparseSum {
+    #[inline]
+    fn add(&mut self, c: u32, w: [f64; 3]) {
+        let s = &mut self.slot[c as usize];
+        if *s == u32::MAX {
+            *s = self.entries.len() as u32;
+            self.entries.push((c, w));
+        } else {
+            let e = &mut self.entries[*s as usize].1;
+            e[0] += w[0];
+            e[1] += w[1];
+            e[2] += w[2];
+        }
+    }
+
+    /// Replaces every entry of a column `c >= nv` (a face centre, face `c − nv`) by equal
+    /// shares over the vertices of that face, given by `face`.
+    #[inline]
+    fn expand_faces<'f>(&mut self, nv: u32, face: impl Fn(u32) -> &'f [u32]) {
+        let n = self.entries.len();
+        let mut kept = 0;
+        for i in 0..n {
+            let (c, w) = self.entries[i];
+            if c < nv {
+                continue;
+            }
+            self.slot[c as usize] = u32::MAX;
+            let verts = face(c - nv);
+            let len = verts.len() as f64;
+            for &u in verts {
+                self.add(u, [w[0] / len, w[1] / len, w[2] / len]);
+            }
+            kept += 1;
+        }
+        if kept > 0 {
+            // Drop the face columns; re-point the slots of the vertices that moved.
+            self.entries.retain(|e| e.0 < nv);
+            for (i, &(c, _)) in self.entries.iter().enumerate() {
+                self.slot[c as usize] = i as u32;
+            }
+        }
+    }
+
+    /// Moves the entries (first-touch order) to `out` and clears the sum.
+    #[inline]
+    fn drain_into(&mut self, out: &mut Vec<(u32, [f64; 3])>) {
+        for &(c, _) in &self.entries {
+            self.slot[c as usize] = u32::MAX;
+        }
+        out.append(&mut self.entries);
+    }
 }
 
 /// Catmull-Clark with non-quads: limit rows of the vertex points after one refinement, composed

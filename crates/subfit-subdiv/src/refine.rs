@@ -345,7 +345,8 @@ fn push_center(
     }
 }
 
-fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
+/// The faces of the child of `topo` (order in the module docs). Cost O(#corners).
+pub(crate) fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
     let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
     let nf = topo.num_faces();
     match scheme {
@@ -379,7 +380,8 @@ fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
     }
 }
 
-fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
+/// The tags of the child of `topo` (see [`Refinement::tags`]). Cost O(#tags · valence).
+pub(crate) fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
     let mut out = Tags::new();
     let nv = topo.num_vertices() as u32;
     for ((a, b), s) in tags.creases() {

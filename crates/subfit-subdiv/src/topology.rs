@@ -347,6 +347,7 @@ impl Topology {
 
     /// The twin of corner `c`: the corner of the opposite directed edge, `u32::MAX` on a
     /// boundary.
+    #[cfg(test)]
     #[inline]
     pub(crate) fn corner_twin(&self, c: u32) -> u32 {
         let [a, b] = self.edge_corners[self.corner_edge[c as usize] as usize];
