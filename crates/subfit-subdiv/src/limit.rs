@@ -69,10 +69,13 @@ pub(crate) fn limit_topology(topo: &Topology, tags: &Tags, options: &Options) ->
 
 /// The three limit masks of the last neighbourhood seen: consecutive vertices mostly share
 /// their neighbourhood (valence, rule), so the masks are recomputed only when it changes.
+/// `weights` holds them interleaved in row order: the vertex, its ring edges, its faces (as
+/// many as both the masks and the vertex have).
 #[derive(Default)]
 struct LimitMasks {
     hood: Option<Neighborhood>,
     masks: [Mask; 3],
+    weights: Vec<[f64; 3]>,
 }
 
 /// Appends the limit row of vertex `v` (position and two tangent weights per entry; repeated
@@ -91,17 +94,24 @@ fn push_limit_row(
         let [p, a, b] = &mut cache.masks;
         scheme.limit_masks(hood, p, a, b);
         cache.hood = Some(*hood);
+        let nf = p.faces.len().max(a.faces.len()).max(b.faces.len());
+        let get = |m: &Mask, i: usize| m.faces.get(i).copied().unwrap_or(0.0);
+        cache.weights.clear();
+        cache.weights.push([p.vertex, a.vertex, b.vertex]);
+        cache
+            .weights
+            .extend((0..hood.num_edges).map(|i| [p.edges[i], a.edges[i], b.edges[i]]));
+        cache
+            .weights
+            .extend((0..nf.min(hood.num_faces)).map(|i| [get(p, i), get(a, i), get(b, i)]));
     }
-    let [p, a, b] = &cache.masks;
-    row.push((v, [p.vertex, a.vertex, b.vertex]));
-    for (i, &u) in ring.iter().enumerate() {
-        row.push((u, [p.edges[i], a.edges[i], b.edges[i]]));
-    }
-    let nf = p.faces.len().max(a.faces.len()).max(b.faces.len());
-    let get = |m: &Mask, i: usize| m.faces.get(i).copied().unwrap_or(0.0);
-    for i in 0..nf.min(hood.num_faces) {
-        row.push((diagonal(i), [get(p, i), get(a, i), get(b, i)]));
-    }
+    let w = &cache.weights;
+    let (ne, nf) = (ring.len(), w.len() - 1 - ring.len());
+    debug_assert_eq!(ne, hood.num_edges);
+    row.reserve(w.len());
+    row.push((v, w[0]));
+    row.extend(ring.iter().copied().zip(w[1..=ne].iter().copied()));
+    row.extend((0..nf).map(diagonal).zip(w[1 + ne..].iter().copied()));
 }
 
 /// [`push_limit_row`] for vertex `v` of `topo`.
