@@ -82,7 +82,6 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The child vertex of child corner `x`.
-    #[cfg(test)]
     #[inline]
     pub(crate) fn vertex(&self, x: u32) -> u32 {
         let t = self.topo;
@@ -109,7 +108,6 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The corner after child corner `x` in its (child) face.
-    #[cfg(test)]
     #[inline]
     pub(crate) fn next(&self, x: u32) -> u32 {
         match self.scheme {
@@ -130,7 +128,6 @@ impl<'a> ChildCorners<'a> {
 
     /// The twin of child corner `x` (the corner of the opposite directed edge), `u32::MAX` on a
     /// boundary.
-    #[cfg(test)]
     #[inline]
     pub(crate) fn twin(&self, x: u32) -> u32 {
         let t = self.topo;
@@ -425,7 +422,7 @@ mod tests {
     }
 
     #[test]
-    fn child_corners_and_rings_equal_the_child_topology() {
+    fn child_corners_rings_and_refined_topology_equal_the_child_topology() {
         for scheme in [Scheme::Loop, Scheme::CatmullClark] {
             let tris = scheme == Scheme::Loop;
             for (nv, faces) in [grid(3, tris), closed(tris)] {
@@ -440,6 +437,7 @@ mod tests {
                     (&parent, &child_topo, &r.faces),
                     (&child_topo, &grandchild, &r2.faces),
                 ] {
+                    assert_eq!(&Topology::refined(p, scheme).unwrap(), c, "{scheme:?}");
                     let k = ChildCorners::new(p, scheme);
                     assert_eq!(k.num_vertices(), c.num_vertices());
                     let nc = faces.indices().len() as u32;

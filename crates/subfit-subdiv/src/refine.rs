@@ -21,6 +21,7 @@
 //! `(ab, bc, ca)`. Catmull-Clark: face `(v_0 … v_{n−1})` with face point `F` gives, for each `i`,
 //! the quad `(v_i, e_{i,i+1}, F, e_{i−1,i})`. Winding is preserved.
 
+use crate::child::ChildCorners;
 use crate::error::SubdivError;
 use crate::mask::{FaceWeights, Mask};
 use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
@@ -147,6 +148,16 @@ pub fn refine(
 
 /// [`refine`] on an already built adjacency (which must suit the scheme).
 pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
+    Refinement {
+        faces: child_faces(topo, options.scheme),
+        num_vertices: ChildCorners::new(topo, options.scheme).num_vertices(),
+        tags: child_tags(topo, tags),
+        matrix: refine_matrix(topo, tags, options),
+    }
+}
+
+/// The refinement matrix [`Refinement::matrix`] alone. Cost O(#corners · max valence), serial.
+pub(crate) fn refine_matrix(topo: &Topology, tags: &Tags, options: &Options) -> StencilMatrix {
     let rows = RefineRows::new(topo, tags, options);
     let mut m = StencilMatrix::new(topo.num_vertices());
     let mut row: Vec<(u32, f64)> = Vec::with_capacity(64);
@@ -156,17 +167,13 @@ pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -
         rows.row(&mut cache, i, None, |c, w| row.push((c, w)));
         m.push_row(&mut row);
     }
-    Refinement {
-        faces: child_faces(topo, options.scheme),
-        num_vertices: rows.num_rows(),
-        tags: child_tags(topo, tags),
-        matrix: m,
-    }
+    m
 }
 
-/// One refinement step composed with `rhs` (`#V × n`): the returned [`Refinement::matrix`] is
-/// `M · rhs` (`#V_child × n`), computed in parallel with rows of `M` generated on the fly, so
-/// `M` itself is never stored (nor sorted). Cost O(Σ_i Σ_{j ∈ row i of M} nnz(rhs_j)).
+/// One refinement step composed with `rhs` (`#V × n`): `M · rhs` (`#V_child × n`, the
+/// [`Refinement::matrix`] of `M` times `rhs`), computed in parallel with rows of `M` generated
+/// on the fly, so `M` itself is never stored (nor sorted). Cost O(Σ_i Σ_{j ∈ row i of M}
+/// nnz(rhs_j)).
 ///
 /// # Panics
 /// If `rhs.nrows() != topo.num_vertices()`.
@@ -176,11 +183,11 @@ pub(crate) fn refine_compose(
     tags: &Tags,
     options: &Options,
     rhs: &StencilMatrix,
-) -> Refinement {
+) -> StencilMatrix {
     assert_eq!(rhs.nrows(), topo.num_vertices(), "inner dimensions differ");
     let rows = RefineRows::new(topo, tags, options);
     let (nv, ne) = (topo.num_vertices(), topo.num_edges());
-    let matrix = match options.scheme {
+    match options.scheme {
         Scheme::Loop => {
             let [m] = compose_rows(
                 rows.num_rows(),
@@ -208,12 +215,6 @@ pub(crate) fn refine_compose(
             m.append_rows(&face_points);
             m
         }
-    };
-    Refinement {
-        faces: child_faces(topo, options.scheme),
-        num_vertices: rows.num_rows(),
-        tags: child_tags(topo, tags),
-        matrix,
     }
 }
 

@@ -9,13 +9,14 @@
 //! multiplied by `P_{l−1}` ([`crate::limit`]), so neither `M_l` nor `P_l` — the largest
 //! intermediate, one row per level-`l` vertex — is stored.
 //!
-//! The adjacency of levels `0 … l − 1` is built from their face lists ([`Topology::new`]); that
-//! of level `l` is read off level `l − 1` (module `child`), so no adjacency with one entry per
-//! corner of the finest mesh is built.
+//! Only the control mesh's adjacency is built from its face list ([`Topology::new`]); that of
+//! each finer level is read off the level above (module `child`) — for levels `1 … l − 1` as a
+//! [`Topology`], for level `l` vertex by vertex as its limit rows need it, so no adjacency with
+//! one entry per corner of the finest mesh is built, and no intermediate face list.
 
 use crate::error::SubdivError;
 use crate::limit::{limit_refine_compose, limit_rows};
-use crate::refine::{child_faces, child_tags, refine_compose, refine_topology, topology_for};
+use crate::refine::{child_faces, child_tags, refine_compose, refine_matrix, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
 use crate::topology::Topology;
@@ -57,7 +58,7 @@ pub struct LimitSamples {
 /// refinement `level`.
 ///
 /// Errors: bad topology, or non-triangles for Loop (see [`SubdivError`]).
-/// Cost: `l − 1` adjacency builds (parallel) and `l` parallel sparse products whose left rows are
+/// Cost: one adjacency build from faces and `l − 1` from the level above (parallel) and `l` parallel sparse products whose left rows are
 /// generated on the fly (refinement rows for `P_k = M_k · P_{k−1}`, `k < l`, Catmull-Clark face
 /// points first and then reused as single rows; rows of `L_l · M_l` for the last, fused product
 /// giving the three matrices); memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15
@@ -89,14 +90,13 @@ pub fn sampling_operator(
     let mut product = StencilMatrix::identity(num_vertices);
     let mut level_tags = tags.clone();
     for k in 1..level {
-        let r = if k == 1 {
-            refine_topology(&topo, &level_tags, options)
+        product = if k == 1 {
+            refine_matrix(&topo, &level_tags, options)
         } else {
             refine_compose(&topo, &level_tags, options, &product)
         };
-        topo = Topology::new(&r.faces, r.num_vertices)
-            .expect("the refinement of a valid mesh is valid");
-        (product, level_tags) = (r.matrix, r.tags);
+        level_tags = child_tags(&topo, &level_tags);
+        topo = Topology::refined(&topo, options.scheme)?;
     }
     // The last level: C = L_l · M_l · P_{l−1}, with neither M_l nor its product stored and the
     // level-l adjacency read off level l − 1.
