@@ -81,6 +81,23 @@ impl<'a> ChildCorners<'a> {
             }
     }
 
+    /// The number of vertices of every child face (4 for Catmull-Clark, 3 for Loop).
+    pub(crate) fn face_size(&self) -> u32 {
+        match self.scheme {
+            Scheme::CatmullClark => 4,
+            Scheme::Loop => 3,
+        }
+    }
+
+    /// Number of child faces (one per parent corner for Catmull-Clark, four per parent
+    /// triangle for Loop).
+    pub(crate) fn num_faces(&self) -> usize {
+        match self.scheme {
+            Scheme::CatmullClark => self.topo.face_first_corner(self.topo.num_faces()),
+            Scheme::Loop => 4 * self.topo.num_faces(),
+        }
+    }
+
     /// The child vertex of child corner `x`.
     #[inline]
     pub(crate) fn vertex(&self, x: u32) -> u32 {
@@ -374,6 +391,33 @@ mod tests {
     use crate::scheme::Options;
     use subfit_mesh::{Polygons, Tags};
 
+    /// The child faces as the module docs of [`crate::refine`] list them, face by face.
+    fn child_faces_by_pattern(topo: &Topology, scheme: Scheme) -> Polygons {
+        let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
+        let mut out = Polygons::new();
+        for f in 0..topo.num_faces() {
+            let v = topo.face(f);
+            let e = topo.face_edges(f);
+            let n = v.len();
+            match scheme {
+                Scheme::Loop => {
+                    let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
+                    out.push(&[v[0], ab, ca]);
+                    out.push(&[v[1], bc, ab]);
+                    out.push(&[v[2], ca, bc]);
+                    out.push(&[ab, bc, ca]);
+                }
+                Scheme::CatmullClark => {
+                    let fp = nv + ne + f as u32;
+                    for i in 0..n {
+                        out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// An open grid of `n × n` quads (or triangles) with one vertex left out of all faces.
     fn grid(n: u32, tris: bool) -> (usize, Polygons) {
         let id = |i: u32, j: u32| i * (n + 1) + j;
@@ -437,6 +481,7 @@ mod tests {
                     (&parent, &child_topo, &r.faces),
                     (&child_topo, &grandchild, &r2.faces),
                 ] {
+                    assert_eq!(faces, &child_faces_by_pattern(p, scheme), "{scheme:?}");
                     assert_eq!(&Topology::refined(p, scheme).unwrap(), c, "{scheme:?}");
                     let k = ChildCorners::new(p, scheme);
                     assert_eq!(k.num_vertices(), c.num_vertices());

@@ -27,6 +27,7 @@ use crate::mask::{FaceWeights, Mask};
 use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
 use crate::stencil::{compose_rows, Stacked, StencilMatrix};
 use crate::topology::Topology;
+use rayon::prelude::*;
 use subfit_mesh::{Polygons, Tags, SHARPNESS_INFINITE};
 
 /// One level of uniform refinement.
@@ -346,39 +347,19 @@ fn push_center(
     }
 }
 
-/// The faces of the child of `topo` (order in the module docs). Cost O(#corners).
+/// The faces of the child of `topo` (order in the module docs), from the child corner algebra
+/// of module `child`. Cost O(#corners), parallel.
+///
+/// # Panics
+/// If the child has `u32::MAX` or more face indices.
+#[track_caller]
 pub(crate) fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
-    let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
-    let nf = topo.num_faces();
-    match scheme {
-        Scheme::Loop => {
-            let mut out = Polygons::with_capacity(4 * nf, 12 * nf);
-            for f in 0..nf {
-                let v = topo.face(f);
-                let e = topo.face_edges(f);
-                let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
-                out.push(&[v[0], ab, ca]);
-                out.push(&[v[1], bc, ab]);
-                out.push(&[v[2], ca, bc]);
-                out.push(&[ab, bc, ca]);
-            }
-            out
-        }
-        Scheme::CatmullClark => {
-            let nc = topo.face_first_corner(nf);
-            let mut out = Polygons::with_capacity(nc, 4 * nc);
-            for f in 0..nf {
-                let v = topo.face(f);
-                let e = topo.face_edges(f);
-                let n = v.len();
-                let fp = nv + ne + f as u32;
-                for i in 0..n {
-                    out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
-                }
-            }
-            out
-        }
-    }
+    let child = ChildCorners::new(topo, scheme);
+    let (size, nf) = (child.face_size(), child.num_faces());
+    let nc = u32::try_from(nf * size as usize).expect("more than u32::MAX child face indices");
+    let indices = (0..nc).into_par_iter().map(|x| child.vertex(x)).collect();
+    let offsets = (0..=nf as u32).map(|f| f * size).collect();
+    Polygons::from_raw(offsets, indices).expect("offsets are those of equal-size faces")
 }
 
 /// The tags of the child of `topo` (see [`Refinement::tags`]). Cost O(#tags · valence).

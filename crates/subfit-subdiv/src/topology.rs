@@ -139,10 +139,7 @@ impl Topology {
     /// corners. Cost O(#child corners), parallel except for the edge numbering.
     pub(crate) fn refined(parent: &Topology, scheme: Scheme) -> Result<Self, SubdivError> {
         let child = ChildCorners::new(parent, scheme);
-        let (size, nf) = match scheme {
-            Scheme::CatmullClark => (4u32, parent.indices.len()),
-            Scheme::Loop => (3u32, 4 * parent.num_faces()),
-        };
+        let (size, nf) = (child.face_size(), child.num_faces());
         let (nv, nc) = (child.num_vertices(), nf * size as usize);
         if nv >= NONE as usize || nc >= NONE as usize {
             return Err(SubdivError::TooLarge {
