@@ -25,10 +25,12 @@ use crate::refine::{
     classify, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
     VertexMaskCache,
 };
+use crate::regular::{is_regular, Regular, Tables};
 use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
 use crate::stencil::{compose_rows, MultiRows, Stacked, StencilMatrix};
 use crate::topology::Topology;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use subfit_mesh::{Polygons, Tags};
 
 /// Limit stencils of every vertex of a mesh: three `#V × #V` matrices over the same vertices.
@@ -169,7 +171,9 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
 /// parent's adjacency ([`crate::child`]); each of its entries is expanded by the refinement row
 /// of that child vertex into parent vertices (repeats summed in a small per-worker table); and
 /// the resulting row over the parent vertices (9–16 entries in regular regions) is multiplied
-/// by `rhs`. Rows in the child vertex order of [`crate::refine`].
+/// by `rhs`. In regular Catmull-Clark regions (all-quad parents) the row over the parent
+/// vertices is read from a table instead, built from the first such row ([`crate::regular`]).
+/// Rows in the child vertex order of [`crate::refine`].
 ///
 /// Cost O(Σ_child rows (|L' row| · |M row| + |L'M row| · |rhs row|)); per worker scratch one
 /// `u32` per parent vertex and one dense row of `rhs.ncols`.
@@ -184,6 +188,20 @@ pub(crate) fn limit_refine_compose(
     options: &Options,
     rhs: &StencilMatrix,
 ) -> [StencilMatrix; 3] {
+    limit_refine_compose_with(parent, parent_tags, child_tags, options, rhs, true, None)
+}
+
+/// [`limit_refine_compose`], with the regular tables of [`crate::regular`] (Catmull-Clark,
+/// all-quad parents) used when `tables`; rows read from a table are counted in `tabulated`.
+fn limit_refine_compose_with(
+    parent: &Topology,
+    parent_tags: &Tags,
+    child_tags: &Tags,
+    options: &Options,
+    rhs: &StencilMatrix,
+    tables: bool,
+    tabulated: Option<&AtomicUsize>,
+) -> [StencilMatrix; 3] {
     assert_eq!(
         rhs.nrows(),
         parent.num_vertices(),
@@ -191,6 +209,10 @@ pub(crate) fn limit_refine_compose(
     );
     let child = ChildCorners::new(parent, options.scheme);
     let refine = RefineRows::new(parent, parent_tags, options);
+    let regular = match options.scheme {
+        Scheme::CatmullClark if tables => Regular::new(parent, refine.hoods()),
+        _ => None,
+    };
     let tagged = !child_tags.is_empty();
     let nv = parent.num_vertices();
     compose_rows(
@@ -205,17 +227,36 @@ pub(crate) fn limit_refine_compose(
                 child_row,
                 vertex_masks,
                 sum,
+                tables,
             } = st;
-            child.ring(w, ring);
-            // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
-            // tagged infinitely sharp.
-            let sharp = ring
-                .verts
-                .iter()
-                .zip(&ring.boundary)
-                .map(|(&u, &b)| b || (tagged && child_tags.is_sharp_edge(w, u)));
-            let corner_tag = tagged && child_tags.is_corner(w);
-            let hood = classify(sharp, ring.corners.len(), corner_tag, options.boundary);
+            let mut hood = None;
+            let child_hood = |ring: &mut ChildRing| {
+                child.ring(w, ring);
+                // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
+                // tagged infinitely sharp.
+                let sharp = ring
+                    .verts
+                    .iter()
+                    .zip(&ring.boundary)
+                    .map(|(&u, &b)| b || (tagged && child_tags.is_sharp_edge(w, u)));
+                let corner_tag = tagged && child_tags.is_corner(w);
+                classify(sharp, ring.corners.len(), corner_tag, options.boundary)
+            };
+            // A regular parent neighbourhood: without tags the child vertex is regular too;
+            // with tags, check.
+            let fast = regular.as_ref().is_some_and(|r| r.find(w, tables))
+                && (!tagged || is_regular(hood.insert(child_hood(ring))));
+            if fast && tables.apply(sum) {
+                if let Some(n) = tabulated {
+                    n.fetch_add(1, Ordering::Relaxed);
+                }
+                sum.drain_into(row);
+                return;
+            }
+            let hood = match hood {
+                Some(h) => h,
+                None => child_hood(ring),
+            };
             let diagonals = &ring.diagonals;
             let diagonal = |i: usize| diagonals[i];
             child_row.clear();
@@ -235,6 +276,9 @@ pub(crate) fn limit_refine_compose(
                 });
             }
             sum.expand_faces(nv as u32, |f| parent.face(f as usize));
+            if fast {
+                tables.record(&sum.entries);
+            }
             sum.drain_into(row);
         },
     )
@@ -247,6 +291,7 @@ struct LimitRefineScratch {
     child_row: Vec<(u32, [f64; 3])>,
     vertex_masks: VertexMaskCache,
     sum: SparseSum,
+    tables: Tables,
 }
 
 impl LimitRefineScratch {
@@ -257,6 +302,7 @@ impl LimitRefineScratch {
             ring: ChildRing::default(),
             child_row: Vec::with_capacity(32),
             vertex_masks: VertexMaskCache::default(),
+            tables: Tables::default(),
             sum: SparseSum {
                 slot: vec![u32::MAX; ncols],
                 entries: Vec::with_capacity(64),
@@ -267,14 +313,14 @@ impl LimitRefineScratch {
 
 /// A short sparse row of 3-weights being summed: `slot[c]` is the position of column `c` in
 /// `entries` (`u32::MAX` if absent).
-struct SparseSum {
+pub(crate) struct SparseSum {
     slot: Vec<u32>,
     entries: Vec<(u32, [f64; 3])>,
 }
 
 impl SparseSum {
     #[inline]
-    fn add(&mut self, c: u32, w: [f64; 3]) {
+    pub(crate) fn add(&mut self, c: u32, w: [f64; 3]) {
         let s = &mut self.slot[c as usize];
         if *s == u32::MAX {
             *s = self.entries.len() as u32;
@@ -366,4 +412,130 @@ fn limit_rows_via_refinement(topo: &Topology, tags: &Tags, options: &Options) ->
         rows.offsets.push(rows.cols.len());
     }
     rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::refine::refine;
+    use crate::scheme::BoundaryRule;
+    use subfit_mesh::{Polygons, SHARPNESS_INFINITE};
+
+    /// An `n × m` grid of quads, closed into a torus or open (a boundary), with every 5th
+    /// cell split into two triangles (extraordinary vertices after one step).
+    fn grid(n: u32, m: u32, closed: bool) -> (usize, Polygons) {
+        let (rows, cols) = if closed { (n, m) } else { (n + 1, m + 1) };
+        let id = |i: u32, j: u32| (i % rows) * cols + (j % cols);
+        let mut faces = Polygons::new();
+        for i in 0..n {
+            for j in 0..m {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if (i * m + j) % 5 == 0 {
+                    faces.push(&[q[0], q[1], q[2]]);
+                    faces.push(&[q[0], q[2], q[3]]);
+                } else {
+                    faces.push(&q);
+                }
+            }
+        }
+        ((rows * cols) as usize, faces)
+    }
+
+    /// `faces` in a scrambled order, each rotated to start at a scrambled corner (seeded), so
+    /// that rings start at varied places.
+    fn scramble(faces: &Polygons, seed: u64) -> Polygons {
+        let mut x = seed;
+        let mut next = move || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 33) as usize
+        };
+        let mut order: Vec<usize> = (0..faces.len()).collect();
+        for i in (1..order.len()).rev() {
+            order.swap(i, next() % (i + 1));
+        }
+        let mut out = Polygons::new();
+        for f in order {
+            let mut face = faces.iter().nth(f).expect("face").to_vec();
+            let k = next() % face.len();
+            face.rotate_left(k);
+            out.push(&face);
+        }
+        out
+    }
+
+    /// Entry by entry `|a − b| ≤ tol`, patterns allowed to differ by entries below `tol`.
+    fn assert_close(a: &StencilMatrix, b: &StencilMatrix, tol: f64, what: &str) {
+        assert_eq!((a.nrows(), a.ncols()), (b.nrows(), b.ncols()), "{what}");
+        let mut dense = vec![0.0f64; a.ncols()];
+        for i in 0..a.nrows() {
+            let ((ca, wa), (cb, wb)) = (a.row(i), b.row(i));
+            ca.iter()
+                .zip(wa)
+                .for_each(|(&c, &w)| dense[c as usize] += w);
+            cb.iter()
+                .zip(wb)
+                .for_each(|(&c, &w)| dense[c as usize] -= w);
+            for &c in ca.iter().chain(cb) {
+                let d = std::mem::take(&mut dense[c as usize]);
+                assert!(d.abs() <= tol, "{what}: row {i} column {c} differs by {d}");
+            }
+        }
+    }
+
+    /// The tabulated rows of regular neighbourhoods equal the general path's (to 1e-14) on
+    /// meshes with extraordinary vertices, boundaries, creases and corners, under both
+    /// boundary rules, one and two levels below the control mesh; and tables are used.
+    #[test]
+    fn regular_tables_give_the_general_rows() {
+        let mut tags = Tags::new();
+        for j in 3..9 {
+            tags.set_crease(j, j + 1, SHARPNESS_INFINITE);
+        }
+        tags.set_corner(40, SHARPNESS_INFINITE);
+        let (tn, tf) = grid(8, 9, true);
+        let (gn, gf) = grid(8, 8, false);
+        let meshes = [
+            ("torus", (tn, tf.clone()), Tags::new()),
+            ("torus creased", (tn, tf.clone()), tags.clone()),
+            ("open grid creased", (gn, gf.clone()), tags.clone()),
+            ("torus scrambled", (tn, scramble(&tf, 1)), Tags::new()),
+            ("open grid scrambled", (gn, scramble(&gf, 2)), tags),
+        ];
+        for (name, (nv, faces), tags) in meshes {
+            for boundary in [BoundaryRule::EdgeOnly, BoundaryRule::EdgeAndCorner] {
+                let o = Options::new(Scheme::CatmullClark).with_boundary(boundary);
+                let (mut f, mut n, mut t) = (faces.clone(), nv, tags.clone());
+                for level in 1..=2 {
+                    let r = refine(&f, n, &t, &o).unwrap();
+                    (f, n, t) = (r.faces, r.num_vertices, r.tags);
+                    let parent = Topology::new(&f, n).unwrap();
+                    let child_tags = refine(&f, n, &t, &o).unwrap().tags;
+                    let id = StencilMatrix::identity(n);
+                    let count = AtomicUsize::new(0);
+                    let fast = limit_refine_compose_with(
+                        &parent,
+                        &t,
+                        &child_tags,
+                        &o,
+                        &id,
+                        true,
+                        Some(&count),
+                    );
+                    let general =
+                        limit_refine_compose_with(&parent, &t, &child_tags, &o, &id, false, None);
+                    let what = format!("{name} {boundary:?} parent level {level}");
+                    let used = count.load(Ordering::Relaxed);
+                    assert!(
+                        used > fast[0].nrows() / 4,
+                        "{what}: {used} rows from tables"
+                    );
+                    for (a, b) in fast.iter().zip(&general) {
+                        assert_close(a, b, 1e-14, &what);
+                    }
+                }
+            }
+        }
+    }
 }

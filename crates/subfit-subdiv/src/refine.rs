@@ -249,6 +249,11 @@ impl<'a> RefineRows<'a> {
         }
     }
 
+    /// The parent vertices' neighbourhoods (rule and crease ends, from the parent's tags).
+    pub(crate) fn hoods(&self) -> &[Neighborhood] {
+        &self.hoods
+    }
+
     /// Number of child vertices (`V + E`, plus `F` for Catmull-Clark).
     pub(crate) fn num_rows(&self) -> usize {
         let t = self.topo;
