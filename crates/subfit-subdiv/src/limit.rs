@@ -17,6 +17,12 @@
 //! same point, exactly), with tangents scaled by 2 to undo the halving of the ring. (OpenSubdiv's
 //! `Limit` applied at level 0 instead weights "the vertex two corners away" in an `n`-gon, which
 //! is not the limit; it documents that it needs one refinement to remove `n`-gons.)
+//!
+//! For the sampling operator the limit rows of a refined mesh are composed with the refinement
+//! step that made it (`L · M`, `limit_refine_compose`) without building either factor: the
+//! child's rings are read off the parent (module `child`), each limit row is expanded locally
+//! by the refinement rows of its entries, and in regular Catmull-Clark regions the expanded row
+//! is a fixed table over the parent's 1-rings (module `regular`).
 
 use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
