@@ -85,15 +85,18 @@ impl<'a> Regular<'a> {
 
     /// The 1-ring of parent vertex `v` as positions: `v`, its ring vertices, its quads'
     /// diagonal vertices. `v` must be regular (4 edges, 4 faces).
+    #[inline]
     fn push_block(&self, v: u32, out: &mut Vec<u32>) {
         let t = self.topo;
         out.push(v);
         out.extend_from_slice(t.vertex_ring(v));
-        out.extend(
-            t.vertex_corners(v)
-                .iter()
-                .map(|&c| t.corner_vertex(t.corner_next(t.corner_next(c)))),
-        );
+        // All faces are quads, so face f has corners 4f … 4f + 3 and the corner two steps
+        // around from c is c ^ 2.
+        debug_assert!(t
+            .vertex_corners(v)
+            .iter()
+            .all(|&c| { t.corner_next(t.corner_next(c)) == c ^ 2 }));
+        out.extend(t.vertex_corners(v).iter().map(|&c| t.corner_vertex(c ^ 2)));
     }
 
     /// Position of corner `c` among the corners of its vertex.
