@@ -8,6 +8,8 @@
 //! * [`stencil`] — [`StencilMatrix`], CSR rows of weights over control points.
 //! * [`topology`] — the edge and vertex-ring adjacency the rules need.
 //! * [`refine`] — one level of uniform refinement as a matrix, with a documented child order.
+//! * `child` (internal) — the adjacency of a refined mesh read off its parent's.
+//! * `regular` (internal) — tabulated limit rows of regular Catmull-Clark neighbourhoods.
 //! * [`limit`] — limit position and tangent stencils at every vertex.
 //! * [`sample`] — the sampling operator `C = L_l · M_l ⋯ M_1` (DESIGN §3.1).
 //!
@@ -23,6 +25,9 @@ pub mod sample;
 pub mod scheme;
 pub mod stencil;
 pub mod topology;
+
+mod child;
+mod regular;
 
 pub use error::SubdivError;
 pub use limit::{limit_stencils, LimitStencils};

@@ -17,14 +17,26 @@
 //! same point, exactly), with tangents scaled by 2 to undo the halving of the ring. (OpenSubdiv's
 //! `Limit` applied at level 0 instead weights "the vertex two corners away" in an `n`-gon, which
 //! is not the limit; it documents that it needs one refinement to remove `n`-gons.)
+//!
+//! For the sampling operator the limit rows of a refined mesh are composed with the refinement
+//! step that made it (`L · M`, `limit_refine_compose`) without building either factor: the
+//! child's rings are read off the parent (module `child`), each limit row is expanded locally
+//! by the refinement rows of its entries, and in regular Catmull-Clark regions the expanded row
+//! is a fixed table over the parent's 1-rings (module `regular`).
 
+use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
-use crate::refine::{neighborhoods, refine_topology, sharp_edges, topology_for};
+use crate::refine::{
+    classify, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
+    VertexMaskCache,
+};
+use crate::regular::{is_regular, Regular, Tables};
 use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
 use crate::stencil::{compose_rows, MultiRows, Stacked, StencilMatrix};
 use crate::topology::Topology;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use subfit_mesh::{Polygons, Tags};
 
 /// Limit stencils of every vertex of a mesh: three `#V × #V` matrices over the same vertices.
@@ -65,15 +77,53 @@ pub(crate) fn limit_topology(topo: &Topology, tags: &Tags, options: &Options) ->
 
 /// The three limit masks of the last neighbourhood seen: consecutive vertices mostly share
 /// their neighbourhood (valence, rule), so the masks are recomputed only when it changes.
+/// `weights` holds them interleaved in row order: the vertex, its ring edges, its faces (as
+/// many as both the masks and the vertex have).
 #[derive(Default)]
 struct LimitMasks {
     hood: Option<Neighborhood>,
     masks: [Mask; 3],
+    weights: Vec<[f64; 3]>,
 }
 
 /// Appends the limit row of vertex `v` (position and two tangent weights per entry; repeated
-/// columns possible) to `row`.
+/// columns possible) to `row`: `ring` holds the far ends of its ring edges and `diagonal(i)` is
+/// the vertex two corners away from `v` in its ring face `i` (the quad's diagonal).
 fn push_limit_row(
+    scheme: Scheme,
+    hood: &Neighborhood,
+    cache: &mut LimitMasks,
+    v: u32,
+    ring: &[u32],
+    diagonal: impl Fn(usize) -> u32,
+    row: &mut Vec<(u32, [f64; 3])>,
+) {
+    if cache.hood.as_ref() != Some(hood) {
+        let [p, a, b] = &mut cache.masks;
+        scheme.limit_masks(hood, p, a, b);
+        cache.hood = Some(*hood);
+        let nf = p.faces.len().max(a.faces.len()).max(b.faces.len());
+        let get = |m: &Mask, i: usize| m.faces.get(i).copied().unwrap_or(0.0);
+        cache.weights.clear();
+        cache.weights.push([p.vertex, a.vertex, b.vertex]);
+        cache
+            .weights
+            .extend((0..hood.num_edges).map(|i| [p.edges[i], a.edges[i], b.edges[i]]));
+        cache
+            .weights
+            .extend((0..nf.min(hood.num_faces)).map(|i| [get(p, i), get(a, i), get(b, i)]));
+    }
+    let w = &cache.weights;
+    let (ne, nf) = (ring.len(), w.len() - 1 - ring.len());
+    debug_assert_eq!(ne, hood.num_edges);
+    row.reserve(w.len());
+    row.push((v, w[0]));
+    row.extend(ring.iter().copied().zip(w[1..=ne].iter().copied()));
+    row.extend((0..nf).map(diagonal).zip(w[1 + ne..].iter().copied()));
+}
+
+/// [`push_limit_row`] for vertex `v` of `topo`.
+fn push_topology_limit_row(
     topo: &Topology,
     scheme: Scheme,
     hood: &Neighborhood,
@@ -81,23 +131,9 @@ fn push_limit_row(
     v: u32,
     row: &mut Vec<(u32, [f64; 3])>,
 ) {
-    if cache.hood.as_ref() != Some(hood) {
-        let [p, a, b] = &mut cache.masks;
-        scheme.limit_masks(hood, p, a, b);
-        cache.hood = Some(*hood);
-    }
-    let [p, a, b] = &cache.masks;
-    row.push((v, [p.vertex, a.vertex, b.vertex]));
-    for (i, &u) in topo.vertex_ring(v).iter().enumerate() {
-        row.push((u, [p.edges[i], a.edges[i], b.edges[i]]));
-    }
-    let nf = p.faces.len().max(a.faces.len()).max(b.faces.len());
-    let get = |m: &Mask, i: usize| m.faces.get(i).copied().unwrap_or(0.0);
-    for (i, &c) in topo.vertex_corners(v).iter().enumerate().take(nf) {
-        // The vertex two corners away (the quad's diagonal).
-        let d = topo.corner_vertex(topo.corner_next(topo.corner_next(c)));
-        row.push((d, [get(p, i), get(a, i), get(b, i)]));
-    }
+    let corners = topo.vertex_corners(v);
+    let diagonal = |i: usize| topo.corner_vertex(topo.corner_next(topo.corner_next(corners[i])));
+    push_limit_row(scheme, hood, cache, v, topo.vertex_ring(v), diagonal, row);
 }
 
 fn needs_refinement(topo: &Topology, options: &Options) -> bool {
@@ -124,7 +160,7 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     let mut row = Vec::new();
     for (v, hood) in hoods.iter().enumerate() {
         row.clear();
-        push_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
+        push_topology_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
         for &(c, w) in &row {
             rows.cols.push(c);
             rows.weights.push(w);
@@ -134,25 +170,211 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     rows
 }
 
-/// The three products `L · rhs` (limit position, tangent 1, tangent 2 of every vertex of
-/// `topo`, times `rhs` with `#V` rows), generating the limit rows on the fly (never stored).
-pub(crate) fn limit_compose(
-    topo: &Topology,
-    tags: &Tags,
+/// The three products `L' · M · rhs`: `M` one step of refinement of `parent` (with crease and
+/// corner tags `parent_tags`), `L'` the limit stencils (position, tangent 1, tangent 2) of the
+/// child mesh (tags `child_tags`), `rhs` with one row per parent vertex. Neither `L'`, `M` nor
+/// `M · rhs` is stored: each child vertex's limit row is built from its ring, read off the
+/// parent's adjacency ([`crate::child`]); each of its entries is expanded by the refinement row
+/// of that child vertex into parent vertices (repeats summed in a small per-worker table); and
+/// the resulting row over the parent vertices (9–16 entries in regular regions) is multiplied
+/// by `rhs`. In regular Catmull-Clark regions (all-quad parents) the row over the parent
+/// vertices is read from a table instead, built from the first such row ([`crate::regular`]).
+/// Rows in the child vertex order of [`crate::refine`].
+///
+/// Cost O(Σ_child rows (|L' row| · |M row| + |L'M row| · |rhs row|)); per worker scratch one
+/// `u32` per parent vertex and one dense row of `rhs.ncols`.
+///
+/// # Panics
+/// If `rhs.nrows()` is not the parent's vertex count.
+#[track_caller]
+pub(crate) fn limit_refine_compose(
+    parent: &Topology,
+    parent_tags: &Tags,
+    child_tags: &Tags,
     options: &Options,
     rhs: &StencilMatrix,
 ) -> [StencilMatrix; 3] {
-    if needs_refinement(topo, options) {
-        return limit_rows(topo, tags, options).compose(rhs);
-    }
-    let sharp = sharp_edges(topo, tags);
-    let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
+    limit_refine_compose_with(parent, parent_tags, child_tags, options, rhs, true, None)
+}
+
+/// [`limit_refine_compose`], with the regular tables of [`crate::regular`] (Catmull-Clark,
+/// all-quad parents) used when `tables`; rows read from a table are counted in `tabulated`.
+fn limit_refine_compose_with(
+    parent: &Topology,
+    parent_tags: &Tags,
+    child_tags: &Tags,
+    options: &Options,
+    rhs: &StencilMatrix,
+    tables: bool,
+    tabulated: Option<&AtomicUsize>,
+) -> [StencilMatrix; 3] {
+    assert_eq!(
+        rhs.nrows(),
+        parent.num_vertices(),
+        "inner dimensions differ"
+    );
+    let child = ChildCorners::new(parent, options.scheme);
+    let refine = RefineRows::new(parent, parent_tags, options);
+    let regular = match options.scheme {
+        Scheme::CatmullClark if tables => Regular::new(parent, refine.hoods()),
+        _ => None,
+    };
+    let tagged = !child_tags.is_empty();
+    let nv = parent.num_vertices();
     compose_rows(
-        topo.num_vertices(),
+        child.num_vertices(),
         Stacked::one(rhs),
-        LimitMasks::default,
-        |masks, v, row| push_limit_row(topo, options.scheme, &hoods[v], masks, v as u32, row),
+        || LimitRefineScratch::new(nv + parent.num_faces()),
+        |st, w, row| {
+            let w = w as u32;
+            let LimitRefineScratch {
+                masks,
+                ring,
+                child_row,
+                vertex_masks,
+                sum,
+                tables,
+            } = st;
+            let mut hood = None;
+            let child_hood = |ring: &mut ChildRing| {
+                child.ring(w, ring);
+                // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
+                // tagged infinitely sharp.
+                let sharp = ring
+                    .verts
+                    .iter()
+                    .zip(&ring.boundary)
+                    .map(|(&u, &b)| b || (tagged && child_tags.is_sharp_edge(w, u)));
+                let corner_tag = tagged && child_tags.is_corner(w);
+                classify(sharp, ring.corners.len(), corner_tag, options.boundary)
+            };
+            // A regular parent neighbourhood: without tags the child vertex is regular too;
+            // with tags, check.
+            let fast = regular.as_ref().is_some_and(|r| r.find(w, tables))
+                && (!tagged || is_regular(hood.insert(child_hood(ring))));
+            if fast && tables.apply(sum) {
+                if let Some(n) = tabulated {
+                    n.fetch_add(1, Ordering::Relaxed);
+                }
+                sum.drain_into(row);
+                return;
+            }
+            let hood = match hood {
+                Some(h) => h,
+                None => child_hood(ring),
+            };
+            let diagonals = &ring.diagonals;
+            let diagonal = |i: usize| diagonals[i];
+            child_row.clear();
+            push_limit_row(
+                options.scheme,
+                &hood,
+                masks,
+                w,
+                &ring.verts,
+                diagonal,
+                child_row,
+            );
+            // Face centres are summed as columns `nv + f` and expanded once per face.
+            for &(j, l) in child_row.iter() {
+                refine.row(vertex_masks, j as usize, Some(nv as u32), |k, m| {
+                    sum.add(k, [l[0] * m, l[1] * m, l[2] * m]);
+                });
+            }
+            sum.expand_faces(nv as u32, |f| parent.face(f as usize));
+            if fast {
+                tables.record(&sum.entries);
+            }
+            sum.drain_into(row);
+        },
     )
+}
+
+/// Per-worker state of [`limit_refine_compose`].
+struct LimitRefineScratch {
+    masks: LimitMasks,
+    ring: ChildRing,
+    child_row: Vec<(u32, [f64; 3])>,
+    vertex_masks: VertexMaskCache,
+    sum: SparseSum,
+    tables: Tables,
+}
+
+impl LimitRefineScratch {
+    /// Scratch for rows over `ncols` columns (parent vertices, then parent faces).
+    fn new(ncols: usize) -> Self {
+        Self {
+            masks: LimitMasks::default(),
+            ring: ChildRing::default(),
+            child_row: Vec::with_capacity(32),
+            vertex_masks: VertexMaskCache::default(),
+            tables: Tables::default(),
+            sum: SparseSum {
+                slot: vec![u32::MAX; ncols],
+                entries: Vec::with_capacity(64),
+            },
+        }
+    }
+}
+
+/// A short sparse row of 3-weights being summed: `slot[c]` is the position of column `c` in
+/// `entries` (`u32::MAX` if absent).
+pub(crate) struct SparseSum {
+    slot: Vec<u32>,
+    entries: Vec<(u32, [f64; 3])>,
+}
+
+impl SparseSum {
+    #[inline]
+    pub(crate) fn add(&mut self, c: u32, w: [f64; 3]) {
+        let s = &mut self.slot[c as usize];
+        if *s == u32::MAX {
+            *s = self.entries.len() as u32;
+            self.entries.push((c, w));
+        } else {
+            let e = &mut self.entries[*s as usize].1;
+            e[0] += w[0];
+            e[1] += w[1];
+            e[2] += w[2];
+        }
+    }
+
+    /// Replaces every entry of a column `c >= nv` (a face centre, face `c − nv`) by equal
+    /// shares over the vertices of that face, given by `face`.
+    #[inline]
+    fn expand_faces<'f>(&mut self, nv: u32, face: impl Fn(u32) -> &'f [u32]) {
+        let n = self.entries.len();
+        let mut kept = 0;
+        for i in 0..n {
+            let (c, w) = self.entries[i];
+            if c < nv {
+                continue;
+            }
+            self.slot[c as usize] = u32::MAX;
+            let verts = face(c - nv);
+            let len = verts.len() as f64;
+            for &u in verts {
+                self.add(u, [w[0] / len, w[1] / len, w[2] / len]);
+            }
+            kept += 1;
+        }
+        if kept > 0 {
+            // Drop the face columns; re-point the slots of the vertices that moved.
+            self.entries.retain(|e| e.0 < nv);
+            for (i, &(c, _)) in self.entries.iter().enumerate() {
+                self.slot[c as usize] = i as u32;
+            }
+        }
+    }
+
+    /// Moves the entries (first-touch order) to `out` and clears the sum.
+    #[inline]
+    fn drain_into(&mut self, out: &mut Vec<(u32, [f64; 3])>) {
+        for &(c, _) in &self.entries {
+            self.slot[c as usize] = u32::MAX;
+        }
+        out.append(&mut self.entries);
+    }
 }
 
 /// Catmull-Clark with non-quads: limit rows of the vertex points after one refinement, composed
@@ -196,4 +418,130 @@ fn limit_rows_via_refinement(topo: &Topology, tags: &Tags, options: &Options) ->
         rows.offsets.push(rows.cols.len());
     }
     rows
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::refine::refine;
+    use crate::scheme::BoundaryRule;
+    use subfit_mesh::{Polygons, SHARPNESS_INFINITE};
+
+    /// An `n × m` grid of quads, closed into a torus or open (a boundary), with every 5th
+    /// cell split into two triangles (extraordinary vertices after one step).
+    fn grid(n: u32, m: u32, closed: bool) -> (usize, Polygons) {
+        let (rows, cols) = if closed { (n, m) } else { (n + 1, m + 1) };
+        let id = |i: u32, j: u32| (i % rows) * cols + (j % cols);
+        let mut faces = Polygons::new();
+        for i in 0..n {
+            for j in 0..m {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if (i * m + j) % 5 == 0 {
+                    faces.push(&[q[0], q[1], q[2]]);
+                    faces.push(&[q[0], q[2], q[3]]);
+                } else {
+                    faces.push(&q);
+                }
+            }
+        }
+        ((rows * cols) as usize, faces)
+    }
+
+    /// `faces` in a scrambled order, each rotated to start at a scrambled corner (seeded), so
+    /// that rings start at varied places.
+    fn scramble(faces: &Polygons, seed: u64) -> Polygons {
+        let mut x = seed;
+        let mut next = move || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 33) as usize
+        };
+        let mut order: Vec<usize> = (0..faces.len()).collect();
+        for i in (1..order.len()).rev() {
+            order.swap(i, next() % (i + 1));
+        }
+        let mut out = Polygons::new();
+        for f in order {
+            let mut face = faces.iter().nth(f).expect("face").to_vec();
+            let k = next() % face.len();
+            face.rotate_left(k);
+            out.push(&face);
+        }
+        out
+    }
+
+    /// Entry by entry `|a − b| ≤ tol`, patterns allowed to differ by entries below `tol`.
+    fn assert_close(a: &StencilMatrix, b: &StencilMatrix, tol: f64, what: &str) {
+        assert_eq!((a.nrows(), a.ncols()), (b.nrows(), b.ncols()), "{what}");
+        let mut dense = vec![0.0f64; a.ncols()];
+        for i in 0..a.nrows() {
+            let ((ca, wa), (cb, wb)) = (a.row(i), b.row(i));
+            ca.iter()
+                .zip(wa)
+                .for_each(|(&c, &w)| dense[c as usize] += w);
+            cb.iter()
+                .zip(wb)
+                .for_each(|(&c, &w)| dense[c as usize] -= w);
+            for &c in ca.iter().chain(cb) {
+                let d = std::mem::take(&mut dense[c as usize]);
+                assert!(d.abs() <= tol, "{what}: row {i} column {c} differs by {d}");
+            }
+        }
+    }
+
+    /// The tabulated rows of regular neighbourhoods equal the general path's (to 1e-14) on
+    /// meshes with extraordinary vertices, boundaries, creases and corners, under both
+    /// boundary rules, one and two levels below the control mesh; and tables are used.
+    #[test]
+    fn regular_tables_give_the_general_rows() {
+        let mut tags = Tags::new();
+        for j in 3..9 {
+            tags.set_crease(j, j + 1, SHARPNESS_INFINITE);
+        }
+        tags.set_corner(40, SHARPNESS_INFINITE);
+        let (tn, tf) = grid(8, 9, true);
+        let (gn, gf) = grid(8, 8, false);
+        let meshes = [
+            ("torus", (tn, tf.clone()), Tags::new()),
+            ("torus creased", (tn, tf.clone()), tags.clone()),
+            ("open grid creased", (gn, gf.clone()), tags.clone()),
+            ("torus scrambled", (tn, scramble(&tf, 1)), Tags::new()),
+            ("open grid scrambled", (gn, scramble(&gf, 2)), tags),
+        ];
+        for (name, (nv, faces), tags) in meshes {
+            for boundary in [BoundaryRule::EdgeOnly, BoundaryRule::EdgeAndCorner] {
+                let o = Options::new(Scheme::CatmullClark).with_boundary(boundary);
+                let (mut f, mut n, mut t) = (faces.clone(), nv, tags.clone());
+                for level in 1..=2 {
+                    let r = refine(&f, n, &t, &o).unwrap();
+                    (f, n, t) = (r.faces, r.num_vertices, r.tags);
+                    let parent = Topology::new(&f, n).unwrap();
+                    let child_tags = refine(&f, n, &t, &o).unwrap().tags;
+                    let id = StencilMatrix::identity(n);
+                    let count = AtomicUsize::new(0);
+                    let fast = limit_refine_compose_with(
+                        &parent,
+                        &t,
+                        &child_tags,
+                        &o,
+                        &id,
+                        true,
+                        Some(&count),
+                    );
+                    let general =
+                        limit_refine_compose_with(&parent, &t, &child_tags, &o, &id, false, None);
+                    let what = format!("{name} {boundary:?} parent level {level}");
+                    let used = count.load(Ordering::Relaxed);
+                    assert!(
+                        used > fast[0].nrows() / 4,
+                        "{what}: {used} rows from tables"
+                    );
+                    for (a, b) in fast.iter().zip(&general) {
+                        assert_close(a, b, 1e-14, &what);
+                    }
+                }
+            }
+        }
+    }
 }

@@ -21,11 +21,13 @@
 //! `(ab, bc, ca)`. Catmull-Clark: face `(v_0 … v_{n−1})` with face point `F` gives, for each `i`,
 //! the quad `(v_i, e_{i,i+1}, F, e_{i−1,i})`. Winding is preserved.
 
+use crate::child::ChildCorners;
 use crate::error::SubdivError;
 use crate::mask::{FaceWeights, Mask};
 use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
 use crate::stencil::{compose_rows, Stacked, StencilMatrix};
 use crate::topology::Topology;
+use rayon::prelude::*;
 use subfit_mesh::{Polygons, Tags, SHARPNESS_INFINITE};
 
 /// One level of uniform refinement.
@@ -80,35 +82,54 @@ pub(crate) fn neighborhoods(
     (0..topo.num_vertices() as u32)
         .map(|v| {
             let edges = topo.vertex_edges(v);
+            let corner_tag = !tags.is_empty() && tags.is_corner(v);
             let num_faces = topo.vertex_corners(v).len();
-            let mut ends = [0usize; 2];
-            let mut nsharp = 0;
-            for (i, &e) in edges.iter().enumerate() {
-                if sharp[e as usize] {
-                    if nsharp < 2 {
-                        ends[nsharp] = i;
-                    }
-                    nsharp += 1;
-                }
-            }
-            let corner = edges.is_empty()
-                || nsharp > 2
-                || (!tags.is_empty() && tags.is_corner(v))
-                || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && edges.len() == 2);
-            let rule = match (corner, nsharp) {
-                (true, _) => VertexRule::Corner,
-                (false, 2) => VertexRule::Crease,
-                (false, 1) => VertexRule::Dart,
-                _ => VertexRule::Smooth,
-            };
-            Neighborhood {
-                num_edges: edges.len(),
+            classify(
+                edges.iter().map(|&e| sharp[e as usize]),
                 num_faces,
-                rule,
-                crease_ends: ends,
-            }
+                corner_tag,
+                boundary,
+            )
         })
         .collect()
+}
+
+/// The [`Neighborhood`] of a vertex from the sharpness of its ring edges (in ring order), its
+/// face count and whether it carries a corner tag. Cost O(valence).
+#[inline]
+pub(crate) fn classify(
+    edge_sharp: impl ExactSizeIterator<Item = bool>,
+    num_faces: usize,
+    corner_tag: bool,
+    boundary: BoundaryRule,
+) -> Neighborhood {
+    let num_edges = edge_sharp.len();
+    let mut ends = [0usize; 2];
+    let mut nsharp = 0;
+    for (i, sharp) in edge_sharp.enumerate() {
+        if sharp {
+            if nsharp < 2 {
+                ends[nsharp] = i;
+            }
+            nsharp += 1;
+        }
+    }
+    let corner = num_edges == 0
+        || nsharp > 2
+        || corner_tag
+        || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && num_edges == 2);
+    let rule = match (corner, nsharp) {
+        (true, _) => VertexRule::Corner,
+        (false, 2) => VertexRule::Crease,
+        (false, 1) => VertexRule::Dart,
+        _ => VertexRule::Smooth,
+    };
+    Neighborhood {
+        num_edges,
+        num_faces,
+        rule,
+        crease_ends: ends,
+    }
 }
 
 /// Refines `faces` (over `num_vertices` vertices, with crease/corner `tags`) by one level of
@@ -128,6 +149,16 @@ pub fn refine(
 
 /// [`refine`] on an already built adjacency (which must suit the scheme).
 pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
+    Refinement {
+        faces: child_faces(topo, options.scheme),
+        num_vertices: ChildCorners::new(topo, options.scheme).num_vertices(),
+        tags: child_tags(topo, tags),
+        matrix: refine_matrix(topo, tags, options),
+    }
+}
+
+/// The refinement matrix [`Refinement::matrix`] alone. Cost O(#corners · max valence), serial.
+pub(crate) fn refine_matrix(topo: &Topology, tags: &Tags, options: &Options) -> StencilMatrix {
     let rows = RefineRows::new(topo, tags, options);
     let mut m = StencilMatrix::new(topo.num_vertices());
     let mut row: Vec<(u32, f64)> = Vec::with_capacity(64);
@@ -137,17 +168,13 @@ pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -
         rows.row(&mut cache, i, None, |c, w| row.push((c, w)));
         m.push_row(&mut row);
     }
-    Refinement {
-        faces: child_faces(topo, options.scheme),
-        num_vertices: rows.num_rows(),
-        tags: child_tags(topo, tags),
-        matrix: m,
-    }
+    m
 }
 
-/// One refinement step composed with `rhs` (`#V × n`): the returned [`Refinement::matrix`] is
-/// `M · rhs` (`#V_child × n`), computed in parallel with rows of `M` generated on the fly, so
-/// `M` itself is never stored (nor sorted). Cost O(Σ_i Σ_{j ∈ row i of M} nnz(rhs_j)).
+/// One refinement step composed with `rhs` (`#V × n`): `M · rhs` (`#V_child × n`, the
+/// [`Refinement::matrix`] of `M` times `rhs`), computed in parallel with rows of `M` generated
+/// on the fly, so `M` itself is never stored (nor sorted). Cost O(Σ_i Σ_{j ∈ row i of M}
+/// nnz(rhs_j)).
 ///
 /// # Panics
 /// If `rhs.nrows() != topo.num_vertices()`.
@@ -157,11 +184,11 @@ pub(crate) fn refine_compose(
     tags: &Tags,
     options: &Options,
     rhs: &StencilMatrix,
-) -> Refinement {
+) -> StencilMatrix {
     assert_eq!(rhs.nrows(), topo.num_vertices(), "inner dimensions differ");
     let rows = RefineRows::new(topo, tags, options);
     let (nv, ne) = (topo.num_vertices(), topo.num_edges());
-    let matrix = match options.scheme {
+    match options.scheme {
         Scheme::Loop => {
             let [m] = compose_rows(
                 rows.num_rows(),
@@ -189,12 +216,6 @@ pub(crate) fn refine_compose(
             m.append_rows(&face_points);
             m
         }
-    };
-    Refinement {
-        faces: child_faces(topo, options.scheme),
-        num_vertices: rows.num_rows(),
-        tags: child_tags(topo, tags),
-        matrix,
     }
 }
 
@@ -226,6 +247,11 @@ impl<'a> RefineRows<'a> {
             sharp,
             hoods,
         }
+    }
+
+    /// The parent vertices' neighbourhoods (rule and crease ends, from the parent's tags).
+    pub(crate) fn hoods(&self) -> &[Neighborhood] {
+        &self.hoods
     }
 
     /// Number of child vertices (`V + E`, plus `F` for Catmull-Clark).
@@ -326,41 +352,23 @@ fn push_center(
     }
 }
 
-fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
-    let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
-    let nf = topo.num_faces();
-    match scheme {
-        Scheme::Loop => {
-            let mut out = Polygons::with_capacity(4 * nf, 12 * nf);
-            for f in 0..nf {
-                let v = topo.face(f);
-                let e = topo.face_edges(f);
-                let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
-                out.push(&[v[0], ab, ca]);
-                out.push(&[v[1], bc, ab]);
-                out.push(&[v[2], ca, bc]);
-                out.push(&[ab, bc, ca]);
-            }
-            out
-        }
-        Scheme::CatmullClark => {
-            let nc = topo.face_first_corner(nf);
-            let mut out = Polygons::with_capacity(nc, 4 * nc);
-            for f in 0..nf {
-                let v = topo.face(f);
-                let e = topo.face_edges(f);
-                let n = v.len();
-                let fp = nv + ne + f as u32;
-                for i in 0..n {
-                    out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
-                }
-            }
-            out
-        }
-    }
+/// The faces of the child of `topo` (order in the module docs), from the child corner algebra
+/// of module `child`. Cost O(#corners), parallel.
+///
+/// # Panics
+/// If the child has `u32::MAX` or more face indices.
+#[track_caller]
+pub(crate) fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
+    let child = ChildCorners::new(topo, scheme);
+    let (size, nf) = (child.face_size(), child.num_faces());
+    let nc = u32::try_from(nf * size as usize).expect("more than u32::MAX child face indices");
+    let indices = (0..nc).into_par_iter().map(|x| child.vertex(x)).collect();
+    let offsets = (0..=nf as u32).map(|f| f * size).collect();
+    Polygons::from_raw(offsets, indices).expect("offsets are those of equal-size faces")
 }
 
-fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
+/// The tags of the child of `topo` (see [`Refinement::tags`]). Cost O(#tags · valence).
+pub(crate) fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
     let mut out = Tags::new();
     let nv = topo.num_vertices() as u32;
     for ((a, b), s) in tags.creases() {

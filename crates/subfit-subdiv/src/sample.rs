@@ -3,12 +3,20 @@
 //!
 //! `M_k` are the refinement matrices of [`crate::refine`], `L_l` the limit stencils of
 //! [`crate::limit`] at level `l`. Products are accumulated right to left
-//! (`P_k = M_k · P_{k−1}`, then `L_l · P_l`), so every intermediate row is over the control
-//! points and stays short (its support is the control-mesh neighbourhood of the vertex).
+//! (`P_k = M_k · P_{k−1}`), so every intermediate row is over the control points and stays
+//! short (its support is the control-mesh neighbourhood of the vertex). The last two factors
+//! are fused: each row of `L_l · M_l` is formed locally over the level-(`l − 1`) vertices and
+//! multiplied by `P_{l−1}` ([`crate::limit`]), so neither `M_l` nor `P_l` — the largest
+//! intermediate, one row per level-`l` vertex — is stored.
+//!
+//! Only the control mesh's adjacency is built from its face list ([`Topology::new`]); that of
+//! each finer level is read off the level above (module `child`) — for levels `1 … l − 1` as a
+//! [`Topology`], for level `l` vertex by vertex as its limit rows need it, so no adjacency with
+//! one entry per corner of the finest mesh is built, and no intermediate face list.
 
 use crate::error::SubdivError;
-use crate::limit::{limit_compose, limit_rows};
-use crate::refine::{refine_compose, refine_topology, topology_for};
+use crate::limit::{limit_refine_compose, limit_rows};
+use crate::refine::{child_faces, child_tags, refine_compose, refine_matrix, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
 use crate::topology::Topology;
@@ -50,16 +58,16 @@ pub struct LimitSamples {
 /// refinement `level`.
 ///
 /// Errors: bad topology, or non-triangles for Loop (see [`SubdivError`]).
-/// Cost: `l` adjacency builds (parallel) and `l` parallel sparse products whose left rows are
-/// generated on the fly (refinement rows for `P_k = M_k · P_{k−1}`, Catmull-Clark face points
-/// first and then reused as single rows; limit rows for the last, fused product giving the three
-/// matrices); memory about `3 · #V_l · s` entries with `s` ≈ 12 (Loop) – 15 (Catmull-Clark)
-/// control points per row. Measured (`benches/stencils.rs`, release, shared 2-core machine under
-/// load): 10k-face control meshes at level 3 take ≈ 0.7–1 s CPU for Loop (320k rows, 11M
-/// entries) and ≈ 2 s for Catmull-Clark (686k rows, 30M entries); one-thread instruction counts
-/// (cachegrind) 3.5 G and 8.1 G. Most of it is the last level's two products (scattered reads of
-/// `P_{l−1}` / `P_l` rows and scattered accumulation), then page faults on the ~0.4 GB output
-/// and the adjacency builds.
+/// Cost: one adjacency build from faces and `l − 1` from the level above (parallel), and `l`
+/// parallel sparse products whose left rows are generated on the fly (refinement rows for
+/// `P_k = M_k · P_{k−1}`, `k < l`, Catmull-Clark face points first and then reused as single
+/// rows; rows of `L_l · M_l` for the last, fused product giving the three matrices, read from
+/// tables in regular Catmull-Clark regions); memory about `3 · #V_l · s` entries with `s` ≈ 12
+/// (Loop) – 15 (Catmull-Clark) control points per row, plus `P_{l−1}` (about a quarter of one
+/// of them). Measured (`benches/stencils.rs`, 2 threads, quiet machine): a 10k-face
+/// Catmull-Clark control mesh at level 3 (686k rows, 30M entries) in ≈ 0.37 s, the first build
+/// of a process included. Most of the time is the last product (scattered reads of `P_{l−1}`
+/// rows and scattered accumulation) and the page faults on the ~0.4 GB output.
 pub fn sampling_operator(
     faces: &Polygons,
     num_vertices: usize,
@@ -68,29 +76,40 @@ pub fn sampling_operator(
     level: usize,
 ) -> Result<SamplingOperator, SubdivError> {
     let mut topo = topology_for(faces, num_vertices, options.scheme)?;
-    let mut level_faces = faces.clone();
-    let mut level_tags = tags.clone();
-    let mut product: Option<StencilMatrix> = None;
-    for _ in 0..level {
-        let r = match &product {
-            None => refine_topology(&topo, &level_tags, options),
-            Some(p) => refine_compose(&topo, &level_tags, options, p),
-        };
-        product = Some(r.matrix);
-        topo = Topology::new(&r.faces, r.num_vertices)
-            .expect("the refinement of a valid mesh is valid");
-        level_faces = r.faces;
-        level_tags = r.tags;
+    if level == 0 {
+        let [position, tangent1, tangent2] = limit_rows(&topo, tags, options).split();
+        return Ok(SamplingOperator {
+            level,
+            faces: faces.clone(),
+            num_vertices,
+            tags: tags.clone(),
+            position,
+            tangent1,
+            tangent2,
+        });
     }
-    let [position, tangent1, tangent2] = match &product {
-        None => limit_rows(&topo, &level_tags, options).split(),
-        Some(p) => limit_compose(&topo, &level_tags, options, p),
-    };
+    // P_{l−1} = M_{l−1} ⋯ M_1 over the control points, with the level-(l−1) adjacency.
+    let mut product = StencilMatrix::identity(num_vertices);
+    let mut level_tags = tags.clone();
+    for k in 1..level {
+        product = if k == 1 {
+            refine_matrix(&topo, &level_tags, options)
+        } else {
+            refine_compose(&topo, &level_tags, options, &product)
+        };
+        level_tags = child_tags(&topo, &level_tags);
+        topo = Topology::refined(&topo, options.scheme)?;
+    }
+    // The last level: C = L_l · M_l · P_{l−1}, with neither M_l nor its product stored and the
+    // level-l adjacency read off level l − 1.
+    let child_tags = child_tags(&topo, &level_tags);
+    let [position, tangent1, tangent2] =
+        limit_refine_compose(&topo, &level_tags, &child_tags, options, &product);
     Ok(SamplingOperator {
         level,
-        faces: level_faces,
-        num_vertices: topo.num_vertices(),
-        tags: level_tags,
+        faces: child_faces(&topo, options.scheme),
+        num_vertices: position.nrows(),
+        tags: child_tags,
         position,
         tangent1,
         tangent2,

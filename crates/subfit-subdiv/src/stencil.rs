@@ -348,10 +348,13 @@ impl<'a> Stacked<'a> {
 /// Rows are produced in waves of [`WAVE`] blocks of [`BLOCK`] rows: the blocks of a wave are
 /// computed in parallel (one `init()` state and one dense scratch row of `rhs.ncols` entries per
 /// worker) into buffers reused from wave to wave, then appended to the output, whose capacity is
-/// extrapolated from the first wave. So the output is written once and no large temporary is
-/// allocated per call beyond one wave's buffers. (A parallel copy into a zero-filled output was
-/// tried: the allocator zero-fills allocations below its mmap threshold, which cost more than
-/// the serial append it saved.)
+/// extrapolated from the first wave. The append of one wave runs beside the computation of the
+/// next (two sets of buffers, `rayon::join`), so the writes into the output — and the page
+/// faults of its fresh memory, a good part of the cost for large outputs — overlap with
+/// arithmetic instead of stalling the other workers. So the output is written once and no large
+/// temporary is allocated per call beyond two waves' buffers. (A parallel copy into a
+/// zero-filled output was tried: the allocator zero-fills allocations below its mmap
+/// threshold, which cost more than the serial append it saved.)
 pub(crate) fn compose_rows<const K: usize, S>(
     nrows: usize,
     rhs: Stacked<'_>,
@@ -366,20 +369,23 @@ where
     for m in &mut out {
         m.offsets.reserve_exact(nrows);
     }
-    // One task slot per block of a wave, each with its own output buffers and scratch, both
-    // reused from wave to wave (small enough to stay in cache; no allocation per wave).
+    // One scratch per block of a wave and two sets of output buffers (the wave being computed
+    // and the wave being appended), all reused from wave to wave (small enough to stay in
+    // cache; no allocation per wave).
     let nslots = nrows.div_ceil(BLOCK).min(WAVE);
-    let mut slots: Vec<([RowBlock; K], Scratch<K, S>)> = (0..nslots)
-        .map(|_| {
-            let bufs = std::array::from_fn(|_| RowBlock::default());
-            (bufs, Scratch::new(ncols, init()))
-        })
-        .collect();
-    let mut first = 0;
-    while first < nrows {
+    let mut scratch: Vec<Scratch<K, S>> =
+        (0..nslots).map(|_| Scratch::new(ncols, init())).collect();
+    let new_bufs = || -> Vec<[RowBlock; K]> {
+        (0..nslots)
+            .map(|_| std::array::from_fn(|_| RowBlock::default()))
+            .collect()
+    };
+    let (mut ready, mut next) = (new_bufs(), new_bufs());
+    let compute = |first: usize, bufs: &mut [[RowBlock; K]], scratch: &mut [Scratch<K, S>]| {
         let nblocks = (nrows - first).div_ceil(BLOCK).min(WAVE);
-        slots[..nblocks]
+        bufs[..nblocks]
             .par_iter_mut()
+            .zip(&mut scratch[..nblocks])
             .enumerate()
             .for_each(|(b, (blk, scratch))| {
                 let rows = first + b * BLOCK..(first + (b + 1) * BLOCK).min(nrows);
@@ -391,38 +397,72 @@ where
                     scratch.emit(blk);
                 }
             });
-        let done = (first + nblocks * BLOCK).min(nrows);
-        for (k, m) in out.iter_mut().enumerate() {
-            if first == 0 {
-                // Extrapolate the total from the first wave, generously: unused capacity is
-                // never touched (so costs no memory) and is given back below.
-                let wave_nnz: usize = slots.iter().map(|s| s.0[k].indices.len()).sum();
-                let guess = (wave_nnz as f64 * nrows as f64 / done as f64 * 1.25) as usize;
-                m.indices.reserve_exact(guess);
-                m.weights.reserve_exact(guess);
-            }
-            for (blk, _) in &slots[..nblocks] {
-                let RowBlock {
-                    lens,
-                    indices,
-                    weights,
-                } = &blk[k];
-                let mut end = m.indices.len();
-                for &l in lens {
-                    end += l as usize;
-                    m.offsets.push(end);
-                }
-                m.indices.extend_from_slice(indices);
-                m.weights.extend_from_slice(weights);
-            }
+        (first + nblocks * BLOCK).min(nrows)
+    };
+    let mut done = if nrows > 0 {
+        compute(0, &mut ready, &mut scratch)
+    } else {
+        0
+    };
+    let mut appended = 0;
+    while appended < nrows {
+        let (first_wave, wave_end) = (appended == 0, done);
+        let nblocks = (wave_end - appended).div_ceil(BLOCK);
+        let append = |out: &mut [StencilMatrix; K]| {
+            append_wave(out, &ready[..nblocks], first_wave, wave_end, nrows)
+        };
+        if done < nrows {
+            let ((), end) = rayon::join(
+                || append(&mut out),
+                || compute(done, &mut next, &mut scratch),
+            );
+            done = end;
+        } else {
+            append(&mut out);
         }
-        first = done;
+        appended = wave_end;
+        std::mem::swap(&mut ready, &mut next);
     }
     for m in &mut out {
         m.indices.shrink_to_fit();
         m.weights.shrink_to_fit();
     }
     out
+}
+
+/// Appends the rows of one wave of [`compose_rows`] (`blocks`, ending at row `wave_end` of
+/// `nrows`) to the outputs; after the first wave, reserves the extrapolated total.
+fn append_wave<const K: usize>(
+    out: &mut [StencilMatrix; K],
+    blocks: &[[RowBlock; K]],
+    first_wave: bool,
+    wave_end: usize,
+    nrows: usize,
+) {
+    for (k, m) in out.iter_mut().enumerate() {
+        if first_wave {
+            // Extrapolate the total from the first wave, generously: unused capacity is
+            // never touched (so costs no memory) and is given back at the end.
+            let wave_nnz: usize = blocks.iter().map(|b| b[k].indices.len()).sum();
+            let guess = (wave_nnz as f64 * nrows as f64 / wave_end as f64 * 1.25) as usize;
+            m.indices.reserve_exact(guess);
+            m.weights.reserve_exact(guess);
+        }
+        for blk in blocks {
+            let RowBlock {
+                lens,
+                indices,
+                weights,
+            } = &blk[k];
+            let mut end = m.indices.len();
+            for &l in lens {
+                end += l as usize;
+                m.offsets.push(end);
+            }
+            m.indices.extend_from_slice(indices);
+            m.weights.extend_from_slice(weights);
+        }
+    }
 }
 
 /// Rows per parallel task in [`compose_rows`].

@@ -6,7 +6,9 @@
 //! `i + 1`, and at a boundary vertex ring edge 0 is the leading boundary edge (see
 //! [`crate::Neighborhood`]).
 
+use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
+use crate::scheme::Scheme;
 use rayon::prelude::*;
 use subfit_mesh::Polygons;
 
@@ -28,7 +30,7 @@ struct RingPart {
 /// corner `c` of a face also names the directed edge from its vertex to the next vertex of the
 /// face. Edges are numbered in order of first appearance when faces are scanned in order and each
 /// face's corners in winding order. Memory O(#corners + #V).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Topology {
     num_vertices: usize,
     offsets: Vec<u32>,
@@ -127,6 +129,75 @@ impl Topology {
         Ok(t)
     }
 
+    /// The adjacency of the once-refined `parent` (child face and vertex order of
+    /// [`crate::refine`]), equal to `Topology::new` of the child's faces but read off the
+    /// parent's corners in closed form (module `child`) instead of searched for: no twin
+    /// search, no outgoing lists, no validation (the child of a valid mesh is valid). The
+    /// parent must suit `scheme` (Loop: triangles only).
+    ///
+    /// Errors: [`SubdivError::TooLarge`] if the child has `u32::MAX` or more vertices or
+    /// corners. Cost O(#child corners), parallel except for the edge numbering.
+    pub(crate) fn refined(parent: &Topology, scheme: Scheme) -> Result<Self, SubdivError> {
+        let child = ChildCorners::new(parent, scheme);
+        let (size, nf) = (child.face_size(), child.num_faces());
+        let (nv, nc) = (child.num_vertices(), nf * size as usize);
+        if nv >= NONE as usize || nc >= NONE as usize {
+            return Err(SubdivError::TooLarge {
+                what: "vertices or face indices",
+                count: nv.max(nc),
+            });
+        }
+        let corners = || (0..nc as u32).into_par_iter();
+        let indices: Vec<u32> = corners().map(|x| child.vertex(x)).collect();
+        let next_vertex = corners().map(|x| indices[child.next(x) as usize]).collect();
+        let twin: Vec<u32> = corners().map(|x| child.twin(x)).collect();
+        let mut t = Topology {
+            num_vertices: nv,
+            offsets: (0..=nf as u32).map(|f| f * size).collect(),
+            indices,
+            corner_face: corners().map(|x| x / size).collect(),
+            next_vertex,
+            corner_edge: vec![NONE; nc],
+            edge_verts: Vec::new(),
+            edge_corners: Vec::new(),
+            ring_offsets: Vec::new(),
+            ring_edges: Vec::new(),
+            ring_verts: Vec::new(),
+            face_ring_offsets: Vec::new(),
+            ring_corners: Vec::new(),
+        };
+        t.build_edges(&twin);
+        drop(twin);
+        const CHUNK: usize = 4096;
+        let this = &t;
+        let parts: Vec<RingPart> = (0..nv.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|k| {
+                let mut part = RingPart::default();
+                let mut ring = ChildRing::default();
+                for v in (k * CHUNK) as u32..((k + 1) * CHUNK).min(nv) as u32 {
+                    child.ring(v, &mut ring);
+                    part.corners.extend_from_slice(&ring.corners);
+                    part.verts.extend_from_slice(&ring.verts);
+                    part.edges
+                        .extend(ring.corners.iter().map(|&c| this.corner_edge[c as usize]));
+                    if let (Some(&last), true) =
+                        (ring.corners.last(), ring.verts.len() > ring.corners.len())
+                    {
+                        // The closing boundary edge, entering `v`.
+                        part.edges
+                            .push(this.corner_edge[this.corner_prev(last) as usize]);
+                    }
+                    part.edge_ends.push(part.edges.len() as u32);
+                    part.corner_ends.push(part.corners.len() as u32);
+                }
+                part
+            })
+            .collect();
+        t.set_rings(parts);
+        Ok(t)
+    }
+
     /// The twin of every corner (the corner of the opposite directed edge, `NONE` on a
     /// boundary), checking that no directed edge is used twice. Parallel over corners.
     fn twins<'a>(
@@ -191,6 +262,14 @@ impl Topology {
             .into_par_iter()
             .map(|k| this.ring_part(k * CHUNK..((k + 1) * CHUNK).min(nv), outgoing, twin))
             .collect();
+        let parts = parts.into_iter().collect::<Result<Vec<_>, _>>()?;
+        self.set_rings(parts);
+        Ok(())
+    }
+
+    /// Concatenates the rings of consecutive blocks of vertices (all vertices, in order).
+    fn set_rings(&mut self, parts: Vec<RingPart>) {
+        let nv = self.num_vertices;
         let mut ring_offsets = Vec::with_capacity(nv + 1);
         let mut face_ring_offsets = Vec::with_capacity(nv + 1);
         ring_offsets.push(0);
@@ -199,7 +278,6 @@ impl Topology {
         let mut ring_verts = Vec::with_capacity(self.indices.len() + nv);
         let mut ring_corners = Vec::with_capacity(self.indices.len());
         for part in parts {
-            let part = part?;
             let (e0, c0) = (ring_edges.len() as u32, ring_corners.len() as u32);
             ring_offsets.extend(part.edge_ends.iter().map(|&x| x + e0));
             face_ring_offsets.extend(part.corner_ends.iter().map(|&x| x + c0));
@@ -212,7 +290,6 @@ impl Topology {
         self.ring_edges = ring_edges;
         self.ring_verts = ring_verts;
         self.ring_corners = ring_corners;
-        Ok(())
     }
 
     /// The rings of the vertices `range` (see [`Self::build_rings`]).
@@ -337,6 +414,24 @@ impl Topology {
     #[inline]
     pub fn corner_next_vertex(&self, c: u32) -> u32 {
         self.next_vertex[c as usize]
+    }
+
+    /// The edge of corner `c` (joining its vertex to the next vertex of its face).
+    #[inline]
+    pub(crate) fn corner_edge(&self, c: u32) -> u32 {
+        self.corner_edge[c as usize]
+    }
+
+    /// The twin of corner `c`: the corner of the opposite directed edge, `u32::MAX` on a
+    /// boundary.
+    #[inline]
+    pub(crate) fn corner_twin(&self, c: u32) -> u32 {
+        let [a, b] = self.edge_corners[self.corner_edge[c as usize] as usize];
+        if a == c {
+            b
+        } else {
+            a
+        }
     }
 
     /// End vertices of edge `e`, in the direction of the first face that uses it.

@@ -200,13 +200,19 @@ fn assert_same_matrix(
     }
 }
 
-/// The sampling operator (built with fused, parallel refinement products and Catmull-Clark face
-/// points reused as rows) equals the plain product of the public pieces: the limit stencils of
-/// the level-`l` mesh times `M_l ⋯ M_1` from [`refine`], with the same level-`l` faces.
+/// The sampling operator (built with fused, parallel refinement products, Catmull-Clark face
+/// points reused as rows, and the last level's limit and refinement rows fused and read off the
+/// level below) equals the plain product of the public pieces: the limit stencils of the
+/// level-`l` mesh times `M_l ⋯ M_1` from [`refine`], with the same level-`l` faces; under both
+/// boundary rules.
 #[test]
 fn sampling_operator_equals_the_product_of_refinement_matrices() {
-    for (name, scheme, pts, faces, tags) in corpus() {
-        let o = Options::new(scheme);
+    let rules = [BoundaryRule::EdgeOnly, BoundaryRule::EdgeAndCorner];
+    for ((name, scheme, pts, faces, tags), boundary) in corpus()
+        .into_iter()
+        .flat_map(|c| rules.map(|r| (c.clone(), r)))
+    {
+        let o = Options::new(scheme).with_boundary(boundary);
         let (mut f, mut nv, mut t) = (faces.clone(), pts.len(), tags.clone());
         let mut product = subfit_subdiv::StencilMatrix::identity(pts.len());
         for level in 1..=3 {
@@ -217,7 +223,7 @@ fn sampling_operator_equals_the_product_of_refinement_matrices() {
             assert_eq!(s.faces, f, "{name}: level {level} faces");
             assert_eq!(s.num_vertices, nv, "{name}: level {level} vertex count");
             let l = limit_stencils(&f, nv, &t, &o).unwrap();
-            let what = format!("{name} level {level}");
+            let what = format!("{name} {boundary:?} level {level}");
             assert_same_matrix(&s.position, &l.position.compose(&product), 1e-14, &what);
             assert_same_matrix(&s.tangent1, &l.tangent1.compose(&product), 1e-13, &what);
             assert_same_matrix(&s.tangent2, &l.tangent2.compose(&product), 1e-13, &what);

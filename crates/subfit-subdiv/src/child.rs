@@ -1,0 +1,527 @@
+//! The adjacency of a once-refined mesh, read off its parent's [`Topology`] without building the
+//! child's.
+//!
+//! Uniform refinement replaces every parent element by a fixed pattern of child elements, so
+//! every child corner, its successor in its face and its twin are closed-form functions of
+//! the parent's corners, edges and twins — the construction of OpenSubdiv's
+//! `Vtr::QuadRefinement` / `Vtr::TriRefinement`, which derive each child level from its parent
+//! instead of searching for twins. With the child face order of [`crate::refine`]:
+//!
+//! * Catmull-Clark: the child quad of parent corner `c` (vertex `v`, face `f`, edges `e_c`
+//!   leaving and `e_p` entering `v`) has index `c` and corners `4c … 4c+3` at the vertex point
+//!   of `v`, the edge points of `e_c`, the face point of `f`, the edge point of `e_p`.
+//! * Loop: parent triangle `f` with corners `3f + k` and edges `e_k` has children `4f + k`
+//!   `= (v_k, e_k, e_{k−1})` and `4f + 3 = (e_0, e_1, e_2)`; child corner `3(4f + j) + i`.
+//!
+//! Rings are then walked exactly as [`Topology::new`] walks them (counter-clockwise from the
+//! leading boundary edge, or from the vertex's lowest-numbered corner), so a child ring here
+//! equals the ring of the child [`Topology`], entry for entry (checked by the tests below).
+//! The last level of the sampling operator uses this instead of building a [`Topology`] with
+//! one entry per corner of the finest mesh, which it would read only once.
+//!
+//! Cost: each query O(1) parent look-ups; a ring O(valence). Nothing is allocated but the
+//! caller's [`ChildRing`] buffers.
+
+use crate::scheme::Scheme;
+use crate::topology::Topology;
+
+const NONE: u32 = u32::MAX;
+
+/// Corner algebra of the child of `topo` under one step of `scheme`.
+///
+/// The parent must suit the scheme (Loop: triangles only). Child corners are numbered as
+/// positions in the child face list's indices; child vertices as in [`crate::refine`].
+#[derive(Clone, Copy)]
+pub(crate) struct ChildCorners<'a> {
+    topo: &'a Topology,
+    scheme: Scheme,
+    nv: u32,
+    ne: u32,
+}
+
+/// The ring of one child vertex, as [`Topology::vertex_ring`] and [`Topology::vertex_corners`]
+/// of the child mesh would give it, with whether each ring edge is a boundary edge. Buffers are
+/// reused from vertex to vertex.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ChildRing {
+    /// The vertex's corners, counter-clockwise (one per incident face).
+    pub(crate) corners: Vec<u32>,
+    /// Far ends of the ring edges (one more than `corners` at a boundary vertex).
+    pub(crate) verts: Vec<u32>,
+    /// Whether each ring edge has a single face.
+    pub(crate) boundary: Vec<bool>,
+    /// Catmull-Clark: the vertex two corners away in each ring face (the quad's diagonal);
+    /// empty for Loop.
+    pub(crate) diagonals: Vec<u32>,
+}
+
+impl<'a> ChildCorners<'a> {
+    /// The child of `topo` (which must suit `scheme`).
+    pub(crate) fn new(topo: &'a Topology, scheme: Scheme) -> Self {
+        debug_assert!(
+            scheme == Scheme::CatmullClark
+                || (0..topo.num_faces()).all(|f| topo.face(f).len() == 3)
+        );
+        Self {
+            topo,
+            scheme,
+            nv: topo.num_vertices() as u32,
+            ne: topo.num_edges() as u32,
+        }
+    }
+
+    /// Number of child vertices.
+    pub(crate) fn num_vertices(&self) -> usize {
+        let t = self.topo;
+        t.num_vertices()
+            + t.num_edges()
+            + match self.scheme {
+                Scheme::CatmullClark => t.num_faces(),
+                Scheme::Loop => 0,
+            }
+    }
+
+    /// The number of vertices of every child face (4 for Catmull-Clark, 3 for Loop).
+    pub(crate) fn face_size(&self) -> u32 {
+        match self.scheme {
+            Scheme::CatmullClark => 4,
+            Scheme::Loop => 3,
+        }
+    }
+
+    /// Number of child faces (one per parent corner for Catmull-Clark, four per parent
+    /// triangle for Loop).
+    pub(crate) fn num_faces(&self) -> usize {
+        match self.scheme {
+            Scheme::CatmullClark => self.topo.face_first_corner(self.topo.num_faces()),
+            Scheme::Loop => 4 * self.topo.num_faces(),
+        }
+    }
+
+    /// The child vertex of child corner `x`.
+    #[inline]
+    pub(crate) fn vertex(&self, x: u32) -> u32 {
+        let t = self.topo;
+        match self.scheme {
+            Scheme::CatmullClark => {
+                let c = x / 4;
+                match x % 4 {
+                    0 => t.corner_vertex(c),
+                    1 => self.nv + t.corner_edge(c),
+                    2 => self.nv + self.ne + t.corner_face(c),
+                    _ => self.nv + t.corner_edge(t.corner_prev(c)),
+                }
+            }
+            Scheme::Loop => {
+                let (f, j, i) = (x / 12, (x % 12) / 3, x % 3);
+                match (j, i) {
+                    (3, i) => self.nv + t.corner_edge(3 * f + i),
+                    (j, 0) => t.corner_vertex(3 * f + j),
+                    (j, 1) => self.nv + t.corner_edge(3 * f + j),
+                    (j, _) => self.nv + t.corner_edge(3 * f + (j + 2) % 3),
+                }
+            }
+        }
+    }
+
+    /// The corner after child corner `x` in its (child) face.
+    #[inline]
+    pub(crate) fn next(&self, x: u32) -> u32 {
+        match self.scheme {
+            Scheme::CatmullClark => (x & !3) | ((x + 1) & 3),
+            Scheme::Loop => x - x % 3 + (x + 1) % 3,
+        }
+    }
+
+    /// The corner before child corner `x` in its face.
+    #[cfg(test)]
+    #[inline]
+    pub(crate) fn prev(&self, x: u32) -> u32 {
+        match self.scheme {
+            Scheme::CatmullClark => (x & !3) | ((x + 3) & 3),
+            Scheme::Loop => x - x % 3 + (x + 2) % 3,
+        }
+    }
+
+    /// The twin of child corner `x` (the corner of the opposite directed edge), `u32::MAX` on a
+    /// boundary.
+    #[inline]
+    pub(crate) fn twin(&self, x: u32) -> u32 {
+        let t = self.topo;
+        match self.scheme {
+            Scheme::CatmullClark => {
+                let c = x / 4;
+                match x % 4 {
+                    // Vertex point → edge point of e_c: back along e_c in the other face.
+                    0 => match t.corner_twin(c) {
+                        NONE => NONE,
+                        o => 4 * t.corner_next(o) + 3,
+                    },
+                    1 => 4 * t.corner_next(c) + 2,
+                    2 => 4 * t.corner_prev(c) + 1,
+                    _ => match t.corner_twin(t.corner_prev(c)) {
+                        NONE => NONE,
+                        o => 4 * o,
+                    },
+                }
+            }
+            Scheme::Loop => {
+                let (f, j, i) = (x / 12, (x % 12) / 3, x % 3);
+                match (j, i) {
+                    (3, i) => 12 * f + 3 * ((i + 1) % 3) + 1,
+                    (j, 0) => match t.corner_twin(3 * f + j) {
+                        NONE => NONE,
+                        o => 12 * (o / 3) + 3 * ((o % 3 + 1) % 3) + 2,
+                    },
+                    (j, 1) => 12 * f + 9 + (j + 2) % 3,
+                    (j, _) => match t.corner_twin(3 * f + (j + 2) % 3) {
+                        NONE => NONE,
+                        o => 12 * (o / 3) + 3 * (o % 3),
+                    },
+                }
+            }
+        }
+    }
+
+    /// Appends the child corners of child vertex `w` (any order) to `out`.
+    #[cfg(test)]
+    fn outgoing(&self, w: u32, out: &mut Vec<u32>) {
+        let t = self.topo;
+        let (nv, ne) = (self.nv, self.ne);
+        if w < nv {
+            let first = |c: u32| match self.scheme {
+                Scheme::CatmullClark => 4 * c,
+                Scheme::Loop => 12 * (c / 3) + 3 * (c % 3),
+            };
+            out.extend(t.vertex_corners(w).iter().map(|&c| first(c)));
+        } else if w < nv + ne {
+            for c in t.edge_corners(w - nv) {
+                if c == NONE {
+                    continue;
+                }
+                match self.scheme {
+                    Scheme::CatmullClark => {
+                        out.extend([4 * c + 1, 4 * t.corner_next(c) + 3]);
+                    }
+                    Scheme::Loop => {
+                        let (f, k) = (c / 3, c % 3);
+                        out.extend([
+                            12 * f + 3 * k + 1,
+                            12 * f + 3 * ((k + 1) % 3) + 2,
+                            12 * f + 9 + k,
+                        ]);
+                    }
+                }
+            }
+        } else {
+            let f = (w - nv - ne) as usize;
+            let c0 = t.face_first_corner(f) as u32;
+            out.extend((c0..c0 + t.face(f).len() as u32).map(|c| 4 * c + 2));
+        }
+    }
+
+    /// The ring of child vertex `w` into `ring` (cleared first), as [`Topology::new`] would
+    /// build it for the child mesh, in closed form from the parent's ring, edge or face (the
+    /// walk of [`Self::ring_by_walk`], worked out per kind of child vertex). Cost O(valence).
+    pub(crate) fn ring(&self, w: u32, ring: &mut ChildRing) {
+        ring.clear();
+        let t = self.topo;
+        let (nv, ne) = (self.nv, self.ne);
+        let scheme = self.scheme;
+        if w < nv {
+            // Vertex point: the parent ring, edge for edge (the lowest child corner and the
+            // boundary corner are those of the parent's lowest and boundary corners).
+            for &c in t.vertex_corners(w) {
+                match scheme {
+                    Scheme::CatmullClark => {
+                        ring.corners.push(4 * c);
+                        ring.diagonals.push(nv + ne + t.corner_face(c));
+                    }
+                    Scheme::Loop => ring.corners.push(12 * (c / 3) + 3 * (c % 3)),
+                }
+            }
+            for &e in t.vertex_edges(w) {
+                ring.verts.push(nv + e);
+                ring.boundary.push(t.is_boundary_edge(e));
+            }
+        } else if w < nv + ne {
+            let [c0, c1] = t.edge_corners(w - nv);
+            match scheme {
+                Scheme::CatmullClark => {
+                    // Per side (corner c of the edge, n = next(c)): the child edges toward
+                    // the vertex point of n's vertex and toward the face point.
+                    let side = |c: u32| {
+                        let n = t.corner_next(c);
+                        [
+                            (4 * n + 3, t.corner_vertex(n), nv + t.corner_edge(n)),
+                            (
+                                4 * c + 1,
+                                nv + ne + t.corner_face(c),
+                                nv + t.corner_edge(t.corner_prev(c)),
+                            ),
+                        ]
+                    };
+                    if c1 == NONE {
+                        ring.push_rotated(&side(c0), false);
+                        ring.verts.push(t.corner_vertex(c0));
+                        ring.boundary[0] = true;
+                        ring.boundary.push(true);
+                    } else {
+                        let ([a, b], [c, d]) = (side(c0), side(c1));
+                        ring.push_rotated(&[a, b, c, d], true);
+                    }
+                }
+                Scheme::Loop => {
+                    // Per side (corner 3f + k of the edge): the child edges toward the vertex
+                    // point of v_{k+1} and the edge points of e_{k+1} and e_{k+2}.
+                    let side = |c: u32| {
+                        let (f, k) = (c / 3, c % 3);
+                        let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
+                        [
+                            (12 * f + 3 * k1 + 2, t.corner_vertex(3 * f + k1), NONE),
+                            (12 * f + 9 + k, nv + t.corner_edge(3 * f + k1), NONE),
+                            (12 * f + 3 * k + 1, nv + t.corner_edge(3 * f + k2), NONE),
+                        ]
+                    };
+                    if c1 == NONE {
+                        ring.push_rotated(&side(c0), false);
+                        ring.verts.push(t.corner_vertex(c0));
+                        ring.boundary[0] = true;
+                        ring.boundary.push(true);
+                    } else {
+                        let ([a, b, c], [d, e, f]) = (side(c0), side(c1));
+                        ring.push_rotated(&[a, b, c, d, e, f], true);
+                    }
+                }
+            }
+        } else {
+            // Face point (Catmull-Clark): one child edge per parent edge, starting at the
+            // face's first corner.
+            let f = (w - nv - ne) as usize;
+            let c0 = t.face_first_corner(f) as u32;
+            let n = t.face(f).len() as u32;
+            for i in 0..n {
+                let c = c0 + i;
+                ring.corners.push(4 * c + 2);
+                ring.verts.push(nv + t.corner_edge(c0 + (i + n - 1) % n));
+                ring.boundary.push(false);
+                ring.diagonals.push(t.corner_vertex(c));
+            }
+        }
+        if scheme == Scheme::Loop {
+            ring.diagonals.clear();
+        }
+    }
+
+    /// The ring of child vertex `w` by walking the child corners, as [`Topology::new`] does:
+    /// from the leading boundary corner or else the lowest-numbered corner, to the twin of the
+    /// previous corner, until the start or a boundary. The reference for [`Self::ring`].
+    #[cfg(test)]
+    pub(crate) fn ring_by_walk(&self, w: u32, ring: &mut ChildRing) {
+        ring.clear();
+        let mut outgoing = Vec::new();
+        self.outgoing(w, &mut outgoing);
+        let Some(&min) = outgoing.iter().min() else {
+            return;
+        };
+        // At most one outgoing corner of a manifold vertex lacks a twin: the leading boundary
+        // edge.
+        let start = outgoing
+            .iter()
+            .copied()
+            .find(|&x| self.twin(x) == NONE)
+            .unwrap_or(min);
+        let mut cur = start;
+        loop {
+            ring.corners.push(cur);
+            ring.verts.push(self.vertex(self.next(cur)));
+            ring.boundary.push(self.twin(cur) == NONE);
+            if self.scheme == Scheme::CatmullClark {
+                ring.diagonals.push(self.vertex(self.next(self.next(cur))));
+            }
+            let pc = self.prev(cur);
+            match self.twin(pc) {
+                NONE => {
+                    ring.verts.push(self.vertex(pc));
+                    ring.boundary.push(true);
+                    break;
+                }
+                x if x == start => break,
+                x => cur = x,
+            }
+            assert!(ring.corners.len() <= outgoing.len());
+        }
+        assert_eq!(ring.corners.len(), outgoing.len());
+    }
+}
+
+impl ChildRing {
+    fn clear(&mut self) {
+        self.corners.clear();
+        self.verts.clear();
+        self.boundary.clear();
+        self.diagonals.clear();
+    }
+
+    /// Appends `(corner, far end, diagonal)` triples in cyclic order, starting at the lowest
+    /// corner when `rotate` (an interior vertex) or at the first.
+    #[inline]
+    fn push_rotated(&mut self, entries: &[(u32, u32, u32)], rotate: bool) {
+        let start = if rotate {
+            (0..entries.len())
+                .min_by_key(|&i| entries[i].0)
+                .expect("entries")
+        } else {
+            0
+        };
+        for i in (start..entries.len()).chain(0..start) {
+            let (c, v, d) = entries[i];
+            self.corners.push(c);
+            self.verts.push(v);
+            self.boundary.push(false);
+            self.diagonals.push(d);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::refine::refine;
+    use crate::scheme::Options;
+    use subfit_mesh::{Polygons, Tags};
+
+    /// The child faces as the module docs of [`crate::refine`] list them, face by face.
+    fn child_faces_by_pattern(topo: &Topology, scheme: Scheme) -> Polygons {
+        let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
+        let mut out = Polygons::new();
+        for f in 0..topo.num_faces() {
+            let v = topo.face(f);
+            let e = topo.face_edges(f);
+            let n = v.len();
+            match scheme {
+                Scheme::Loop => {
+                    let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
+                    out.push(&[v[0], ab, ca]);
+                    out.push(&[v[1], bc, ab]);
+                    out.push(&[v[2], ca, bc]);
+                    out.push(&[ab, bc, ca]);
+                }
+                Scheme::CatmullClark => {
+                    let fp = nv + ne + f as u32;
+                    for i in 0..n {
+                        out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// An open grid of `n × n` quads (or triangles) with one vertex left out of all faces.
+    fn grid(n: u32, tris: bool) -> (usize, Polygons) {
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        let mut faces = Polygons::new();
+        for i in 0..n {
+            for j in 0..n {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if tris {
+                    faces.push(&[q[0], q[1], q[2]]);
+                    faces.push(&[q[0], q[2], q[3]]);
+                } else {
+                    faces.push(&q);
+                }
+            }
+        }
+        (((n + 1) * (n + 1) + 1) as usize, faces)
+    }
+
+    /// A closed cube-like mesh with a pentagon, a triangle and valence-3 and -5 vertices (an
+    /// octahedron for Loop).
+    fn closed(tris: bool) -> (usize, Polygons) {
+        if tris {
+            let f = [
+                [0, 1, 2],
+                [0, 2, 3],
+                [0, 3, 4],
+                [0, 4, 1],
+                [5, 2, 1],
+                [5, 3, 2],
+                [5, 4, 3],
+                [5, 1, 4],
+            ];
+            return (6, Polygons::from_triangles(&f));
+        }
+        // A cube with a vertex added on one edge (two pentagons) and a side split in two
+        // triangles.
+        let mut p = Polygons::new();
+        p.push(&[0, 3, 2, 1]);
+        p.push(&[0, 1, 5]);
+        p.push(&[0, 5, 4]);
+        p.push(&[1, 2, 6, 5]);
+        p.push(&[2, 3, 7, 8, 6]);
+        p.push(&[3, 0, 4, 7]);
+        p.push(&[4, 5, 6, 8, 7]);
+        (9, p)
+    }
+
+    #[test]
+    fn child_corners_rings_and_refined_topology_equal_the_child_topology() {
+        for scheme in [Scheme::Loop, Scheme::CatmullClark] {
+            let tris = scheme == Scheme::Loop;
+            for (nv, faces) in [grid(3, tris), closed(tris)] {
+                let o = Options::new(scheme);
+                let parent = Topology::new(&faces, nv).unwrap();
+                let r = refine(&faces, nv, &Tags::new(), &o).unwrap();
+                // Two levels: the second parent has only regular faces.
+                let child_topo = Topology::new(&r.faces, r.num_vertices).unwrap();
+                let r2 = refine(&r.faces, r.num_vertices, &Tags::new(), &o).unwrap();
+                let grandchild = Topology::new(&r2.faces, r2.num_vertices).unwrap();
+                for (p, c, faces) in [
+                    (&parent, &child_topo, &r.faces),
+                    (&child_topo, &grandchild, &r2.faces),
+                ] {
+                    assert_eq!(faces, &child_faces_by_pattern(p, scheme), "{scheme:?}");
+                    assert_eq!(&Topology::refined(p, scheme).unwrap(), c, "{scheme:?}");
+                    let k = ChildCorners::new(p, scheme);
+                    assert_eq!(k.num_vertices(), c.num_vertices());
+                    let nc = faces.indices().len() as u32;
+                    for x in 0..nc {
+                        assert_eq!(k.vertex(x), c.corner_vertex(x), "{scheme:?} corner {x}");
+                        assert_eq!(k.next(x), c.corner_next(x));
+                        assert_eq!(k.prev(x), c.corner_prev(x));
+                        assert_eq!(k.twin(x), c.corner_twin(x), "{scheme:?} twin of {x}");
+                    }
+                    let mut ring = ChildRing::default();
+                    for w in 0..c.num_vertices() as u32 {
+                        let b: Vec<bool> = c
+                            .vertex_edges(w)
+                            .iter()
+                            .map(|&e| c.is_boundary_edge(e))
+                            .collect();
+                        let d: Vec<u32> = match scheme {
+                            Scheme::CatmullClark => c
+                                .vertex_corners(w)
+                                .iter()
+                                .map(|&x| c.corner_vertex(c.corner_next(c.corner_next(x))))
+                                .collect(),
+                            Scheme::Loop => Vec::new(),
+                        };
+                        for walk in [false, true] {
+                            if walk {
+                                k.ring_by_walk(w, &mut ring);
+                            } else {
+                                k.ring(w, &mut ring);
+                            }
+                            let what = format!("{scheme:?} vertex {w} (walk: {walk})");
+                            assert_eq!(ring.verts, c.vertex_ring(w), "{what}");
+                            assert_eq!(ring.corners, c.vertex_corners(w), "{what}");
+                            assert_eq!(ring.boundary, b, "{what}");
+                            assert_eq!(ring.diagonals, d, "{what}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
