@@ -1017,7 +1017,7 @@ pub struct VertexProperty<'a> {
     pub values: &'a [f64],
 }
 
-/// Writes a mesh as PLY like [`write`], with extra per-vertex scalar properties after the
+/// Writes a mesh as PLY like [`fn@write`], with extra per-vertex scalar properties after the
 /// standard ones (stored as `double`, or `float` when `single_precision`).
 ///
 /// Errors (`InvalidInput`) when an attribute or property length differs from the vertex count

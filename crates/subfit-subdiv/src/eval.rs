@@ -4,7 +4,7 @@
 //! Method: Stam 1998 (*Exact evaluation of Catmull-Clark subdivision surfaces at arbitrary
 //! parameter values*; *Evaluation of Loop subdivision surfaces*), in its "repeated subdivision of
 //! the local patch" form rather than the eigen-basis form: the two-ring neighbourhood of the face
-//! is refined locally ([`crate::local`], with the masks of [`crate::mask`]) and the child face
+//! is refined locally (module `local`, with the masks of [`crate::mask`]) and the child face
 //! containing the point is kept, until that face is regular; then the regular polynomial patch
 //! ([`crate::patch`]: quartic box spline for Loop, bicubic B-spline for Catmull-Clark) is
 //! evaluated. Both steps are exact, so the result is exact to rounding, near extraordinary
@@ -18,7 +18,7 @@
 //!   `c2` at `(1,1)`, `c3` at `(0,1)`.
 //! * Catmull-Clark `n`-gon (`n ≠ 4`): sub-patch `k` (`0 ≤ k < n`) is the quad of the first-level
 //!   split at corner `k`, `(v_k, e_{k,k+1}, F, e_{k−1,k})` with `e_{i,j}` the edge point of edge
-//!   `v_i v_j` and `F` the face point (the order of [`crate::refine`]); `(u, v) ∈ [0,1]²` on it
+//!   `v_i v_j` and `F` the face point (the order of [`mod@crate::refine`]); `(u, v) ∈ [0,1]²` on it
 //!   with the quad convention above (`v_k` at `(0,0)`, `e_{k,k+1}` at `(1,0)`, `F` at `(1,1)`,
 //!   `e_{k−1,k}` at `(0,1)`). Each sub-patch covers a quarter-like sector of the `n`-gon.
 //!
@@ -30,8 +30,8 @@
 //!
 //! # Boundaries, creases, corners
 //! Boundary edges and infinitely sharp creases (sharpness ≥ [`subfit_mesh::SHARPNESS_INFINITE`])
-//! follow [`crate::refine`]'s rules exactly (`EdgeOnly` and `EdgeAndCorner`); regular patches
-//! along them use phantom points ([`crate::local`]), so they are exact as well. Semi-sharp tags
+//! follow [`mod@crate::refine`]'s rules exactly (`EdgeOnly` and `EdgeAndCorner`); regular patches
+//! along them use phantom points (module `local`), so they are exact as well. Semi-sharp tags
 //! are treated as smooth, as in the rest of the crate.
 
 use crate::error::SubdivError;

@@ -7,7 +7,7 @@
 //!   Halstead et al. 1993; OpenSubdiv 3.5 tangent masks).
 //! * [`stencil`] — [`StencilMatrix`], CSR rows of weights over control points.
 //! * [`topology`] — the edge and vertex-ring adjacency the rules need.
-//! * [`refine`] — one level of uniform refinement as a matrix, with a documented child order.
+//! * [`mod@refine`] — one level of uniform refinement as a matrix, with a documented child order.
 //! * `child` (internal) — the adjacency of a refined mesh read off its parent's.
 //! * `regular` (internal) — tabulated limit rows of regular Catmull-Clark neighbourhoods.
 //! * [`limit`] — limit position and tangent stencils at every vertex.

@@ -1,7 +1,7 @@
 //! The sampling operator `C = L_l · M_l ⋯ M_1` (Lavoué et al., §5.1; DESIGN §3.1): limit
 //! positions and limit tangents of all level-`l` vertices as sparse rows over the control points.
 //!
-//! `M_k` are the refinement matrices of [`crate::refine`], `L_l` the limit stencils of
+//! `M_k` are the refinement matrices of [`mod@crate::refine`], `L_l` the limit stencils of
 //! [`crate::limit`] at level `l`. Products are accumulated right to left
 //! (`P_k = M_k · P_{k−1}`), so every intermediate row is over the control points and stays
 //! short (its support is the control-mesh neighbourhood of the vertex). The last two factors

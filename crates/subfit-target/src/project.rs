@@ -15,8 +15,8 @@
 //! N, i.e., N·(S_k⁰ − V_k⁰) > 0, then d > 0; otherwise, d ≤ 0. Similarly, if the curvature center
 //! in the normal section along the tangent vector T_i is on the side of Γ_T pointed to by N, then
 //! ρ_i > 0; otherwise, ρ_i ≤ 0." and "α_1 = d/(d − ρ_1) and α_2 = d/(d − ρ_2) … Denote
-//! [α]₊ = max{α, 0}." So for a sphere of radius r with outward normals: ρ = −r, a point outside
-//! has d > 0 and α = d/(d + r) ∈ (0, 1); a point inside has d < 0 and [α]₊ = 0.
+//! `[α]₊ = max{α, 0}`." So for a sphere of radius r with outward normals: ρ = −r, a point outside
+//! has d > 0 and α = d/(d + r) ∈ (0, 1); a point inside has d < 0 and `[α]₊ = 0`.
 
 use rayon::prelude::*;
 
