@@ -89,7 +89,7 @@ fn report(name: &str, t: &Target) {
     let s = t.stats();
     let tm = &s.timings;
     println!(
-        "{name}: {} points: total {:.3} s (validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh {:.3}); merged {}, flipped {} (winding check {}), ambiguous {}, components {}",
+        "{name}: {} points: total {:.3} s (validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh {:.3}); merged {}, flipped {} (winding check {}; field: suspicious {}, iterations {}, flips {}, redirected {}), ambiguous {}, components {}",
         t.len(),
         tm.total.as_secs_f64(),
         tm.validate.as_secs_f64(),
@@ -102,6 +102,10 @@ fn report(name: &str, t: &Target) {
         s.merged_duplicates,
         s.flipped_normals,
         s.winding_flips,
+        s.field_suspicious,
+        s.field_iterations,
+        s.field_flips,
+        s.field_redirected,
         s.ambiguous_normals,
         s.orientation_components,
     );

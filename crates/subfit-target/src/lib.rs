@@ -39,6 +39,7 @@ mod options;
 pub mod orient;
 pub mod project;
 pub mod quadric;
+mod regularize;
 mod target;
 mod vec3;
 mod winding;

@@ -157,6 +157,17 @@ pub struct TargetStats {
     /// points next to them are blended over the neighbouring quadrics (see
     /// [`crate::Target::foot_point`]).
     pub untrusted_quadrics: usize,
+    /// Points failing the winding-field check of the orientation (field `w` outside `[0, 1]`
+    /// or normal more than 60° from `−∇w`; see the `regularize` step of [`crate::orient`]).
+    /// 0: the field refinement was skipped.
+    pub field_suspicious: usize,
+    /// Iterations of the field refinement (0 when skipped).
+    pub field_iterations: usize,
+    /// Sign changes made by the field refinement (included in the net `flipped_normals`).
+    pub field_flips: usize,
+    /// Normals whose direction the field refinement replaced (more than 30° from the local
+    /// estimate); their quadrics are refitted in the new frame.
+    pub field_redirected: usize,
     /// Connected components of the orientation graph (0 when no orientation was needed).
     pub orientation_components: usize,
     /// Smallest, mean and largest neighbourhood size (points, the point itself included).

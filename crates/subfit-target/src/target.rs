@@ -10,14 +10,15 @@ use subfit_mesh::PolyMesh;
 use crate::closest::TriangleBvh;
 use crate::error::TargetError;
 use crate::estimate::{
-    estimate_all, graph_stride, EstimateParams, Neighborhood, PointEstimate, DESCENT_K,
+    estimate_all, estimate_point, graph_stride, EstimateParams, Neighborhood, PointEstimate,
+    Scratch, DESCENT_K,
 };
 use crate::neighbors::{morton_order, NeighborGraph, PointIndex};
 use crate::normalize::Normalization;
 use crate::options::{
     NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
 };
-use crate::orient::{orient_normals, KnnGraph, OrientInput};
+use crate::orient::{orient_normals, KnnGraph, OrientInput, FIELD_MAX_NEIGHBORS};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
 use crate::vec3::{add, cross, dot, normalize, scale, sub};
 
@@ -220,6 +221,10 @@ impl Target {
             let orient_graph = prefix_rows(&graph, stride, k);
             let ambiguous: Vec<bool> = estimates.iter().map(|e| e.ambiguous).collect();
             let area: Vec<f64> = estimates.iter().map(|e| e.radius * e.radius).collect();
+            let trusted: Vec<bool> = estimates
+                .iter()
+                .map(|e| e.size as usize > FIELD_MAX_NEIGHBORS)
+                .collect();
             let o = orient_normals(
                 &points,
                 &mut normals,
@@ -232,6 +237,7 @@ impl Target {
                     fixed: &fixed,
                     area: &area,
                     tangent_penalty: options.orientation_tangent_penalty,
+                    trusted: &trusted,
                 },
             );
             for (q, &f) in quadrics.iter_mut().zip(&o.flipped) {
@@ -239,9 +245,23 @@ impl Target {
                     *q = q.flipped();
                 }
             }
+            if !o.redirected.is_empty() {
+                refit_redirected(
+                    &points,
+                    &index,
+                    &normals,
+                    &o.redirected,
+                    &params,
+                    &mut quadrics,
+                );
+            }
             stats.flipped_normals = o.flipped.iter().filter(|&&f| f).count();
             stats.orientation_components = o.components;
             stats.winding_flips = o.winding_flips;
+            stats.field_suspicious = o.field_suspicious;
+            stats.field_iterations = o.field_iterations;
+            stats.field_flips = o.field_flips;
+            stats.field_redirected = o.redirected.iter().filter(|&&r| r).count();
         }
         let radius: Vec<f64> = estimates.iter().map(|e| e.radius).collect();
         let layout = QueryLayout::new(
@@ -482,6 +502,30 @@ impl QueryLayout {
             descent,
         }
     }
+}
+
+/// Refits the quadric of every redirected point in the frame of its new normal (`normals`,
+/// `redirected`: `#P`). Parallel, O(R·k) for `R` redirected points.
+fn refit_redirected(
+    points: &[[f64; 3]],
+    index: &PointIndex,
+    normals: &[[f64; 3]],
+    redirected: &[bool],
+    params: &EstimateParams,
+    quadrics: &mut [LocalQuadric],
+) {
+    let stride = graph_stride(params);
+    quadrics
+        .par_iter_mut()
+        .enumerate()
+        .filter(|(i, _)| redirected[*i])
+        .for_each_init(
+            || (Scratch::default(), vec![u32::MAX; stride]),
+            |(scratch, row), (i, q)| {
+                let e = estimate_point(points, index, i, Some(normals[i]), params, row, scratch);
+                *q = e.quadric;
+            },
+        );
 }
 
 /// The first `k` entries of each row of a graph with rows of `stride` entries (`k ≤ stride`);

@@ -41,6 +41,10 @@ struct Node {
     hi: u32,
     /// Index of the first child (the second is `child + 1`), `u32::MAX` for a leaf.
     child: u32,
+    /// Total charge `Σ c_j` (for [`DipoleTree::coulomb`]).
+    charge: f64,
+    /// Charge dipole `Σ c_j (p_j − center)`.
+    charge_dipole: [f64; 3],
 }
 
 /// Barnes–Hut tree of dipoles `a_j n_j` at points `p_j` (indices into the arrays it was built
@@ -62,6 +66,8 @@ impl DipoleTree {
             lo: 0,
             hi: 0,
             child: u32::MAX,
+            charge: 0.0,
+            charge_dipole: [0.0; 3],
         });
         build(points, area, 0, 0, points.len(), &mut nodes);
         let mut tree = Self { nodes };
@@ -124,6 +130,146 @@ impl DipoleTree {
         }
         g
     }
+
+    /// Recomputes the charges `c` (`#P`, any sign) of [`Self::coulomb`]. O(P).
+    pub(crate) fn refresh_charges(&mut self, points: &[[f64; 3]], charges: &[f64]) {
+        for k in (0..self.nodes.len()).rev() {
+            let nd = self.nodes[k];
+            let (q, d) = if nd.child == u32::MAX {
+                (nd.lo as usize..nd.hi as usize).fold((0.0, [0.0; 3]), |(q, d), j| {
+                    (
+                        q + charges[j],
+                        add(d, scale(sub(points[j], nd.center), charges[j])),
+                    )
+                })
+            } else {
+                // Shift the children's dipoles to this node's centre.
+                let mut q = 0.0;
+                let mut d = [0.0; 3];
+                for c in [nd.child as usize, nd.child as usize + 1] {
+                    let ch = &self.nodes[c];
+                    q += ch.charge;
+                    d = add(
+                        d,
+                        add(
+                            ch.charge_dipole,
+                            scale(sub(ch.center, nd.center), ch.charge),
+                        ),
+                    );
+                }
+                (q, d)
+            };
+            self.nodes[k].charge = q;
+            self.nodes[k].charge_dipole = d;
+        }
+    }
+
+    /// `4π w(q)` and `4π ∇w(q)` of all the dipoles, with the kernel regularized near the
+    /// samples: a point `j` closer than the opening distance contributes with `|p_j − q|²`
+    /// replaced by `|p_j − q|² + (σ_q² + σ_j²)/2` (`sigma`: `#P`, ≥ 0; `sigma_q` that of the
+    /// evaluation point). Far nodes act as plain dipoles. Point `skip` (an index, or
+    /// `usize::MAX`) is left out. O(log P) per call for well-spread samples.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn field(
+        &self,
+        points: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        area: &[f64],
+        sigma: &[f64],
+        q: [f64; 3],
+        sigma_q: f64,
+        skip: usize,
+    ) -> (f64, [f64; 3]) {
+        let (mut w, mut g) = (0.0, [0.0; 3]);
+        let s2q = 0.5 * sigma_q * sigma_q;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let nd = &self.nodes[stack[top] as usize];
+            let d = sub(nd.center, q);
+            let d2 = dot(d, d);
+            if d2 > nd.open2 && d2 > nd.radius * nd.radius {
+                let inv = 1.0 / d2.sqrt();
+                w += dot(d, nd.moment) * inv * inv * inv;
+                g = add(g, dipole_gradient(d, nd.moment));
+            } else if nd.child == u32::MAX || top + 2 > stack.len() {
+                for j in nd.lo as usize..nd.hi as usize {
+                    if j == skip {
+                        continue;
+                    }
+                    let r = sub(points[j], q);
+                    let m = scale(normals[j], area[j]);
+                    let e2 = dot(r, r) + s2q + 0.5 * sigma[j] * sigma[j];
+                    if !(e2 > 0.0) {
+                        continue;
+                    }
+                    let inv = 1.0 / e2.sqrt();
+                    let inv3 = inv * inv * inv;
+                    let rm = dot(r, m);
+                    w += rm * inv3;
+                    g = add(
+                        g,
+                        add(scale(m, -inv3), scale(r, 3.0 * rm * inv3 * inv * inv)),
+                    );
+                }
+            } else {
+                stack[top] = nd.child;
+                stack[top + 1] = nd.child + 1;
+                top += 2;
+            }
+        }
+        (w, g)
+    }
+
+    /// `4π E(q)`, the field `Σ_j c_j (q − p_j)/|q − p_j|³` of the charges of the last
+    /// [`Self::refresh_charges`], regularized near the samples as in [`Self::field`]; far nodes
+    /// act as a charge plus a dipole at their centre. O(log P) per call.
+    pub(crate) fn coulomb(
+        &self,
+        points: &[[f64; 3]],
+        charges: &[f64],
+        sigma: &[f64],
+        q: [f64; 3],
+        sigma_q: f64,
+    ) -> [f64; 3] {
+        let mut e = [0.0; 3];
+        let s2q = 0.5 * sigma_q * sigma_q;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let nd = &self.nodes[stack[top] as usize];
+            let d = sub(nd.center, q);
+            let d2 = dot(d, d);
+            if d2 > nd.open2 && d2 > nd.radius * nd.radius {
+                let inv = 1.0 / d2.sqrt();
+                // Charge at the centre, field (q − c) Q/|q − c|³; the dipole D gives
+                // ∇ of −D·(c − q)/|c − q|³ negated, i.e. `dipole_gradient(c − q, D)`.
+                e = add(e, scale(d, -nd.charge * inv * inv * inv));
+                e = add(e, dipole_gradient(d, nd.charge_dipole));
+            } else if nd.child == u32::MAX || top + 2 > stack.len() {
+                for j in nd.lo as usize..nd.hi as usize {
+                    let c = charges[j];
+                    if c == 0.0 {
+                        continue;
+                    }
+                    let r = sub(q, points[j]);
+                    let e2 = dot(r, r) + s2q + 0.5 * sigma[j] * sigma[j];
+                    if !(e2 > 0.0) {
+                        continue;
+                    }
+                    let inv = 1.0 / e2.sqrt();
+                    e = add(e, scale(r, c * inv * inv * inv));
+                }
+            } else {
+                stack[top] = nd.child;
+                stack[top + 1] = nd.child + 1;
+                top += 2;
+            }
+        }
+        e
+    }
 }
 
 /// `4π ∇_q` of the dipole field `(p − q)·m / |p − q|³`, with `r = p − q`; 0 at `r = 0`.
@@ -167,6 +313,8 @@ fn build(points: &[[f64; 3]], area: &[f64], k: usize, lo: usize, hi: usize, node
         lo: lo as u32,
         hi: hi as u32,
         child: u32::MAX,
+        charge: 0.0,
+        charge_dipole: [0.0; 3],
     };
     if hi - lo > LEAF {
         let mid = lo + (hi - lo) / 2;
@@ -203,9 +351,14 @@ const FIRST_PASS_POINTS: usize = 32_768;
 
 /// Flips normals that point into the winding-number field of the rest of the shape (see the
 /// module doc), in Jacobi passes: the first over all eligible points, later ones over the
-/// points flipped in the previous pass and their neighbours. Returns the number of flips (a
-/// point flipped twice counts twice).
-pub(crate) fn refine(normals: &mut [[f64; 3]], inp: &WindingInput<'_>) -> usize {
+/// points flipped in the previous pass and their neighbours. `tree` is built over `inp.points`
+/// and `inp.area` with moments from `normals`, and is left refreshed with the result. Returns
+/// the number of flips (a point flipped twice counts twice).
+pub(crate) fn refine(
+    normals: &mut [[f64; 3]],
+    inp: &WindingInput<'_>,
+    tree: &mut DipoleTree,
+) -> usize {
     let n = inp.points.len();
     let k = inp.stride;
     // First pass on a subsample (every `step`-th point in Morton order: spread over the shape),
@@ -218,13 +371,12 @@ pub(crate) fn refine(normals: &mut [[f64; 3]], inp: &WindingInput<'_>) -> usize 
     if active.is_empty() {
         return 0;
     }
-    let mut tree = DipoleTree::new(inp.points, normals, inp.area);
     let mut total = 0;
     let mut mark = vec![false; n];
     for _ in 0..PASSES {
         let flips: Vec<u32> = {
             let normals = &*normals;
-            let tree = &tree;
+            let tree = &*tree;
             active
                 .par_iter()
                 .copied()
@@ -382,7 +534,8 @@ mod tests {
             eligible: &eligible,
         };
         let mut normals = truth.clone();
-        assert_eq!(refine(&mut normals, &inp), 0);
+        let mut tree = DipoleTree::new(&pts, &normals, &area);
+        assert_eq!(refine(&mut normals, &inp, &mut tree), 0);
         assert_eq!(normals, truth);
         // Flip a cap (about 10 % of the points): all of it comes back.
         let cap = |p: &[f64; 3]| p[2] > 0.5 + 0.4 * 0.8;
@@ -393,7 +546,8 @@ mod tests {
         }
         let flipped = pts.iter().filter(|p| cap(p)).count();
         assert!(flipped > n / 20);
-        assert!(refine(&mut normals, &inp) >= flipped);
+        tree.refresh(&normals, &area);
+        assert!(refine(&mut normals, &inp, &mut tree) >= flipped);
         assert_eq!(normals, truth);
     }
 }

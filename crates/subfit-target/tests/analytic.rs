@@ -49,11 +49,14 @@ fn check_estimates(
     let curv_ok = fraction(&errs, |&e| e <= tol);
     let st = t.stats();
     println!(
-        "{name}: {} pts, max normal angle {max_angle:.4}°, curvature within {:.0}% at {:.2}% of points, flipped {}, ambiguous {}, components {}, k {:?}, times {:?}",
+        "{name}: {} pts, max normal angle {max_angle:.4}°, curvature within {:.0}% at {:.2}% of points, flipped {} (field: suspicious {}, flips {}, redirected {}), ambiguous {}, components {}, k {:?}, times {:?}",
         pts.len(),
         tol * 100.0,
         curv_ok * 100.0,
         st.flipped_normals,
+        st.field_suspicious,
+        st.field_flips,
+        st.field_redirected,
         st.ambiguous_normals,
         st.orientation_components,
         st.neighborhood_size,
