@@ -440,13 +440,17 @@ fn squared_errors(target: &Target, source: FootPointSource, samples: &[[f64; 3]]
         .collect()
 }
 
-/// How far above the tolerance a face is (`> 1`: too large).
+/// How far above the tolerance a face is (`> 1`: too large), counting only the tolerances the
+/// whole surface does not meet yet: once `E_rms` is within its tolerance, a face whose own RMS
+/// is above it needs no refinement for it (the budget goes where `E_max` is still missed).
 fn face_score(e: &FaceError, stages: &StageOptions, last: &ErrorStats) -> f64 {
+    let rms_unmet = stages.tolerance_rms > 0.0 && last.e_rms > stages.tolerance_rms;
+    let max_unmet = stages.tolerance_max > 0.0 && last.e_max > stages.tolerance_max;
     let mut s: f64 = 0.0;
-    if stages.tolerance_rms > 0.0 {
+    if rms_unmet {
         s = s.max(e.rms() / stages.tolerance_rms);
     }
-    if stages.tolerance_max > 0.0 {
+    if max_unmet {
         s = s.max(e.max / stages.tolerance_max);
     }
     if stages.tolerance_rms <= 0.0 && stages.tolerance_max <= 0.0 {
