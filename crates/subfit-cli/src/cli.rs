@@ -184,7 +184,7 @@ pub struct FitArgs {
     #[arg(long)]
     pub no_flips: bool,
     /// Split a face of the initial cage at most this many times (levels of local refinement).
-    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=12))]
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=12))]
     pub max_depth: u8,
     /// After a refinement, optimize only the new control points and the faces around them
     /// (`--local-rings` rings), holding the rest fixed: faster stages on large cages.

@@ -90,7 +90,7 @@ impl Default for StageOptions {
             refine: true,
             growth: 0.6,
             edge_flips: true,
-            max_depth: 3,
+            max_depth: 4,
             local: false,
             local_rings: 2,
         }
