@@ -52,8 +52,8 @@ fn cage_topology(dir: &Path) -> serde_json::Value {
 /// E_max ≤ 0.0036 (unit cube, the fitter's own foot points) with ≤ 2,385 control points. Then an
 /// independent check against the exact distance from the limit surface to Igea's triangles,
 /// which the fit never saw: RMS within the same 0.0005; the maximum is bounded by scanner debris
-/// at the base rim and a crevice under the chin that the triangles bridge (measured 0.0036;
-/// bounded here by 0.005).
+/// at the base rim and a crevice under the chin that the triangles bridge (measured 0.0036 to
+/// 0.0043 over stage lengths and depths; bounded here by 0.005).
 #[test]
 fn igea_as_a_point_cloud_reaches_table_iv_within_its_control_point_budget() {
     let Some(data) = data_dir() else { return };
