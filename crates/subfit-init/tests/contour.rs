@@ -155,6 +155,14 @@ fn inward_normals_are_detected_and_flipped() {
         "{worst} vs cell {}",
         rep.cell_size
     );
+    // Also when the band is two octree levels above the finest cells.
+    let fine = ContourOptions {
+        resolution: Some(4 * rep.resolution),
+        ..ContourOptions::default()
+    };
+    let (m, rep) = contour(&t, &fine).unwrap();
+    assert!(rep.flipped && rep.band_level == 2, "{rep:?}");
+    assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
 }
 
 #[test]
