@@ -4,11 +4,12 @@
 //! module).
 //!
 //! Cheng et al. 2004 §4.3 contour an octree by marching cubes and Cheng et al. 2007 §II-C by the
-//! dual marching cubes of Schaefer & Warren 2004. Both can leave cracks or non-manifold edges
-//! where cells of different sizes meet, or on ambiguous cubes; this module contours a
-//! tetrahedralization that is conforming across level transitions instead (face triangles
-//! shared by both sides, hanging nodes included; see the octree module), so the
-//! piecewise-linear zero set is always a closed 2-manifold. Leaves without hanging nodes, which
+//! dual marching cubes of Schaefer & Warren 2004. Marching cubes on the leaves leaves cracks
+//! where cells of different sizes meet, and the cube cases of both are ambiguous, so the
+//! result can be non-manifold; this module contours a tetrahedralization of the leaves that is
+//! conforming across level transitions instead (face triangles shared by both sides, hanging
+//! nodes included; see the octree module), so the piecewise-linear zero set is always a closed
+//! 2-manifold with no cracks. Leaves without hanging nodes, which
 //! are all the leaves near the surface in practice, use the Kuhn triangulation of the cube,
 //! so on a uniform region the result is exactly the uniform-grid marching tetrahedra.
 //!
