@@ -1,6 +1,7 @@
 //! Timings of the initial-mesh steps on real data (needs `SUBFIT_DATA`): QEM simplification of
 //! Igea (134k vertices, 269k faces) to 2,385 vertices (Cheng 2007 Tab. IV), the same through a
-//! point cloud (contour + simplification), and the rocker arm / fertility meshes.
+//! point cloud (contour + simplification), and the rocker arm / fertility meshes; then the octree
+//! contour of a torus cloud at 512 finest cells (far beyond the 160 of the former uniform grid).
 //! Run with `cargo bench -p subfit-init --bench init`.
 #![allow(clippy::print_stdout)]
 
@@ -67,10 +68,13 @@ fn main() {
     let t = Instant::now();
     let (c, crep) = contour(&target, &ContourOptions::default()).expect("contour");
     println!(
-        "contour igea: grid {:?} cell {:.4}, {} band nodes, {} V / {} F, {} components kept of {}, \
-         genus {} in {:.3} s",
+        "contour igea: finest {:?} cell {:.4}, octree {} points (a uniform grid: {}), leaves per \
+         level {:?}, {} band nodes, {} V / {} F, {} components kept of {}, genus {} in {:.3} s",
         crep.nodes,
         crep.cell_size,
+        crep.octree_nodes,
+        crep.nodes.iter().product::<usize>(),
+        crep.leaves_per_level,
         crep.band_nodes,
         c.num_vertices(),
         c.num_faces(),
@@ -102,5 +106,39 @@ fn main() {
         rep.simplify.rejected_flip,
         rep.simplify.rejected_degenerate,
         rep.simplify.relaxations
+    );
+
+    torus_at_512();
+}
+
+/// The octree contour of an 8000-point torus cloud at 512 finest cells: time, size of the
+/// octree against the 512³ of a uniform grid, leaves per level.
+fn torus_at_512() {
+    let shape = subfit_mesh::shapes::Shape::DEFAULT_TORUS;
+    let cloud = shape.sample(8000, 0.0, 7);
+    let target = Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .expect("a valid point cloud");
+    let opts = ContourOptions {
+        resolution: Some(512),
+        ..ContourOptions::default()
+    };
+    let t = Instant::now();
+    let (c, crep) = contour(&target, &opts).expect("contour");
+    println!(
+        "contour torus (8000 points) at 512: octree {} points ({:.2} % of 512³), band level {}, \
+         leaves per level {:?}, cut {:?}, {} V / {} F, genus {} in {:.3} s",
+        crep.octree_nodes,
+        100.0 * crep.octree_nodes as f64 / 512f64.powi(3),
+        crep.band_level,
+        crep.leaves_per_level,
+        crep.cut_leaves_per_level,
+        c.num_vertices(),
+        c.num_faces(),
+        crep.genus,
+        t.elapsed().as_secs_f64()
     );
 }

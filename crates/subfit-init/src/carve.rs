@@ -19,7 +19,8 @@
 use subfit_mesh::{HalfEdgeMesh, PolyMesh};
 use subfit_target::Target;
 
-use crate::contour::{bounds, keep_components, march, ContourError, ContourReport, Grid};
+use crate::contour::{bounds, keep_components, ContourError, ContourReport};
+use crate::march::{march_grid, Grid};
 
 /// Carves the space around the target's points with a ball of radius `radius` (normalized
 /// units) on a grid of `resolution` cells along the longest side, and returns the wrap (see
@@ -94,7 +95,7 @@ pub fn carve(
         })
         .collect();
 
-    let (positions, tris) = march(&grid, &value);
+    let (positions, tris) = march_grid(&grid, &value);
     if tris.is_empty() {
         return Err(ContourError::Empty(resolution));
     }
@@ -114,6 +115,7 @@ pub fn carve(
         vertices: mesh.num_vertices(),
         faces: mesh.num_faces(),
         genus: he.genus(),
+        ..ContourReport::default()
     };
     Ok((mesh, report))
 }

@@ -1,48 +1,80 @@
 //! A closed, manifold surface from an oriented point cloud: the IMLS function of Xie et al. 2023
-//! (eq. 2–3, [`subfit_target::Target::imls`]) sampled on a uniform grid and contoured by marching
-//! tetrahedra (Cheng et al. 2004 §4.3 use marching cubes, Lorensen & Cline 1987; each cube is
-//! split here into the 6 tetrahedra of the Kuhn triangulation around its main diagonal, which is
-//! consistent between neighbouring cubes and has no ambiguous cases, so the piecewise-linear
-//! zero set is always a closed 2-manifold).
+//! (eq. 2–3, [`subfit_target::Target::imls`]) sampled on an adaptive octree and contoured by
+//! marching tetrahedra on a conforming tetrahedralization of its leaves (the crate's `octree`
+//! module).
 //!
-//! **Sign far from the data.** The IMLS value is used only at grid nodes within a band of
-//! [`ContourOptions::band_cells`] cells (Chebyshev distance) of a data point. Every other node
-//! is classified by a flood fill over the non-band nodes from the grid boundary (which is padded
-//! beyond the data): reached nodes are outside, unreached ones (enclosed by the band) inside.
-//! So the surface cannot grow sheets away from the data, and a scan with holes larger than the
+//! Cheng et al. 2004 §4.3 contour an octree by marching cubes and Cheng et al. 2007 §II-C by the
+//! dual marching cubes of Schaefer & Warren 2004. Marching cubes on the leaves leaves cracks
+//! where cells of different sizes meet, and the cube cases of both are ambiguous, so the
+//! result can be non-manifold; this module contours a tetrahedralization of the leaves that is
+//! conforming across level transitions instead (face triangles shared by both sides, hanging
+//! nodes included; see the octree module), so the piecewise-linear zero set is always a closed
+//! 2-manifold with no cracks. Leaves without hanging nodes, which
+//! are all the leaves near the surface in practice, use the Kuhn triangulation of the cube,
+//! so on a uniform region the result is exactly the uniform-grid marching tetrahedra.
+//!
+//! **Octree.** The finest level has [`ContourOptions::resolution`] cells along the longest side
+//! of the data. The *band* is built on the **band level**, the coarsest level whose cells are no
+//! larger than the automatic cell (`h / cells_per_radius`, `h` the IMLS radius): the band cells
+//! are those within [`ContourOptions::band_cells`] cells (Chebyshev distance, on that level) of a
+//! data point; those and the cells touching them are refined to the band level at least. With
+//! the automatic resolution the band level is the finest level, and the octree is exactly the
+//! uniform grid's band plus coarse cells elsewhere. With a finer `resolution`, band cells are
+//! split further, level by level, only where the IMLS values at their corners change sign or
+//! come within [`ContourOptions::refine_margin`] cell edges of zero, so the finest cells hug
+//! the zero set. The tree is then 2:1 balanced. Memory and time grow with the area of the
+//! surface over the square of the cell, not with the cube of the resolution.
+//!
+//! **Sign far from the data.** The IMLS value is used only at points in the closed band cells
+//! (corners, hanging nodes, leaf centres). Every other point is classified by a flood fill from
+//! the octree's boundary over the points off the band, along leaf edges (split at hanging
+//! nodes; on the band level this is the 6-neighbourhood of a uniform grid): reached points are
+//! outside (`+2·band·cell`), unreached ones, enclosed by the band, inside (`−2·band·cell`). So
+//! the surface cannot grow sheets away from the data, and a scan with holes larger than the
 //! band leaks (its inside is taken as outside; the surface then hugs the band's inner side).
 //!
-//! If most band nodes next to the outside region are negative, the normals point inward and the
-//! IMLS values are negated ([`ContourReport::flipped`]).
+//! If most band points on an edge to the outside region are negative, the normals point inward
+//! and the IMLS values are negated ([`ContourReport::flipped`]).
 //!
-//! Then small components are removed ([`ContourOptions::min_component_fraction`]). Vertices on
-//! shared grid edges are welded by edge keys. Cost: `O(N³)` flags for an `N`-cell grid plus one
-//! IMLS evaluation per band node (parallel in `subfit-target`).
-
-use std::collections::HashMap;
+//! Then small components are removed ([`ContourOptions::min_component_fraction`]). Cost:
+//! `O(n log n)` for the `n` octree points (about the band's cells on the band level plus, with
+//! a finer resolution, a few layers of finest cells around the zero set) plus one IMLS
+//! evaluation per band point (parallel in `subfit-target`).
 
 use subfit_mesh::{face_components, HalfEdgeMesh, PolyMesh, Polygons};
 use subfit_target::Target;
 
-use crate::simplify::{cross, dot, sub};
+use crate::march::Marcher;
+use crate::octree::{
+    dilate3, face_centre, face_needs_steiner, leaf_tets, pack, unpack, KeyMap, Leaf, Octree,
+    CENTRE, CORNERS, CORNER_MASK, HANGING, KUHN,
+};
+
+/// Largest accepted [`ContourOptions::resolution`] and [`ContourOptions::max_resolution`].
+pub const MAX_RESOLUTION: usize = 4096;
 
 /// Options of [`contour`]. Lengths in the target's normalized units (unit cube).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContourOptions {
-    /// Grid cells along the longest side of the data's bounding box. Default `None`: from the
-    /// target's IMLS radius `h` (itself from the point spacing), cell size
-    /// `h / cells_per_radius`, clamped to `16..=max_resolution`.
+    /// Cells of the octree's finest level along the longest side of the data's bounding box
+    /// (`2..=`[`MAX_RESOLUTION`]). Default `None`: from the target's IMLS radius `h` (itself from
+    /// the point spacing), cell size `h / cells_per_radius`, clamped to `16..=max_resolution`;
+    /// the finest level is then also the band level (see the module docs).
     pub resolution: Option<usize>,
-    /// Grid cells per IMLS radius `h` when `resolution` is `None`. Default 1.25 (cell `0.8 h`):
-    /// the IMLS function has no detail finer than `h`, and on the real models a finer grid
-    /// (2.5 cells per `h`) was 4× larger and slower to contour and simplify, and created a
-    /// spurious handle on the armadillo. Valid: finite, `> 0`.
+    /// Cells per IMLS radius `h` of the automatic resolution, which is also the finest band
+    /// level. Default 1.25 (cell `0.8 h`): the IMLS function has no detail finer than `h`, and
+    /// on the real models a finer grid (2.5 cells per `h`) was 4× larger and slower to contour
+    /// and simplify, and created a spurious handle on the armadillo. Valid: finite, `> 0`.
     pub cells_per_radius: f64,
-    /// Upper bound of the automatic resolution. Default 160 (about 4·10⁶ nodes at most).
+    /// Upper bound of the automatic resolution (`2..=`[`MAX_RESOLUTION`]). Default 1024.
     pub max_resolution: usize,
-    /// Half-width of the band of nodes where the IMLS sign is trusted, in cells. Default `None`:
-    /// `max(2, ⌈h / cell⌉)`.
+    /// Half-width of the band where the IMLS sign is trusted, in cells of the band level.
+    /// Default `None`: `max(2, ⌈h / band cell⌉)`.
     pub band_cells: Option<usize>,
+    /// Below the band level, a band cell is split when its corner values change sign or the
+    /// smallest `|f|` at its corners is below this many of its edges. Default 0.5. Valid:
+    /// finite, `≥ 0`.
+    pub refine_margin: f64,
     /// Components with fewer faces than this fraction of the largest one are removed.
     /// Default 0.05 (valid `[0, 1]`; 1 keeps only the largest).
     pub min_component_fraction: f64,
@@ -53,8 +85,9 @@ impl Default for ContourOptions {
         Self {
             resolution: None,
             cells_per_radius: 1.25,
-            max_resolution: 160,
+            max_resolution: 1024,
             band_cells: None,
+            refine_margin: 0.5,
             min_component_fraction: 0.05,
         }
     }
@@ -63,19 +96,30 @@ impl Default for ContourOptions {
 /// What [`contour`] did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ContourReport {
-    /// Grid nodes along x, y, z.
+    /// Finest-level lattice nodes along x, y, z of the padded bounding box of the data (the
+    /// octree's root is the cube of `2^(leaves_per_level.len() − 1)` finest cells containing it).
     pub nodes: [usize; 3],
-    /// Grid cells along the longest side of the data's bounding box.
+    /// Cells of the finest level along the longest side of the data's bounding box.
     pub resolution: usize,
-    /// Cell size (normalized units).
+    /// Finest cell size (normalized units).
     pub cell_size: f64,
-    /// Band half-width in cells.
+    /// Band half-width in cells of the band level.
     pub band_cells: usize,
-    /// Nodes where the IMLS function was evaluated.
+    /// Level of the band (0 = finest; cells `2^band_level` finest cells wide).
+    pub band_level: usize,
+    /// Points where the IMLS function was evaluated.
     pub band_nodes: usize,
-    /// Nodes off the band classified inside by the flood fill.
+    /// Points off the band classified inside by the flood fill.
     pub enclosed_nodes: usize,
-    /// Whether the IMLS sign was flipped because most band nodes next to the outside were
+    /// All octree points: leaf corners (hanging nodes included), leaf centres and face Steiner
+    /// points of leaves next to finer ones.
+    pub octree_nodes: usize,
+    /// Leaves per level, finest first (`leaves_per_level[l]`: leaves `2^l` finest cells wide).
+    pub leaves_per_level: Vec<usize>,
+    /// Leaves crossed by the zero set per level, finest first (before small components are
+    /// removed).
+    pub cut_leaves_per_level: Vec<usize>,
+    /// Whether the IMLS sign was flipped because most band points next to the outside were
     /// negative (inward-pointing normals).
     pub flipped: bool,
     /// Components of the raw contour.
@@ -97,138 +141,78 @@ pub enum ContourError {
     #[error("invalid contour option: {0}")]
     InvalidOption(&'static str),
     /// The zero set is empty (e.g. all normals point inward, or the resolution is too coarse).
-    #[error("the implicit function has no zero crossing on the {0}³ grid")]
+    #[error("the implicit function has no zero crossing at resolution {0}")]
     Empty(usize),
     /// Internal error: the contour is not manifold (a bug).
     #[error("internal error: the contour is not manifold: {0}")]
     NotManifold(String),
 }
 
-/// Kuhn triangulation of the unit cube (corner `c = dx + 2dy + 4dz`) into 6 tetrahedra around
-/// the diagonal 0–7.
-const TETS: [[usize; 4]; 6] = [
-    [0, 1, 3, 7],
-    [0, 1, 5, 7],
-    [0, 2, 3, 7],
-    [0, 2, 6, 7],
-    [0, 4, 5, 7],
-    [0, 4, 6, 7],
-];
-
-/// Contours the target's IMLS function (see the module docs). Returns a closed, manifold,
-/// outward-oriented triangle mesh in normalized units (vertices within about a cell of the zero
-/// set) and a report.
+/// Contours the target's IMLS function on an adaptive octree (see the module docs). Returns a
+/// closed, manifold, outward-oriented triangle mesh in normalized units (vertices within about
+/// a finest cell of the zero set) and a report.
+///
+/// Errors: [`ContourError::InvalidOption`] for an option out of its documented range,
+/// [`ContourError::Empty`] when the function has no zero crossing, [`ContourError::NotManifold`]
+/// (a bug). Cost: see the module docs.
 pub fn contour(
     target: &Target,
     options: &ContourOptions,
 ) -> Result<(PolyMesh, ContourReport), ContourError> {
-    if !(0.0..=1.0).contains(&options.min_component_fraction) {
-        return Err(ContourError::InvalidOption(
-            "min_component_fraction must be in [0, 1]",
-        ));
-    }
-    if options.resolution == Some(0) || options.max_resolution < 2 {
-        return Err(ContourError::InvalidOption("resolution must be ≥ 2"));
-    }
-    if !(options.cells_per_radius.is_finite() && options.cells_per_radius > 0.0) {
-        return Err(ContourError::InvalidOption(
-            "cells_per_radius must be finite and > 0",
-        ));
-    }
-    let pts = target.points();
-    let (lo, hi) = bounds(pts);
-    let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-12);
-    let h = target.imls_radius();
-    let res = options.resolution.unwrap_or_else(|| {
-        ((ext * options.cells_per_radius / h).ceil() as usize).clamp(16, options.max_resolution)
-    });
-    let cell = ext / res as f64;
-    let band = options
-        .band_cells
-        .unwrap_or_else(|| ((h / cell).ceil() as usize).max(2));
-    let pad = band + 2;
-    let origin = [0, 1, 2].map(|k| lo[k] - pad as f64 * cell);
-    let dims = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / cell).ceil() as usize + 2 * pad + 1);
-    let grid = Grid { dims, origin, cell };
+    validate(options)?;
+    let frame = Frame::new(target, options)?;
+    let band = Band::new(target.points(), &frame);
+    let mut tree = Octree::new(frame.root_level);
+    let mut points = Points::default();
+    let mut values = Vec::new();
+    refine_band(
+        target,
+        &frame,
+        &band,
+        &mut tree,
+        &mut points,
+        &mut values,
+        options.refine_margin,
+    );
+    let parents = band.ring.iter().map(|&k| pack(unpack(k).map(|c| c >> 1)));
+    tree.split(frame.band_level + 1, parents);
+    tree.balance();
+    let leaves = tree.leaves();
+    let sampled = Sampled::new(&leaves, &mut points);
 
-    // 1. Band nodes: within `band` cells (Chebyshev) of a data point.
-    let n_nodes = dims[0] * dims[1] * dims[2];
-    let mut in_band = vec![false; n_nodes];
-    for p in pts {
-        let c = [0, 1, 2].map(|k| ((p[k] - origin[k]) / cell).round() as isize);
-        let b = band as isize;
-        for z in c[2] - b..=c[2] + b {
-            for y in c[1] - b..=c[1] + b {
-                let row = grid.id(c[0] - b, y, z);
-                in_band[row..=row + 2 * band].fill(true);
-            }
-        }
-    }
-    let band_ids: Vec<usize> = (0..n_nodes).filter(|&i| in_band[i]).collect();
-    let band_pos: Vec<[f64; 3]> = band_ids.iter().map(|&i| grid.pos(i)).collect();
-    let band_val = target.imls_batch(&band_pos);
-
-    // 2. Off-band nodes: flood fill from the grid boundary.
-    let far = 2.0 * band as f64 * cell;
-    let mut value = vec![f64::NAN; n_nodes];
-    for (&i, v) in band_ids.iter().zip(&band_val) {
-        value[i] = if v.value == 0.0 { 1e-300 } else { v.value };
-    }
-    let mut stack: Vec<usize> = (0..n_nodes)
-        .filter(|&i| !in_band[i] && grid.on_boundary(i))
+    let in_band = band_points(&leaves, &sampled, &points, &band);
+    values.resize(points.len(), f64::NAN);
+    let fresh: Vec<u32> = (0..points.len() as u32)
+        .filter(|&i| in_band[i as usize] && values[i as usize].is_nan())
         .collect();
-    for &i in &stack {
-        value[i] = far;
-    }
-    while let Some(i) = stack.pop() {
-        for j in grid.neighbors6(i) {
-            if value[j].is_nan() {
-                value[j] = far;
-                stack.push(j);
-            }
-        }
-    }
-    // Band nodes next to the outside should be positive; if most are negative the normals
-    // point inward: flip the sign of the IMLS values.
-    let (mut pos_rim, mut neg_rim) = (0usize, 0usize);
-    for &i in &band_ids {
-        if grid.neighbors6(i).any(|j| !in_band[j] && value[j] == far) {
-            if value[i] < 0.0 {
-                neg_rim += 1;
-            } else {
-                pos_rim += 1;
-            }
-        }
-    }
-    let flipped = neg_rim > pos_rim;
-    if flipped {
-        for &i in &band_ids {
-            value[i] = -value[i];
-        }
-    }
-    let mut enclosed = 0;
-    for v in value.iter_mut().filter(|v| v.is_nan()) {
-        *v = -far;
-        enclosed += 1;
-    }
+    evaluate(target, &frame, &points, &fresh, &mut values);
+    let (flipped, enclosed) = classify(&frame, &sampled, &points, &in_band, &mut values);
 
-    // 3. Marching tetrahedra.
-    let (positions, tris) = march(&grid, &value);
+    let pos = |i: usize| frame.position(points.keys[i]);
+    let (positions, tris, cut_leaves_per_level) =
+        march_octree(&leaves, &sampled, &points, &values, &pos, frame.root_level);
     if tris.is_empty() {
-        return Err(ContourError::Empty(res));
+        return Err(ContourError::Empty(frame.resolution));
     }
 
-    // 4. Keep the large components.
     let (mesh, found, kept) = keep_components(positions, &tris, options.min_component_fraction);
     let he =
         HalfEdgeMesh::from_mesh(&mesh).map_err(|e| ContourError::NotManifold(e.to_string()))?;
+    let mut leaves_per_level = vec![0; cut_leaves_per_level.len()];
+    for f in &leaves {
+        leaves_per_level[f.level as usize] += 1;
+    }
     let report = ContourReport {
-        nodes: dims,
-        resolution: res,
-        cell_size: cell,
-        band_cells: band,
-        band_nodes: band_ids.len(),
+        nodes: frame.dims,
+        resolution: frame.resolution,
+        cell_size: frame.cell,
+        band_cells: frame.band,
+        band_level: frame.band_level as usize,
+        band_nodes: in_band.iter().filter(|&&b| b).count(),
         enclosed_nodes: enclosed,
+        octree_nodes: points.len(),
+        leaves_per_level,
+        cut_leaves_per_level,
         flipped,
         components_found: found,
         components_kept: kept,
@@ -237,6 +221,31 @@ pub fn contour(
         genus: he.genus(),
     };
     Ok((mesh, report))
+}
+
+fn validate(options: &ContourOptions) -> Result<(), ContourError> {
+    if !(0.0..=1.0).contains(&options.min_component_fraction) {
+        return Err(ContourError::InvalidOption(
+            "min_component_fraction must be in [0, 1]",
+        ));
+    }
+    let ok = |r: usize| (2..=MAX_RESOLUTION).contains(&r);
+    if !options.resolution.is_none_or(ok) || !ok(options.max_resolution) {
+        return Err(ContourError::InvalidOption(
+            "resolution and max_resolution must be in 2..=4096",
+        ));
+    }
+    if !(options.cells_per_radius.is_finite() && options.cells_per_radius > 0.0) {
+        return Err(ContourError::InvalidOption(
+            "cells_per_radius must be finite and > 0",
+        ));
+    }
+    if !(options.refine_margin.is_finite() && options.refine_margin >= 0.0) {
+        return Err(ContourError::InvalidOption(
+            "refine_margin must be finite and ≥ 0",
+        ));
+    }
+    Ok(())
 }
 
 pub(crate) fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
@@ -251,117 +260,477 @@ pub(crate) fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
     (lo, hi)
 }
 
-pub(crate) struct Grid {
-    pub(crate) dims: [usize; 3],
-    pub(crate) origin: [f64; 3],
-    pub(crate) cell: f64,
+/// The lattice of one contour: finest cell, band level, padding, root.
+struct Frame {
+    /// Position of finest-lattice point 0.
+    origin: [f64; 3],
+    /// Finest cell size.
+    cell: f64,
+    /// Finest cells along the data's longest side.
+    resolution: usize,
+    band_level: u32,
+    /// Band half-width in band-level cells.
+    band: usize,
+    root_level: u32,
+    /// Finest nodes of the padded box along x, y, z.
+    dims: [usize; 3],
 }
 
-impl Grid {
-    pub(crate) fn id(&self, x: isize, y: isize, z: isize) -> usize {
-        x as usize + self.dims[0] * (y as usize + self.dims[1] * z as usize)
+impl Frame {
+    fn new(target: &Target, options: &ContourOptions) -> Result<Self, ContourError> {
+        let (lo, hi) = bounds(target.points());
+        let ext = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1e-12);
+        let h = target.imls_radius();
+        let auto = ((ext * options.cells_per_radius / h).ceil() as usize)
+            .clamp(16.min(options.max_resolution), options.max_resolution);
+        let resolution = options.resolution.unwrap_or(auto);
+        let mut band_level = 0;
+        while resolution >> (band_level + 1) >= auto {
+            band_level += 1;
+        }
+        let cell = ext / resolution as f64;
+        let band_cell = cell * f64::from(1u32 << band_level);
+        let band = options
+            .band_cells
+            .unwrap_or_else(|| ((h / band_cell).ceil() as usize).max(2));
+        let pad = (band + 2) << band_level;
+        let origin = [0, 1, 2].map(|k| lo[k] - pad as f64 * cell);
+        let dims = [0, 1, 2].map(|k| ((hi[k] - lo[k]) / cell).ceil() as usize + 2 * pad + 1);
+        let cells = dims.iter().max().map_or(1, |&d| d - 1);
+        let root_level = (band_level + 1).max(cells.next_power_of_two().trailing_zeros());
+        if root_level > 20 {
+            return Err(ContourError::InvalidOption(
+                "band_cells too large for the resolution",
+            ));
+        }
+        Ok(Self {
+            origin,
+            cell,
+            resolution,
+            band_level,
+            band,
+            root_level,
+            dims,
+        })
     }
-    pub(crate) fn coords(&self, i: usize) -> [usize; 3] {
-        let x = i % self.dims[0];
-        let y = (i / self.dims[0]) % self.dims[1];
-        [x, y, i / (self.dims[0] * self.dims[1])]
-    }
-    pub(crate) fn pos(&self, i: usize) -> [f64; 3] {
-        let c = self.coords(i);
+
+    /// Position of a packed finest-lattice point.
+    fn position(&self, key: u64) -> [f64; 3] {
+        let c = unpack(key);
         [0, 1, 2].map(|k| self.origin[k] + c[k] as f64 * self.cell)
     }
-    pub(crate) fn on_boundary(&self, i: usize) -> bool {
-        let c = self.coords(i);
-        (0..3).any(|k| c[k] == 0 || c[k] + 1 == self.dims[k])
+}
+
+/// The band on the band level (sorted packed band-level coordinates).
+struct Band {
+    level: u32,
+    /// Cells within `band` cells (Chebyshev) of a data point's nearest band-level node.
+    cells: Vec<u64>,
+    /// `cells` and the cells touching them (refined to the band level at least).
+    ring: Vec<u64>,
+}
+
+impl Band {
+    /// Cost `O(m log m)`, `m` the band cells (points are first reduced to distinct nodes).
+    fn new(points: &[[f64; 3]], frame: &Frame) -> Self {
+        let level = frame.band_level;
+        let band_cell = frame.cell * f64::from(1u32 << level);
+        let mut q: Vec<u64> = points
+            .iter()
+            .map(|p| pack([0, 1, 2].map(|k| ((p[k] - frame.origin[k]) / band_cell).round() as u64)))
+            .collect();
+        q.sort_unstable();
+        q.dedup();
+        let limit = 1u64 << (frame.root_level - level);
+        let b = frame.band as i64;
+        let cells = dilate3(&q, -b, b - 1, limit);
+        let ring = dilate3(&cells, -1, 1, limit);
+        Self { level, cells, ring }
     }
-    pub(crate) fn neighbors6(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
-        let c = self.coords(i);
-        let strides = [1, self.dims[0], self.dims[0] * self.dims[1]];
-        (0..3).flat_map(move |k| {
-            let down = (c[k] > 0).then(|| i - strides[k]);
-            let up = (c[k] + 1 < self.dims[k]).then(|| i + strides[k]);
-            down.into_iter().chain(up)
-        })
+
+    /// Whether `leaf` lies in a band cell. Cost `O(log m)`.
+    fn holds(&self, leaf: &Leaf) -> bool {
+        leaf.level <= self.level
+            && self
+                .cells
+                .binary_search(&pack(unpack(leaf.min).map(|c| c >> self.level)))
+                .is_ok()
     }
 }
 
-/// Marching tetrahedra over every cell with a sign change; vertices welded by grid-edge keys.
-/// Triangles are oriented so that their normals point to positive values (outside).
-pub(crate) fn march(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let [nx, ny, nz] = grid.dims;
-    let corner_off: [usize; 8] =
-        std::array::from_fn(|c| (c & 1) + nx * (((c >> 1) & 1) + ny * ((c >> 2) & 1)));
-    let mut positions = Vec::new();
-    let mut tris = Vec::new();
-    let mut edge_vertex: HashMap<(usize, usize), u32> = HashMap::new();
-    let mut vertex_on = |a: usize, b: usize, positions: &mut Vec<[f64; 3]>| -> u32 {
-        let key = (a.min(b), a.max(b));
-        *edge_vertex.entry(key).or_insert_with(|| {
-            let (va, vb) = (value[key.0], value[key.1]);
-            let t = (va / (va - vb)).clamp(0.02, 0.98);
-            let (pa, pb) = (grid.pos(key.0), grid.pos(key.1));
-            positions.push([0, 1, 2].map(|k| pa[k] + t * (pb[k] - pa[k])));
-            (positions.len() - 1) as u32
-        })
-    };
-    for z in 0..nz - 1 {
-        for y in 0..ny - 1 {
-            for x in 0..nx - 1 {
-                let base = x + nx * (y + ny * z);
-                let ids = corner_off.map(|o| base + o);
-                let neg = ids.map(|i| value[i] < 0.0);
-                if neg.iter().all(|&s| s) || neg.iter().all(|&s| !s) {
-                    continue;
+/// Which points lie in a closed band cell: the points (corners, hanging nodes, centres and
+/// Steiner points) of the leaves inside band cells, which tile those cells.
+fn band_points(leaves: &[Leaf], sampled: &Sampled, points: &Points, band: &Band) -> Vec<bool> {
+    let mut in_band = vec![false; points.len()];
+    for (f, leaf) in leaves.iter().enumerate() {
+        if !band.holds(leaf) {
+            continue;
+        }
+        if sampled.masks[f] == CORNER_MASK {
+            for &i in &sampled.corners[f] {
+                in_band[i as usize] = true;
+            }
+        } else {
+            for i in sampled.local_ids(f, leaf, points) {
+                if i != u32::MAX {
+                    in_band[i as usize] = true;
                 }
-                for tet in &TETS {
-                    let v = tet.map(|c| ids[c]);
-                    let inside: Vec<usize> =
-                        v.iter().copied().filter(|&i| value[i] < 0.0).collect();
-                    let outside: Vec<usize> =
-                        v.iter().copied().filter(|&i| value[i] >= 0.0).collect();
-                    let polygon: Vec<(usize, usize)> = match inside.len() {
-                        1 => outside.iter().map(|&o| (inside[0], o)).collect(),
-                        3 => inside.iter().map(|&i| (i, outside[0])).collect(),
-                        2 => {
-                            let ([a, b], [c, d]) =
-                                ([inside[0], inside[1]], [outside[0], outside[1]]);
-                            vec![(a, c), (a, d), (b, d), (b, c)]
-                        }
-                        _ => continue,
-                    };
-                    let centroid = |s: &[usize]| {
-                        let mut m = [0.0; 3];
-                        for &i in s {
-                            let p = grid.pos(i);
-                            for k in 0..3 {
-                                m[k] += p[k] / s.len() as f64;
-                            }
-                        }
-                        m
-                    };
-                    let dir = sub(centroid(&outside), centroid(&inside));
-                    let vs: Vec<u32> = polygon
-                        .iter()
-                        .map(|&(a, b)| vertex_on(a, b, &mut positions))
-                        .collect();
-                    let mut emit = |t: [u32; 3]| {
-                        let p = t.map(|i| positions[i as usize]);
-                        let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-                        tris.push(if dot(n, dir) >= 0.0 {
-                            t
+            }
+        }
+    }
+    in_band
+}
+
+/// Octree points (packed finest-lattice keys) numbered in insertion order.
+#[derive(Default)]
+struct Points {
+    index: KeyMap<u64, u32>,
+    keys: Vec<u64>,
+}
+
+impl Points {
+    fn insert(&mut self, key: u64) -> (u32, bool) {
+        let next = self.keys.len() as u32;
+        let id = *self.index.entry(key).or_insert(next);
+        if id == next {
+            self.keys.push(key);
+        }
+        (id, id == next)
+    }
+    fn get(&self, key: u64) -> Option<u32> {
+        self.index.get(&key).copied()
+    }
+    fn len(&self) -> usize {
+        self.keys.len()
+    }
+}
+
+/// IMLS values at the points `ids` into `values` (grown with NaN as needed); exact zeros are
+/// nudged to `1e-300` (outside).
+fn evaluate(target: &Target, frame: &Frame, points: &Points, ids: &[u32], values: &mut Vec<f64>) {
+    values.resize(points.len(), f64::NAN);
+    let xs: Vec<[f64; 3]> = ids
+        .iter()
+        .map(|&i| frame.position(points.keys[i as usize]))
+        .collect();
+    for (&i, v) in ids.iter().zip(target.imls_batch(&xs)) {
+        values[i as usize] = if v.value == 0.0 { 1e-300 } else { v.value };
+    }
+}
+
+/// Below the band level: splits band cells level by level where the zero set may pass
+/// (corner values of both signs, or some `|f|` below `margin` edges), evaluating the IMLS
+/// function at the corners of the cells it examines.
+fn refine_band(
+    target: &Target,
+    frame: &Frame,
+    band: &Band,
+    tree: &mut Octree,
+    points: &mut Points,
+    values: &mut Vec<f64>,
+    margin: f64,
+) {
+    let mut current = band.cells.clone();
+    for l in (1..=frame.band_level).rev() {
+        let mut fresh = Vec::new();
+        let ids: Vec<[u32; 8]> = current
+            .iter()
+            .map(|&cell| {
+                let leaf = Leaf {
+                    min: pack(unpack(cell).map(|c| c << l)),
+                    level: l,
+                };
+                CORNERS.map(|c| {
+                    let (id, new) = points.insert(leaf.point_at(c));
+                    if new {
+                        fresh.push(id);
+                    }
+                    id
+                })
+            })
+            .collect();
+        evaluate(target, frame, points, &fresh, values);
+        let edge = margin * frame.cell * f64::from(1u32 << l);
+        let split: Vec<u64> = current
+            .iter()
+            .zip(&ids)
+            .filter(|(_, ids)| {
+                let v = ids.map(|i| values[i as usize]);
+                let neg = v.iter().filter(|&&x| x < 0.0).count();
+                (neg > 0 && neg < 8) || v.iter().any(|x| x.abs() < edge)
+            })
+            .map(|(&c, _)| c)
+            .collect();
+        tree.split(l, split.iter().copied());
+        current = split
+            .iter()
+            .flat_map(|&p| {
+                let pc = unpack(p);
+                (0..8u64).map(move |c| pack([0, 1, 2].map(|k| 2 * pc[k] + (c >> k & 1))))
+            })
+            .collect();
+        current.sort_unstable();
+    }
+}
+
+/// The leaves' points: corner ids, which hanging nodes each leaf has, and the extra points
+/// (leaf centres and face Steiner points) of leaves with hanging nodes.
+struct Sampled {
+    corners: Vec<[u32; 8]>,
+    /// Bit `i` set when local lattice point `i` of the leaf is a node ([`CORNER_MASK`] = none
+    /// hanging).
+    masks: Vec<u32>,
+    /// Points `0..n_nodes` are leaf corners; the others are extra points.
+    n_nodes: usize,
+    /// The leaf that created each extra point.
+    owner: Vec<u32>,
+}
+
+impl Sampled {
+    fn new(leaves: &[Leaf], points: &mut Points) -> Self {
+        // A level-0 leaf shares its low-x corners with the previous leaf when that is its
+        // neighbour along x (leaves are sorted z-major): half the lookups on the band.
+        let mut corners: Vec<[u32; 8]> = Vec::with_capacity(leaves.len());
+        for (i, f) in leaves.iter().enumerate() {
+            let prev = i.checked_sub(1).map(|p| (&leaves[p], corners[p]));
+            let ids = match prev {
+                Some((g, ids)) if f.level == 0 && g.level == 0 && g.min + 1 == f.min => {
+                    let mut own = [0; 8];
+                    for c in 0..8 {
+                        own[c] = if c & 1 == 0 {
+                            ids[c | 1]
                         } else {
-                            [t[0], t[2], t[1]]
-                        });
-                    };
-                    emit([vs[0], vs[1], vs[2]]);
-                    if vs.len() == 4 {
-                        emit([vs[0], vs[2], vs[3]]);
+                            points.insert(f.point_at(CORNERS[c])).0
+                        };
+                    }
+                    own
+                }
+                _ => CORNERS.map(|c| points.insert(f.point_at(c)).0),
+            };
+            corners.push(ids);
+        }
+        let n_nodes = points.len();
+        let is_node =
+            |points: &Points, key| points.get(key).is_some_and(|i| (i as usize) < n_nodes);
+        let masks: Vec<u32> = leaves
+            .iter()
+            .map(|f| {
+                let mut mask = CORNER_MASK;
+                if f.level > 0 {
+                    for &h in &HANGING {
+                        if is_node(points, f.point_at(h)) {
+                            mask |= 1 << h;
+                        }
+                    }
+                }
+                mask
+            })
+            .collect();
+        let mut owner = Vec::new();
+        for (i, (f, &mask)) in leaves.iter().zip(&masks).enumerate() {
+            if mask == CORNER_MASK {
+                continue;
+            }
+            let steiner = (0..6)
+                .filter(|&face| face_needs_steiner(mask, face))
+                .map(face_centre);
+            for l in std::iter::once(CENTRE).chain(steiner) {
+                if points.insert(f.point_at(l)).1 {
+                    owner.push(i as u32);
+                }
+            }
+        }
+        Self {
+            corners,
+            masks,
+            n_nodes,
+            owner,
+        }
+    }
+
+    /// Point ids of leaf `f`'s 27 local lattice points (`u32::MAX` where there is none).
+    fn local_ids(&self, f: usize, leaf: &Leaf, points: &Points) -> [u32; 27] {
+        let mut loc = [u32::MAX; 27];
+        for (c, &id) in self.corners[f].iter().enumerate() {
+            loc[CORNERS[c]] = id;
+        }
+        let mask = self.masks[f];
+        if mask != CORNER_MASK {
+            for (i, slot) in loc.iter_mut().enumerate() {
+                if *slot == u32::MAX && (mask & (1 << i) != 0 || i == CENTRE) {
+                    *slot = points.get(leaf.point_at(i)).unwrap_or(u32::MAX);
+                }
+            }
+            for face in (0..6).filter(|&face| face_needs_steiner(mask, face)) {
+                let i = face_centre(face);
+                loc[i] = points.get(leaf.point_at(i)).unwrap_or(u32::MAX);
+            }
+        }
+        loc
+    }
+}
+
+/// Marching tetrahedra over the conforming tetrahedralization of the leaves (see the octree
+/// module), skipping leaves whose points all have one sign. `values` and `pos` are indexed by
+/// point id. Returns the vertices, the outward triangles and the cut leaves per level
+/// (`0..=root_level`).
+fn march_octree(
+    leaves: &[Leaf],
+    sampled: &Sampled,
+    points: &Points,
+    values: &[f64],
+    pos: &dyn Fn(usize) -> [f64; 3],
+    root_level: u32,
+) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<usize>) {
+    let order = |i: usize| points.keys[i];
+    let mut marcher = Marcher::new(values, pos, &order);
+    let mut cut = vec![0; root_level as usize + 1];
+    let mut tets = Vec::new();
+    for (f, leaf) in leaves.iter().enumerate() {
+        let ids = &sampled.corners[f];
+        if sampled.masks[f] == CORNER_MASK {
+            let neg = ids.iter().filter(|&&i| values[i as usize] < 0.0).count();
+            if neg > 0 && neg < 8 {
+                cut[leaf.level as usize] += 1;
+                for t in &KUHN {
+                    marcher.tet(t.map(|c| ids[c] as usize));
+                }
+            }
+            continue;
+        }
+        let loc = sampled.local_ids(f, leaf, points);
+        let present = || loc.iter().filter(|&&i| i != u32::MAX);
+        let neg = present().filter(|&&i| values[i as usize] < 0.0).count();
+        if neg == 0 || neg == present().count() {
+            continue;
+        }
+        cut[leaf.level as usize] += 1;
+        tets.clear();
+        leaf_tets(sampled.masks[f], &mut tets);
+        for t in &tets {
+            marcher.tet(t.map(|i| loc[i] as usize));
+        }
+    }
+    (marcher.positions, marcher.tris, cut)
+}
+
+/// Union-find with path halving.
+struct Dsu(Vec<u32>);
+
+impl Dsu {
+    fn find(&mut self, mut i: u32) -> u32 {
+        while self.0[i as usize] != i {
+            let g = self.0[self.0[i as usize] as usize];
+            self.0[i as usize] = g;
+            i = g;
+        }
+        i
+    }
+    fn union(&mut self, a: u32, b: u32) {
+        let (a, b) = (self.find(a), self.find(b));
+        if a != b {
+            self.0[a.max(b) as usize] = a.min(b);
+        }
+    }
+}
+
+/// Values off the band: a flood fill from the root's corner along leaf edges (split at hanging
+/// nodes) over the off-band points gives `+far` to the reached ones, `−far` to the others,
+/// `far = 2·band·band cell`; the IMLS values are negated when most band points on an edge to
+/// the outside are negative. Extra points off the band copy an off-band corner of their leaf
+/// (or take the mean of its corners). Returns (flipped, enclosed off-band nodes).
+fn classify(
+    frame: &Frame,
+    sampled: &Sampled,
+    points: &Points,
+    in_band: &[bool],
+    values: &mut [f64],
+) -> (bool, usize) {
+    let mut dsu = Dsu((0..points.len() as u32).collect());
+    let mut rim = Vec::new();
+    let leaves_of = |f: usize| (sampled.corners[f], sampled.masks[f]);
+    for f in 0..sampled.corners.len() {
+        let (ids, mask) = leaves_of(f);
+        if mask == CORNER_MASK && ids.iter().all(|&i| in_band[i as usize]) {
+            continue;
+        }
+        for k in 0..3 {
+            for c in (0..8).filter(|c| c & (1 << k) == 0) {
+                let (a, b) = (CORNERS[c], CORNERS[c | 1 << k]);
+                let (ia, ib) = (ids[c], ids[c | 1 << k]);
+                let mid = (a + b) / 2;
+                let chain = if mask & (1 << mid) != 0 {
+                    let key = mid_key(points, ia, ib);
+                    let im = points.get(key).expect("hanging node is a point");
+                    [ia, im, ib]
+                } else {
+                    [ia, ib, ib]
+                };
+                for w in chain.windows(2) {
+                    match (in_band[w[0] as usize], in_band[w[1] as usize]) {
+                        (false, false) => dsu.union(w[0], w[1]),
+                        (true, false) => rim.push((w[0], w[1])),
+                        (false, true) => rim.push((w[1], w[0])),
+                        (true, true) => {}
                     }
                 }
             }
         }
     }
-    (positions, tris)
+    let far = 2.0 * frame.band as f64 * frame.cell * f64::from(1u32 << frame.band_level);
+    let outside = dsu.find(points.get(0).expect("the root's corner is a node"));
+    let mut enclosed = 0;
+    for i in 0..sampled.n_nodes {
+        if !in_band[i] {
+            values[i] = if dsu.find(i as u32) == outside {
+                far
+            } else {
+                enclosed += 1;
+                -far
+            };
+        }
+    }
+    let mut seen = vec![false; points.len()];
+    let (mut pos_rim, mut neg_rim) = (0usize, 0usize);
+    for &(b, o) in &rim {
+        if values[o as usize] == far && !seen[b as usize] {
+            seen[b as usize] = true;
+            if values[b as usize] < 0.0 {
+                neg_rim += 1;
+            } else {
+                pos_rim += 1;
+            }
+        }
+    }
+    let flipped = neg_rim > pos_rim;
+    if flipped {
+        for (v, &b) in values.iter_mut().zip(in_band) {
+            if b {
+                *v = -*v;
+            }
+        }
+    }
+    for (e, &f) in sampled.owner.iter().enumerate() {
+        let i = sampled.n_nodes + e;
+        if in_band[i] {
+            continue;
+        }
+        let ids = sampled.corners[f as usize];
+        values[i] = match ids.iter().find(|&&c| !in_band[c as usize]) {
+            Some(&c) => values[c as usize],
+            None => ids.iter().map(|&c| values[c as usize]).sum::<f64>() / 8.0,
+        };
+    }
+    (flipped, enclosed)
+}
+
+/// Packed key of the midpoint of two points.
+fn mid_key(points: &Points, a: u32, b: u32) -> u64 {
+    let (pa, pb) = (
+        unpack(points.keys[a as usize]),
+        unpack(points.keys[b as usize]),
+    );
+    pack([0, 1, 2].map(|k| (pa[k] + pb[k]) / 2))
 }
 
 /// Keeps the components with at least `fraction` × (largest face count) faces; re-indexes.
@@ -401,4 +770,79 @@ pub(crate) fn keep_components(
         comps.count,
         kept,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The exact signed distance to a sphere (radius 20 finest cells) on an octree of 64³
+    /// cells refined around it to level 0 where `x < 32` and only to level 2 elsewhere: the
+    /// zero set crosses leaves of three levels, leaves with hanging nodes among them, and is
+    /// still a closed, manifold sphere with every edge in exactly two triangles.
+    #[test]
+    fn the_zero_set_is_crack_free_across_level_transitions() {
+        let root = 6;
+        let sdf = |p: [f64; 3]| {
+            let d = [p[0] - 32.3, p[1] - 31.7, p[2] - 32.1];
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() - 20.0
+        };
+        let mut tree = Octree::new(root);
+        for l in (1..=root).rev() {
+            let n = 1u64 << (root - l);
+            let s = f64::from(1u32 << l);
+            let near = (0..n * n * n).filter_map(|i| {
+                let c = [i % n, i / n % n, i / (n * n)];
+                let centre = c.map(|v| (v as f64 + 0.5) * s);
+                let deep_enough = l >= 3 || centre[0] < 32.0;
+                (deep_enough && sdf(centre).abs() < s).then(|| pack(c))
+            });
+            let near: Vec<u64> = near.collect();
+            tree.split(l, near);
+        }
+        tree.balance();
+        let leaves = tree.leaves();
+        let mut points = Points::default();
+        let sampled = Sampled::new(&leaves, &mut points);
+        let values: Vec<f64> = points
+            .keys
+            .iter()
+            .map(|&k| sdf(unpack(k).map(|c| c as f64)))
+            .map(|v| if v == 0.0 { 1e-300 } else { v })
+            .collect();
+        let pos = |i: usize| unpack(points.keys[i]).map(|c| c as f64);
+        let (positions, tris, cut) = march_octree(&leaves, &sampled, &points, &values, &pos, root);
+        assert!(cut[0] > 0 && cut[1] > 0 && cut[2] > 0, "{cut:?}");
+        let cut_transitions = leaves
+            .iter()
+            .zip(&sampled.masks)
+            .enumerate()
+            .filter(|(f, (leaf, &mask))| {
+                let loc = sampled.local_ids(*f, leaf, &points);
+                let neg = loc
+                    .iter()
+                    .filter(|&&i| i != u32::MAX && values[i as usize] < 0.0)
+                    .count();
+                mask != CORNER_MASK && neg > 0
+            })
+            .count();
+        assert!(cut_transitions > 0);
+        let mut edges = KeyMap::<(u32, u32), u32>::default();
+        for t in &tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        assert!(edges.values().all(|&n| n == 2));
+        for p in &positions {
+            assert!(sdf(*p).abs() < 0.5, "{p:?}");
+        }
+        let mesh = PolyMesh::new(positions, Polygons::from_triangles(&tris));
+        let he = HalfEdgeMesh::from_mesh(&mesh).expect("manifold");
+        assert_eq!(
+            (he.genus(), he.boundary_loops().len(), he.components().count),
+            (0, 0, 1)
+        );
+    }
 }

@@ -2,7 +2,7 @@
 //!
 //! Mesh targets are simplified ([`crate::simplify`](mod@crate::simplify), Garland & Heckbert 1997 with the link
 //! condition of Dey et al. 1999), like the method of reference 13 in Cheng et al. 2007 §I; point
-//! clouds are contoured first ([`crate::contour()`](mod@crate::contour): IMLS of Xie et al. 2023 on a grid, marching
+//! clouds are contoured first ([`crate::contour()`](mod@crate::contour): IMLS of Xie et al. 2023 on an adaptive octree, marching
 //! tetrahedra) and then simplified, as Cheng et al. 2004 §4.3 (marching cubes on an octree, then
 //! simplification).
 
@@ -33,7 +33,7 @@ pub struct InitOptions {
     pub require_genus: bool,
     /// Point clouds: when the contour has fewer than this many vertices per requested control
     /// vertex and [`ContourOptions::resolution`] is automatic, the cloud is contoured again on a
-    /// finer grid (the vertex count grows with the resolution squared; at most
+    /// finer octree (the vertex count grows with the resolution squared; at most
     /// [`ContourOptions::max_resolution`]), so that the simplification has room to place the
     /// control vertices. Default 8.
     pub contour_vertices_per_control: f64,
@@ -199,7 +199,9 @@ pub enum InitError {
 /// [`InitOptions::require_genus`]). A target with too few points fails earlier, in
 /// [`Target`]'s constructor.
 ///
-/// Cost: contouring `O(N³ + band·k)` for an `N`-cell grid, simplification `O(E log E)`.
+/// Cost: contouring `O(n log n + n·k)` for the `n` octree points (proportional to the band around
+/// the data, see [`crate::contour()`]) and `k` points per IMLS neighbourhood, simplification
+/// `O(E log E)`.
 pub fn initial_control_mesh(
     target: &Target,
     mesh: Option<&PolyMesh>,
@@ -296,7 +298,7 @@ fn normalized_mesh(target: &Target, m: &PolyMesh) -> Result<PolyMesh, InitError>
     ))
 }
 
-/// The contour of the target's points, re-contoured once on a finer grid when it has fewer
+/// The contour of the target's points, re-contoured once at a finer resolution when it has fewer
 /// than [`InitOptions::contour_vertices_per_control`] vertices per requested control vertex
 /// and the resolution is automatic; the finer contour is used only when its genus and
 /// component count agree with the coarse one's.
@@ -321,7 +323,7 @@ fn contour_for(
         resolution: Some(res),
         ..options.contour.clone()
     };
-    // A finer grid resolves more of the IMLS function's noise: on thin parts it can open
+    // A finer resolution resolves more of the IMLS function's noise: on thin parts it can open
     // spurious handles (the armadillo at 2.5 cells per radius). The coarse contour's topology
     // is the more trustworthy; keep it when the two disagree.
     match contour(target, &finer) {
@@ -332,14 +334,20 @@ fn contour_for(
     }
 }
 
+/// Carving runs on a uniform grid (`O(N³)` memory): its resolution stays below the 2 × 160 it
+/// had when the IMLS contour was a uniform grid of at most 160 cells, now that the octree
+/// contour can be much finer.
+const MAX_CARVE_RESOLUTION: usize = 320;
+
 /// The space-carving fallback: carving radii of 1, 1.5, 2 and 3 IMLS-contour cells on a grid
-/// twice as fine; the first result of genus `genus` with one component, if any, with its radius.
+/// twice as fine (at most [`MAX_CARVE_RESOLUTION`]); the first result of genus `genus` with one
+/// component, if any, with its radius.
 fn carve_for(
     target: &Target,
     imls: &ContourReport,
     genus: u32,
 ) -> Option<(PolyMesh, ContourReport, f64)> {
-    let res = (2 * imls.resolution).max(32);
+    let res = (2 * imls.resolution).clamp(32, MAX_CARVE_RESOLUTION);
     [1.0, 1.5, 2.0, 3.0].into_iter().find_map(|k| {
         let r = k * imls.cell_size;
         match carve(target, res, r, 1.0) {

@@ -3,9 +3,11 @@
 //!
 //! * [`simplify`](mod@simplify): topology-preserving quadric-error edge collapse (Garland & Heckbert 1997) with
 //!   the link condition of Dey et al. 1999, for mesh targets and for contoured point clouds.
-//! * [`contour`](mod@contour): a point cloud's IMLS function (Xie et al. 2023 eq. 2–3) sampled on a grid and
-//!   contoured by marching tetrahedra (the ambiguity-free variant of Lorensen & Cline 1987), which
-//!   always yields a closed, manifold, consistently oriented surface.
+//! * [`contour`](mod@contour): a point cloud's IMLS function (Xie et al. 2023 eq. 2–3) sampled on an
+//!   adaptive, 2:1-balanced octree (fine only in a band around the data, as Cheng et al. 2004
+//!   §4.3 and 2007 §II-C contour an octree) and contoured by marching tetrahedra (the
+//!   ambiguity-free variant of Lorensen & Cline 1987) on a conforming tetrahedralization of its
+//!   leaves, which always yields a closed, manifold, consistently oriented, crack-free surface.
 //! * [`carve`](mod@carve): a normal-free wrap of a point cloud (space carving with a ball), the
 //!   fallback when the IMLS contour misses an expected genus (e.g. badly oriented normals).
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
@@ -19,10 +21,12 @@
 pub mod carve;
 pub mod contour;
 pub mod init;
+mod march;
+mod octree;
 pub mod simplify;
 
 pub use carve::carve;
-pub use contour::{contour, ContourError, ContourOptions, ContourReport};
+pub use contour::{contour, ContourError, ContourOptions, ContourReport, MAX_RESOLUTION};
 pub use init::{
     default_control_points, initial_control_mesh, min_vertices_for_topology, InitError,
     InitOptions, InitReport, InitSource, InitTimings,

@@ -155,6 +155,14 @@ fn inward_normals_are_detected_and_flipped() {
         "{worst} vs cell {}",
         rep.cell_size
     );
+    // Also when the band is two octree levels above the finest cells.
+    let fine = ContourOptions {
+        resolution: Some(4 * rep.resolution),
+        ..ContourOptions::default()
+    };
+    let (m, rep) = contour(&t, &fine).unwrap();
+    assert!(rep.flipped && rep.band_level == 2, "{rep:?}");
+    assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
 }
 
 #[test]
@@ -231,4 +239,117 @@ fn wrong_normals_fall_back_to_carving_when_the_genus_is_known() {
     assert!(rep.carve_radius.is_some(), "{rep:?}");
     assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
     assert!(m.num_vertices() <= 200);
+}
+
+/// Every undirected edge of `m` is in exactly two triangles (no crack, no fin).
+#[track_caller]
+fn assert_crack_free(m: &subfit_mesh::PolyMesh) {
+    let mut count = std::collections::HashMap::<(u32, u32), u32>::new();
+    for t in m.faces.triangulate_fan() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let bad: Vec<_> = count.iter().filter(|(_, &n)| n != 2).take(5).collect();
+    assert!(bad.is_empty(), "edges not in exactly two faces: {bad:?}");
+}
+
+/// First-order distance `|f| / |∇f|` of a point to the target's IMLS zero set.
+fn imls_distance(t: &Target, p: [f64; 3]) -> f64 {
+    let v = t.imls(p);
+    let g = v.gradient;
+    v.value.abs() / (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt()
+}
+
+/// The octree contour of a sphere and a torus cloud, at the automatic resolution (band level =
+/// finest) and at 4× (band two levels up, finest cells only around the zero set): closed,
+/// manifold, one component of the right genus, every edge in two faces, leaves on at least 3
+/// levels; vertices within a fifth of a finest cell of the IMLS zero set, and within 0.15 (0.5 at 4×) of the
+/// true surface at the automatic resolution (at 4× the cell is finer than the IMLS function's
+/// own bias, about a quarter of the band cell here).
+#[test]
+fn octree_contours_are_closed_crack_free_and_on_the_surface() {
+    let sphere = Shape::Ellipsoid {
+        a: 1.0,
+        b: 1.0,
+        c: 1.0,
+    };
+    for (shape, n) in [(sphere, 6000), (Shape::DEFAULT_TORUS, 8000)] {
+        let t = target_of(&shape, n);
+        let (_, auto) = contour(&t, &ContourOptions::default()).unwrap();
+        for res in [auto.resolution, 4 * auto.resolution] {
+            let opts = ContourOptions {
+                resolution: Some(res),
+                ..ContourOptions::default()
+            };
+            let (m, rep) = contour(&t, &opts).unwrap();
+            let what = format!("{shape:?} at {res}: {rep:?}");
+            assert_eq!(topology(&m), (shape.genus(), 0, 1), "{what}");
+            assert_crack_free(&m);
+            let levels = rep.leaves_per_level.iter().filter(|&&n| n > 0).count();
+            assert!(levels >= 3, "{what}");
+            assert_eq!(rep.band_level, if res == auto.resolution { 0 } else { 2 });
+            let cell = rep.cell_size;
+            let worst =
+                |d: &dyn Fn([f64; 3]) -> f64| m.positions.iter().map(|&p| d(p)).fold(0.0, f64::max);
+            let on_imls = worst(&|p| imls_distance(&t, p));
+            assert!(on_imls < 0.2 * cell, "{on_imls} vs cell {cell}: {what}");
+            let on_shape = worst(&|p| distance(&shape, &t, p));
+            let allowed = if rep.band_level == 0 { 0.15 } else { 0.5 } * cell;
+            assert!(on_shape < allowed, "{on_shape} vs cell {cell}: {what}");
+        }
+    }
+}
+
+/// A resolution far above the old uniform grid's 160: 512 finest cells on a torus cloud. The
+/// octree stays proportional to the surface (its points are a small fraction of the 512³ a
+/// uniform grid would need; the figures are printed by `cargo bench --bench init`) and the
+/// contour is still a closed, crack-free torus on the IMLS zero set.
+#[test]
+fn resolution_512_uses_a_small_octree() {
+    let shape = Shape::DEFAULT_TORUS;
+    let t = target_of(&shape, 8000);
+    let opts = ContourOptions {
+        resolution: Some(512),
+        ..ContourOptions::default()
+    };
+    let (m, rep) = contour(&t, &opts).unwrap();
+    let what = format!(
+        "{} points, leaves {:?}, {} V",
+        rep.octree_nodes, rep.leaves_per_level, rep.vertices
+    );
+    assert_eq!(rep.resolution, 512);
+    assert!(rep.octree_nodes < 512 * 512 * 512 / 20, "{what}");
+    assert_eq!(topology(&m), (1, 0, 1), "{what}");
+    assert_crack_free(&m);
+    let cell = rep.cell_size;
+    for &p in m.positions.iter().step_by(97) {
+        let d = imls_distance(&t, p);
+        assert!(d < 0.1 * cell, "{d} vs cell {cell}: {what}");
+    }
+}
+
+#[test]
+fn resolutions_out_of_range_are_errors() {
+    let t = target_of(&Shape::PAPER_ELLIPSOID, 2000);
+    for bad in [
+        ContourOptions {
+            resolution: Some(1),
+            ..ContourOptions::default()
+        },
+        ContourOptions {
+            resolution: Some(subfit_init::MAX_RESOLUTION + 1),
+            ..ContourOptions::default()
+        },
+        ContourOptions {
+            refine_margin: -1.0,
+            ..ContourOptions::default()
+        },
+    ] {
+        assert!(matches!(
+            contour(&t, &bad),
+            Err(subfit_init::ContourError::InvalidOption(_))
+        ));
+    }
 }

@@ -2,7 +2,7 @@
 //! mesh with the target's topology (DESIGN.md §3.6), written in the target's coordinates.
 //!
 //! Mesh targets are simplified (topology-preserving QEM); point clouds, or any target with
-//! `--from-points`, are contoured (IMLS + marching tetrahedra) and then simplified. The default
+//! `--from-points`, are contoured (IMLS on an adaptive octree + marching tetrahedra) and then simplified. The default
 //! size is [`subfit::init::default_control_points`]: `clamp(round(1.5·√points), 200, 2000)`.
 
 use std::process::ExitCode;
@@ -173,8 +173,10 @@ fn print_summary(
     }
     match (r.source, &r.contour) {
         (InitSource::Contour, Some(c)) => println!(
-            "contour: grid {}x{}x{} (cell {:.4} unit cube), {} vertices, {} faces, genus {}, \
-             {} of {} components kept",
+            "contour: octree of {} points and {} leaves, finest {}x{}x{} (cell {:.4} unit cube), \
+             {} vertices, {} faces, genus {}, {} of {} components kept",
+            c.octree_nodes,
+            c.leaves_per_level.iter().sum::<usize>(),
             c.nodes[0],
             c.nodes[1],
             c.nodes[2],
