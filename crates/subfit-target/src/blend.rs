@@ -20,10 +20,10 @@
 //!
 //! So a data point is marked **untrusted** at build time when the quadrics of its graph
 //! neighbours (same-side ones: normals within 90°) pass farther than [`DISAGREEMENT`] times its
-//! neighbourhood radius from it; and a query is in a **gap** when its tangential offset from
-//! its nearest data point exceeds [`GAP_OFFSET`] times that point's radius. Only then is the
-//! foot point blended, so in smooth, dense regions results are exactly the nearest-quadric
-//! ones (and as fast).
+//! neighbourhood radius from it; and a foot point is over a **gap** when it lies farther than
+//! [`GAP_OFFSET`] times that point's radius from the data point whose quadric gave it. Only
+//! then is the foot point blended, so in smooth, dense regions results are exactly the
+//! nearest-quadric ones (and as fast).
 
 use crate::project::{alpha_plus, foot_point_on, FootPoint};
 use crate::quadric::LocalQuadric;
@@ -34,9 +34,11 @@ use crate::vec3::{cross, dot, normalize, scale, sub};
 pub(crate) const BLEND_K: usize = 16;
 /// Blend weight `exp(−|x − p_j|² / (BLEND_SCALE · R_j)²)`, `R_j` the neighbourhood radius.
 const BLEND_SCALE: f64 = 0.5;
-/// A query is in a sampling gap when its offset from the nearest data point, tangential to the
-/// foot point's normal, exceeds this fraction of that point's neighbourhood radius. In a dense
-/// sampling the offset is below about the spacing (≈ R/4 for the 24-point neighbourhood).
+/// A foot point is over a sampling gap when it lies farther from the data point whose quadric
+/// gave it than this fraction of that point's neighbourhood radius. In a dense sampling the
+/// foot point of a query near the surface is within about the spacing (≈ R/4 for the 24-point
+/// neighbourhood) of its data point, since the quadric of the data point nearest to the foot
+/// point is the one used.
 const GAP_OFFSET: f64 = 0.4;
 /// A data point is untrusted when a same-side neighbour's quadric passes farther from it than
 /// this fraction of its neighbourhood radius (first-order distance). On smooth data the
@@ -72,17 +74,17 @@ pub(crate) fn untrusted(
         .any(|j| first_order_distance(&quadrics[j], points[j], p).abs() > limit)
 }
 
-/// Whether the foot point `f` of `x`, computed on the quadric of slot `s`, should be replaced by
-/// the blended one: `s` is untrusted, or `x` lies in a sampling gap next to it.
+/// Whether the foot point `f`, computed on the quadric of slot `s`, should be replaced by the
+/// blended one: `s` is untrusted, or `f` lies farther from `s`'s data point than
+/// [`GAP_OFFSET`] times its neighbourhood radius (the quadric was extrapolated: a sampling gap).
 #[inline]
-pub(crate) fn needs_blend(l: &QueryLayout, x: [f64; 3], s: usize, f: &FootPoint) -> bool {
+pub(crate) fn needs_blend(l: &QueryLayout, s: usize, f: &FootPoint) -> bool {
     if l.untrusted[s] {
         return true;
     }
-    let r = sub(x, l.points[s]);
-    let t2 = dot(r, r) - f.distance * f.distance;
+    let r = sub(f.point, l.points[s]);
     let g = GAP_OFFSET * l.radius[s];
-    t2 > g * g
+    dot(r, r) > g * g
 }
 
 /// The blended foot point of `x`: the projections of `x` on the quadrics of its

@@ -140,9 +140,9 @@ impl Target {
     /// point (then no other data point can be nearer to it: triangle inequality), so the result
     /// is the same as with the second query.
     ///
-    /// Next to an untrusted quadric ([`crate::TargetStats::untrusted_quadrics`]) or when `x`
-    /// lies over a sampling gap (its offset from the nearest data point, tangential to the foot
-    /// point's normal, above 0.4 of that point's neighbourhood radius), the signed distances
+    /// Next to an untrusted quadric ([`crate::TargetStats::untrusted_quadrics`]) or over a
+    /// sampling gap (the foot point farther than 0.4 of the neighbourhood radius from the data
+    /// point whose quadric gave it), the signed distances
     /// and normals of the projections on the 16 nearest points' quadrics are blended instead
     /// (weights `exp(−|x − p_j|² / (R_j/2)²)`, points of an opposite-facing sheet left out);
     /// this costs one 16-nearest query and 16 projections more.
@@ -173,7 +173,7 @@ impl Target {
         let l = self.layout();
         let i = self.nearest_from(&x, start);
         let (f, j) = self.nearest_quadric_foot(x, i);
-        if !(l.untrusted[j as usize] || needs_blend(l, x, i as usize, &f)) {
+        if !needs_blend(l, j as usize, &f) {
             return (f, i);
         }
         let near = self
