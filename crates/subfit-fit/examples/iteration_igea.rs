@@ -35,7 +35,7 @@
 //! mean wall per iteration over 3 iterations, 4 runs: 10k control points 0.29–0.42 s (CPU
 //! 0.61–0.82 s; stable iterations: project 140–170 ms, assemble 49–52, solve 16–19); the
 //! blended foot points of `subfit-target` (where a quadric is untrusted or extrapolated, about
-//! 1.5 % of the queries here) cost about 20 ms of it (same runs with blending disabled:
+//! 1.5 % of the queries here) cost 25–90 ms of it (alternate runs with blending disabled:
 //! 0.23–0.26 s). 1k control points: 42–45 ms.
 //! The assembly is the grouped fill of `subfit_fit::assemble` (see `examples/assemble_igea.rs`
 //! for its CPU time alone); projection is `subfit-target`'s and dominates what is left.
