@@ -227,16 +227,7 @@ impl LocalMesh {
             }
         }
         let (ne, nf) = (ring.verts.len(), ring.corners.len());
-        let corner = ne == 0
-            || nsharp > 2
-            || self.corner[v as usize]
-            || (boundary_rule == BoundaryRule::EdgeAndCorner && nf == 1 && ne == 2);
-        let rule = match (corner, nsharp) {
-            (true, _) => VertexRule::Corner,
-            (false, 2) => VertexRule::Crease,
-            (false, 1) => VertexRule::Dart,
-            _ => VertexRule::Smooth,
-        };
+        let rule = VertexRule::classify(ne, nf, nsharp, self.corner[v as usize], boundary_rule);
         Neighborhood {
             num_edges: ne,
             num_faces: nf,

@@ -114,16 +114,7 @@ pub(crate) fn classify(
             nsharp += 1;
         }
     }
-    let corner = num_edges == 0
-        || nsharp > 2
-        || corner_tag
-        || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && num_edges == 2);
-    let rule = match (corner, nsharp) {
-        (true, _) => VertexRule::Corner,
-        (false, 2) => VertexRule::Crease,
-        (false, 1) => VertexRule::Dart,
-        _ => VertexRule::Smooth,
-    };
+    let rule = VertexRule::classify(num_edges, num_faces, nsharp, corner_tag, boundary);
     Neighborhood {
         num_edges,
         num_faces,

@@ -108,6 +108,29 @@ pub enum VertexRule {
     Corner,
 }
 
+impl VertexRule {
+    /// The rule of a vertex with `num_edges` incident edges on `num_faces` faces, `nsharp` of
+    /// the edges sharp (boundary edges count as sharp), a corner tag or not, under `boundary`.
+    pub fn classify(
+        num_edges: usize,
+        num_faces: usize,
+        nsharp: usize,
+        corner_tag: bool,
+        boundary: BoundaryRule,
+    ) -> Self {
+        let corner = num_edges == 0
+            || nsharp > 2
+            || corner_tag
+            || (boundary == BoundaryRule::EdgeAndCorner && num_faces == 1 && num_edges == 2);
+        match (corner, nsharp) {
+            (true, _) => VertexRule::Corner,
+            (false, 2) => VertexRule::Crease,
+            (false, 1) => VertexRule::Dart,
+            _ => VertexRule::Smooth,
+        }
+    }
+}
+
 /// What a scheme needs to know about a vertex to fill its masks.
 ///
 /// The vertex's ring is ordered counter-clockwise (seen with the face winding counter-clockwise):
