@@ -111,6 +111,10 @@ pub struct BenchFitArgs {
     /// Run only these models (e.g. `--models igea,rocker-arm`).
     #[arg(long, value_delimiter = ',')]
     pub models: Vec<String>,
+    /// Judge the tolerances surface → data only, as the papers do (both directions are
+    /// printed either way).
+    #[arg(long)]
+    pub one_sided: bool,
 }
 
 /// `subfit bench convergence`.
@@ -174,7 +178,13 @@ pub struct FitArgs {
     /// Also require E_max (unit-cube units) to be at most this; exit code 1 if it is not.
     #[arg(long)]
     pub max_error: Option<f64>,
-    /// Never refine the cage beyond this many control points.
+    /// Judge --tolerance and --max-error on the surface → data distance only (Cheng et al.'s
+    /// measure). By default both directions must hold: the limit surface within the tolerance
+    /// of the data and the data within it of the limit surface.
+    #[arg(long)]
+    pub one_sided: bool,
+    /// The control-point budget: the initial cage and every refinement stay within it (exit
+    /// code 2 when the target's topology needs more).
     #[arg(long, default_value_t = 5_000, value_parser = clap::value_parser!(u32).range(4..=10_000_000))]
     pub max_control_points: u32,
     /// Keep the initial cage's connectivity: no local refinement, no edge flips.

@@ -9,7 +9,6 @@
 mod cli;
 mod commands;
 mod interrupt;
-mod plot;
 mod progress;
 
 use std::process::ExitCode;

@@ -91,8 +91,7 @@ fn main() {
             .map(|&x| target.to_normalized(x))
             .collect();
         let fopts = FitOptions::variant(Variant::SdmLm).with_sample_level(3);
-        let fitter =
-            Fitter::new(&target, &cage.faces, p.len(), &Tags::new(), &fopts).expect("fitter");
+        let fitter = Fitter::new(&target, &cage.faces, p.len(), &fopts).expect("fitter");
         let op = &fitter.sampling_operator().position;
         let s = op.apply(&p);
         let feet = fitter.foot_points(&s);

@@ -71,14 +71,8 @@ fn main() {
             .with_sample_level(level)
             .with_max_iterations(iters);
         let t = Instant::now();
-        let mut fitter = Fitter::new(
-            &target,
-            &mesh.faces,
-            mesh.num_vertices(),
-            &Tags::new(),
-            &opts,
-        )
-        .expect("fitter");
+        let mut fitter =
+            Fitter::new(&target, &mesh.faces, mesh.num_vertices(), &opts).expect("fitter");
         let setup = t.elapsed();
         println!(
             "\n{} control points, {} samples (level {level}), H: {} nonzeros (upper), setup {:.2?}",

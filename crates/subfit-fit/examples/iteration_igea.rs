@@ -158,14 +158,8 @@ fn main() {
                 .with_max_iterations(iters)
         };
         let (c0, t) = (cpu_time(), Instant::now());
-        let mut fitter = Fitter::new(
-            &target,
-            &cage.faces,
-            cage.num_vertices(),
-            &Tags::new(),
-            &opts,
-        )
-        .expect("fitter");
+        let mut fitter =
+            Fitter::new(&target, &cage.faces, cage.num_vertices(), &opts).expect("fitter");
         let (setup, setup_cpu) = (t.elapsed(), cpu_time() - c0);
         println!(
             "\n{} control points, {} samples (level {level}), H: {} scalar nonzeros (upper), \

@@ -32,6 +32,15 @@ pub fn foot_points(target: &Target, source: FootPointSource, xs: &[[f64; 3]]) ->
     }
 }
 
+/// Squared distances `|x − V(x)|²` of `xs` to their foot points from `source`, in parallel.
+pub fn squared_errors(target: &Target, source: FootPointSource, xs: &[[f64; 3]]) -> Vec<f64> {
+    let feet = foot_points(target, source, xs);
+    xs.par_iter()
+        .zip(feet.par_iter())
+        .map(|(s, f)| (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum())
+        .collect()
+}
+
 /// [`foot_points`] warm-started for samples that moved little since the last call: `hints`
 /// holds, per sample, the nearest data point found last time (resized to `xs.len()` with
 /// "no hint"; updated). Same results as [`foot_points`] (the quadric path certifies every

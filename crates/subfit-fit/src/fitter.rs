@@ -6,8 +6,8 @@
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
-use subfit_mesh::{PolyMesh, Polygons, Tags};
-use subfit_subdiv::{sampling_operator, Options, SamplingOperator};
+use subfit_mesh::{PolyMesh, Polygons};
+use subfit_subdiv::{sampling_operator, SamplingOperator};
 use subfit_target::{FootPoint, Target};
 
 use crate::active::{sample_rows, ActiveSet, FixedErrors};
@@ -71,8 +71,8 @@ fn make_solver(options: &FitOptions, n: usize, block: usize) -> NormalSolver {
 }
 
 impl<'t> Fitter<'t> {
-    /// Prepares fitting `faces` (over `num_vertices` control points, with crease/corner `tags`)
-    /// to `target`. Builds the sampling operator at `options.sample_level`, the umbrella
+    /// Prepares fitting `faces` (over `num_vertices` control points, with the crease/corner
+    /// tags and subdivision rules of `options`) to `target`. Builds the sampling operator at `options.sample_level`, the umbrella
     /// Laplacian, the pattern of `H` and its symbolic Cholesky analysis. The control points themselves are given to
     /// [`Self::run`], in the target's normalized coordinates.
     ///
@@ -83,7 +83,6 @@ impl<'t> Fitter<'t> {
         target: &'t Target,
         faces: &Polygons,
         num_vertices: usize,
-        tags: &Tags,
         options: &FitOptions,
     ) -> Result<Self, FitError> {
         let t0 = Instant::now();
@@ -96,8 +95,8 @@ impl<'t> Fitter<'t> {
         let op = sampling_operator(
             faces,
             num_vertices,
-            tags,
-            &Options::new(options.scheme),
+            &options.tags,
+            &options.subdivision(),
             options.sample_level,
         )?;
         let lap = Laplacian::umbrella(faces, num_vertices);
@@ -196,6 +195,30 @@ impl<'t> Fitter<'t> {
     /// Changes `λ` (e.g. between stages); the pattern and factorization are kept.
     pub fn set_lambda(&mut self, lambda: f64) {
         self.options.lambda = lambda;
+    }
+
+    /// Sets what the next [`Self::run`] does, keeping everything built for the topology:
+    /// `λ`, the iteration cap, the stopping tolerances (`E_rms`, `E_max`; 0 = off) and the
+    /// stall threshold ([`FitOptions::min_relative_decrease`]).
+    pub fn set_stage(
+        &mut self,
+        lambda: f64,
+        max_iterations: usize,
+        tolerance_rms: f64,
+        tolerance_max: f64,
+        stall: f64,
+    ) {
+        self.options.lambda = lambda;
+        self.options.max_iterations = max_iterations;
+        self.options.tolerance_rms = tolerance_rms;
+        self.options.tolerance_max = tolerance_max;
+        self.options.min_relative_decrease = stall;
+    }
+
+    /// Squared distances of `samples` (e.g. `C·P`) to fresh foot points from the options'
+    /// source; the warm-start hints are left alone.
+    pub fn squared_errors(&self, samples: &[[f64; 3]]) -> Vec<f64> {
+        crate::feet::squared_errors(self.target, self.options.foot_points, samples)
     }
 
     /// The sampling operator (`m × n` limit stencils at the sample level).
@@ -761,7 +784,7 @@ pub struct FitResult {
     pub report: FitReport,
 }
 
-/// One-shot fit of `control_mesh` (positions in the target's normalized units, no creases)
+/// One-shot fit of `control_mesh` (positions in the target's normalized units; tags in `options`)
 /// to `target` with `options`. See [`Fitter`] for reuse across calls and stages.
 pub fn fit(
     target: &Target,
@@ -772,7 +795,6 @@ pub fn fit(
         target,
         &control_mesh.faces,
         control_mesh.num_vertices(),
-        &Tags::new(),
         options,
     )?;
     let mut control_points = control_mesh.positions.clone();

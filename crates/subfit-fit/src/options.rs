@@ -1,6 +1,7 @@
 //! Options of the fitting loop (Cheng et al. 2007, §II-B, §II-E, §III-C; DESIGN.md §3.4).
 
-use subfit_subdiv::Scheme;
+use subfit_mesh::Tags;
+use subfit_subdiv::{BoundaryRule, Options, Scheme};
 
 use crate::feet::FootPointSource;
 
@@ -107,6 +108,12 @@ impl Variant {
 pub struct FitOptions {
     /// Subdivision scheme of the control mesh. Default [`Scheme::Loop`].
     pub scheme: Scheme,
+    /// Boundary interpolation rule of the subdivision. Default [`BoundaryRule::EdgeOnly`]
+    /// (OpenSubdiv's `VTX_BOUNDARY_EDGE_ONLY`).
+    pub boundary: BoundaryRule,
+    /// Crease and corner tags of the control mesh (OpenSubdiv semantics; vertex ids of the
+    /// cage). Default none. [`crate::fit_stages`] carries them through refinement.
+    pub tags: Tags,
     /// Refinement level `l` at which the limit surface is sampled (one sample per level-`l`
     /// vertex, about `4^l ·` #faces samples for triangles). Default 3.
     pub sample_level: usize,
@@ -163,6 +170,8 @@ impl Default for FitOptions {
     fn default() -> Self {
         Self {
             scheme: Scheme::Loop,
+            boundary: BoundaryRule::EdgeOnly,
+            tags: Tags::new(),
             sample_level: 3,
             method: Method::Sdm,
             step: StepControl::LevenbergMarquardt,
@@ -219,6 +228,11 @@ impl FitOptions {
     pub fn with_sample_level(mut self, l: usize) -> Self {
         self.sample_level = l;
         self
+    }
+
+    /// The subdivision options: scheme and boundary rule.
+    pub fn subdivision(&self) -> Options {
+        Options::new(self.scheme).with_boundary(self.boundary)
     }
 
     /// Sets the subdivision scheme.

@@ -6,22 +6,29 @@
 //! with red-green closure ([`crate::adapt`]). Stops at the tolerance (`E_rms`, and `E_max`
 //! when asked), at the control-point budget, or when nothing more can be changed.
 //!
+//! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
+//! surface against the data (Cheng's measure) and the data against the limit surface (the
+//! tessellation of the fitter's samples, [`subfit_report::MeshDistance`]). Tolerances hold only when both do; faces
+//! that miss in either direction are refined; the best cage measured is the one returned.
+//!
 //! Only triangle cages (Loop) are refined and flipped; a Catmull-Clark cage goes through the
 //! `λ` schedule alone.
 
 use std::time::{Duration, Instant};
 
-use rayon::prelude::*;
+use std::collections::HashSet;
+
 use subfit_mesh::{PolyMesh, Polygons, Tags};
-use subfit_subdiv::{sampling_operator, Options};
+use subfit_report::data_samples::SampleKind;
+use subfit_report::{data_samples, DistanceStats, MeshDistance, TwoSided};
+use subfit_subdiv::sampling_operator;
 use subfit_target::Target;
 
 use crate::adapt::{
-    apply_flips, face_errors, independent_flips, refine_red_green_with_parents, FaceError,
-    RefineStats,
+    apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
+    FaceError, RefineStats,
 };
 use crate::error::FitError;
-use crate::feet::FootPointSource;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
 use crate::report::{ErrorStats, FitReport, IterationRow};
@@ -72,6 +79,13 @@ pub struct StageOptions {
     pub local: bool,
     /// Rings of faces added around the changed region by [`Self::local`].
     pub local_rings: usize,
+    /// Judge the tolerances both ways: surface → data and data → surface (default true).
+    /// False keeps Cheng et al.'s one-sided measure (surface → data) for stopping; both are
+    /// measured and reported either way.
+    pub two_sided: bool,
+    /// Data → surface samples of a mesh target, uniform by area (0 = as many as it has
+    /// points; a point cloud always uses its points). Default 0.
+    pub data_samples: usize,
 }
 
 impl Default for StageOptions {
@@ -93,6 +107,8 @@ impl Default for StageOptions {
             max_depth: 4,
             local: false,
             local_rings: 2,
+            two_sided: true,
+            data_samples: 0,
         }
     }
 }
@@ -133,11 +149,57 @@ impl StageOptions {
         Ok(())
     }
 
-    /// Whether `e` meets every tolerance that is set (false when none is set).
+    /// Whether `e` (surface → data) meets every tolerance that is set (false when none is
+    /// set): Cheng et al.'s one-sided test.
     pub fn reached(&self, e: &ErrorStats) -> bool {
         let any = self.tolerance_rms > 0.0 || self.tolerance_max > 0.0;
         any && (self.tolerance_rms <= 0.0 || e.e_rms <= self.tolerance_rms)
             && (self.tolerance_max <= 0.0 || e.e_max <= self.tolerance_max)
+    }
+
+    /// Whether a cage measured `e` (surface → data, as the fitter measures it) and `two`
+    /// (both ways) meets the tolerances: both ways when [`Self::two_sided`], else one.
+    pub fn met(&self, e: &ErrorStats, two: &TwoSided) -> bool {
+        if self.two_sided {
+            self.reached(e) && two.within(self.tolerance_rms, self.tolerance_max)
+        } else {
+            self.reached(e)
+        }
+    }
+
+    /// The judged RMS and maximum: the worse direction when two-sided, else surface → data.
+    fn judged(&self, e: &ErrorStats, two: &TwoSided) -> (f64, f64) {
+        if self.two_sided {
+            (e.e_rms.max(two.rms()), e.e_max.max(two.max()))
+        } else {
+            (e.e_rms, e.e_max)
+        }
+    }
+
+    /// Which tolerances (RMS, max) the cage still misses.
+    fn unmet(&self, e: &ErrorStats, two: &TwoSided) -> (bool, bool) {
+        let (rms, max) = self.judged(e, two);
+        (
+            self.tolerance_rms > 0.0 && rms > self.tolerance_rms,
+            self.tolerance_max > 0.0 && max > self.tolerance_max,
+        )
+    }
+
+    /// How far a cage is from its tolerances: the largest ratio of judged error to tolerance
+    /// over those set, or the judged RMS when none is. Lower is better.
+    fn badness(&self, e: &ErrorStats, two: &TwoSided) -> f64 {
+        let (rms, max) = self.judged(e, two);
+        let mut b: f64 = 0.0;
+        if self.tolerance_rms > 0.0 {
+            b = b.max(rms / self.tolerance_rms);
+        }
+        if self.tolerance_max > 0.0 {
+            b = b.max(max / self.tolerance_max);
+        }
+        if self.tolerance_rms <= 0.0 && self.tolerance_max <= 0.0 {
+            b = rms;
+        }
+        b
     }
 }
 
@@ -154,6 +216,8 @@ pub struct StageReport {
     pub num_faces: usize,
     /// The iterations of this stage.
     pub fit: FitReport,
+    /// Both-way distances of the cage at the end of this stage's fit (before its changes).
+    pub two_sided: TwoSided,
     /// Edge flips evaluated after the fit.
     pub flips_tried: usize,
     /// Edge flips kept (they lowered the error on their faces).
@@ -213,7 +277,7 @@ fn local_region(faces: &Polygons, mut seed: Vec<bool>, rings: usize) -> Option<V
 /// Why the stage driver stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StageStop {
-    /// Every tolerance set is met.
+    /// Every tolerance set is met (both ways unless [`StageOptions::two_sided`] is off).
     Tolerance,
     /// The control-point budget is spent and `λ` is at its end value.
     Budget,
@@ -226,10 +290,19 @@ pub enum StageStop {
 /// The log of [`fit_stages`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct StagesReport {
-    /// Errors of the initial control mesh (at the first stage's `λ`).
+    /// Errors of the initial control mesh (at the first stage's `λ`; surface → data).
     pub initial: ErrorStats,
-    /// Errors of the final control mesh.
+    /// Both-way distances of the initial control mesh.
+    pub initial_two_sided: TwoSided,
+    /// Errors of the returned control mesh (surface → data, at the `λ` of its stage).
     pub last: ErrorStats,
+    /// Both-way distances of the returned control mesh.
+    pub two_sided: TwoSided,
+    /// The stage whose fitted cage is returned: the best measured ([`StageOptions`] decide
+    /// what "best" means: see [`fit_stages`]).
+    pub best_stage: usize,
+    /// Where the data → surface distances were measured from.
+    pub data_samples: SampleKind,
     /// One entry per stage.
     pub stages: Vec<StageReport>,
     /// Why it stopped.
@@ -251,6 +324,8 @@ pub struct StagesResult {
     /// The fitted cage in the target's normalized units (new control points appended after
     /// the initial ones; the initial ids persist).
     pub mesh: PolyMesh,
+    /// Its crease and corner tags (those given, carried through refinement).
+    pub tags: Tags,
     /// The log.
     pub report: StagesReport,
 }
@@ -265,17 +340,93 @@ pub enum StageEvent<'a> {
         /// The iteration's row.
         row: &'a IterationRow,
     },
-    /// A stage ended (after its mesh changes).
+    /// A stage ended (after its measurement and mesh changes).
     Stage(&'a StageReport),
 }
 
-/// Fits `mesh` (control points in the target's normalized units; no creases) to `target` in
-/// stages. `base` gives the scheme, method, step control and sample level; its `λ`,
-/// tolerances and iteration limits are replaced by those of `stages`.
+/// The cage of one topology with what is built for it: the fitter (sampling operator, pattern,
+/// symbolic factorization) and the control face of every face of the sample tessellation.
+/// Rebuilt only when the topology changes (refinement, flips); a `λ` change keeps both.
+struct Topo<'t> {
+    fitter: Fitter<'t>,
+    owners: Vec<u32>,
+}
+
+impl<'t> Topo<'t> {
+    fn new(target: &'t Target, mesh: &PolyMesh, opts: &FitOptions) -> Result<Self, FitError> {
+        let fitter = Fitter::new(target, &mesh.faces, mesh.num_vertices(), opts)?;
+        let owners = face_owners(&mesh.faces, fitter.sampling_operator());
+        Ok(Self { fitter, owners })
+    }
+}
+
+/// Both-way distances of one cage, with per-face errors for refinement.
+struct Measurement {
+    two_sided: TwoSided,
+    /// Surface → data, per control face.
+    surface_faces: Vec<FaceError>,
+    /// Data → surface, per control face (the face of each data point's closest point).
+    data_faces: Vec<FaceError>,
+}
+
+/// Measures `positions` both ways: fresh foot points of every sample of the fitter's sampling
+/// operator, and the distance of every data sample to the tessellation of the samples (the
+/// level-`l` limit points; within its chordal error of the limit surface).
+fn measure(
+    topo: &Topo<'_>,
+    faces: &Polygons,
+    positions: &[[f64; 3]],
+    data: &[[f64; 3]],
+) -> Measurement {
+    let op = topo.fitter.sampling_operator();
+    let samples = op.position.apply(positions);
+    let err2 = topo.fitter.squared_errors(&samples);
+    let surface_faces = face_errors(faces, op, &err2);
+    let to_surface = MeshDistance::new(&samples, &op.faces).distances(data);
+    let mut data_faces = vec![FaceError::default(); faces.len()];
+    for p in &to_surface {
+        let e = &mut data_faces[topo.owners[p.face as usize] as usize];
+        e.sum_sq += p.distance * p.distance;
+        e.count += 1;
+        e.max = e.max.max(p.distance);
+    }
+    let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
+    Measurement {
+        two_sided: TwoSided {
+            surface_to_data: DistanceStats::of_squared(&err2),
+            data_to_surface: DistanceStats::of(&d),
+        },
+        surface_faces,
+        data_faces,
+    }
+}
+
+/// The best cage measured so far.
+struct Best {
+    stage: usize,
+    badness: f64,
+    mesh: PolyMesh,
+    tags: Tags,
+    errors: ErrorStats,
+    two_sided: TwoSided,
+}
+
+/// Fits `mesh` (control points in the target's normalized units; crease and corner tags in
+/// `base.tags`) to `target` in stages. `base` gives the scheme, method, step control and sample
+/// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
-/// Errors: those of [`Fitter::new`] and [`Fitter::run`]; invalid stage options.
-/// Cost: per stage, one [`Fitter`] setup (sampling operator, symbolic analysis) and its
-/// iterations; flips cost one more sampling operator and projection.
+/// After each stage's fit the cage is measured both ways (surface → data with fresh foot
+/// points; data → surface from the target's data samples, [`subfit_report::data_samples`],
+/// to the tessellation of the limit samples); the tolerances are judged on both
+/// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
+/// direction, so data the surface leaves uncovered gets control points. The cage returned is
+/// the best measured at a stage's end — the lowest ratio of error to tolerance over the
+/// tolerances set (the two-sided `E_rms` when none is) — never one refined and not yet
+/// optimized: no refinement or flip is made when no iteration or stage is left to fit it.
+///
+/// Errors: those of [`Fitter::new`] and [`Fitter::run`]; invalid stage options. Cost: per topology one [`Fitter`] setup (sampling
+/// operator, symbolic analysis); per stage its iterations and one measurement (one projection
+/// of the samples, a BVH over their tessellation and one query per data sample); flips cost one more sampling operator and projection.
 pub fn fit_stages(
     target: &Target,
     mesh: &PolyMesh,
@@ -285,8 +436,9 @@ pub fn fit_stages(
 ) -> Result<StagesResult, FitError> {
     stages.validate()?;
     let t0 = Instant::now();
+    let data = data_samples(target, stages.data_samples);
     let mut mesh = PolyMesh::new(mesh.positions.clone(), mesh.faces.clone());
-    let tags = Tags::new();
+    let mut tags = base.tags.clone();
     let mut lambda = stages.lambda_start;
     // Refinement depth of every face (0 for the initial faces).
     let mut depth = vec![0u8; mesh.faces.len()];
@@ -294,84 +446,134 @@ pub fn fit_stages(
     let mut initial = None;
     let mut stop = StageStop::Limit;
     let mut used = 0;
+    let mut best: Option<Best> = None;
+    // Whether data → surface met the tolerances at the last measurement: until it does, a
+    // stage does not stop at the one-sided tolerance.
+    let mut data_met = !stages.two_sided;
     // Vertices the last change touched, for a local stage.
     let mut touched: Option<Vec<bool>> = None;
+    let mut topo: Option<Topo<'_>> = None;
     for stage in 0..stages.max_stages {
         if used >= stages.max_iterations {
             break;
         }
         let ts = Instant::now();
-        let opts = FitOptions {
-            lambda,
-            max_iterations: stages
-                .iterations_per_stage
-                .min(stages.max_iterations - used),
-            tolerance_rms: stages.tolerance_rms,
-            tolerance_max: stages.tolerance_max,
-            min_relative_decrease: stages.stall,
+        let stage_opts = FitOptions {
+            tags: tags.clone(),
             ..base.clone()
         };
+        let t = match &mut topo {
+            Some(t) => t,
+            None => topo.insert(Topo::new(target, &mesh, &stage_opts)?),
+        };
+        let (tol_rms, tol_max) = if data_met {
+            (stages.tolerance_rms, stages.tolerance_max)
+        } else {
+            (0.0, 0.0)
+        };
+        t.fitter.set_stage(
+            lambda,
+            stages
+                .iterations_per_stage
+                .min(stages.max_iterations - used),
+            tol_rms,
+            tol_max,
+            stages.stall,
+        );
         let n = mesh.num_vertices();
-        let mut fitter = Fitter::new(target, &mesh.faces, n, &tags, &opts)?;
         let active = touched
             .take()
             .and_then(|seed| local_region(&mesh.faces, seed, stages.local_rings));
         let active_points = active.as_ref().map(|a| a.iter().filter(|&&x| x).count());
-        if active.is_some() {
-            fitter.set_active(active)?;
-        }
+        t.fitter.set_active(active)?;
+        let initial_two_sided = match initial {
+            None => Some(measure(t, &mesh.faces, &mesh.positions, &data.points).two_sided),
+            Some(_) => None,
+        };
         let fit = {
             let mut cb = |row: &IterationRow| {
                 if let Some(p) = progress.as_mut() {
                     p(StageEvent::Iteration { stage, row });
                 }
             };
-            fitter.run(&mut mesh.positions, Some(&mut cb))?
+            t.fitter.run(&mut mesh.positions, Some(&mut cb))?
         };
-        initial.get_or_insert(fit.initial);
         used += fit.iterations.len().max(1);
         let last = fit.last();
+        let m = measure(t, &mesh.faces, &mesh.positions, &data.points);
+        initial.get_or_insert((fit.initial, initial_two_sided.unwrap_or(m.two_sided)));
+        data_met = !stages.two_sided
+            || m.two_sided
+                .data_to_surface
+                .within(stages.tolerance_rms, stages.tolerance_max);
         let mut report = StageReport {
             stage,
             lambda,
             num_control_points: n,
             num_faces: mesh.faces.len(),
             fit,
+            two_sided: m.two_sided,
             flips_tried: 0,
             flips_kept: 0,
             refine: None,
             active_points,
             time: Duration::ZERO,
         };
+        let badness = stages.badness(&last, &m.two_sided);
+        if best.as_ref().is_none_or(|b| badness < b.badness) {
+            best = Some(Best {
+                stage,
+                badness,
+                mesh: mesh.clone(),
+                tags: tags.clone(),
+                errors: last,
+                two_sided: m.two_sided,
+            });
+        }
         let next_lambda = (lambda * stages.lambda_factor).max(stages.lambda_end);
         let mut changed = next_lambda < lambda;
-        if stages.reached(&last) {
+        // Change the cage only if an iteration of a later stage can fit the change.
+        let room = used < stages.max_iterations && stage + 1 < stages.max_stages;
+        if stages.met(&last, &m.two_sided) {
             stop = StageStop::Tolerance;
-        } else if mesh.faces.is_triangles() && (stages.refine || stages.edge_flips) {
-            let errors = sample_face_errors(target, &mesh, &fitter);
-            drop(fitter);
+        } else if room && mesh.faces.is_triangles() && (stages.refine || stages.edge_flips) {
+            let unmet = stages.unmet(&last, &m.two_sided);
+            let mut score: Vec<f64> = m
+                .surface_faces
+                .iter()
+                .zip(&m.data_faces)
+                .map(|(s, d)| face_score(s, stages, unmet).max(face_score(d, stages, unmet)))
+                .collect();
             let mut seed = stages.local.then(|| vec![false; n]);
-            let errors = if stages.edge_flips {
-                let before = seed.is_some().then(|| mesh.faces.clone());
-                let (tried, kept, errs) =
-                    flip_pass(target, &mut mesh, errors, stages, base, &last)?;
+            let before = mesh.faces.clone();
+            if stages.edge_flips {
+                let (tried, kept) = flip_pass(
+                    target,
+                    &mut mesh,
+                    (&m.surface_faces, &m.data_faces),
+                    &mut score,
+                    stages,
+                    unmet,
+                    &stage_opts,
+                )?;
                 report.flips_tried = tried;
                 report.flips_kept = kept;
                 changed |= kept > 0;
-                if let (Some(seed), Some(before)) = (seed.as_mut(), before) {
+                if let Some(seed) = seed.as_mut() {
                     mark_flipped(seed, &before, &mesh.faces);
                 }
-                errs
-            } else {
-                errors
-            };
+            }
             if stages.refine && n < stages.max_control_points {
-                if let Some((refined, rs, d)) = refine_step(&mesh, &errors, &depth, stages, &last) {
+                if let Some((refined, rs, d)) = refine_step(&mesh, &score, &depth, stages) {
                     changed |= rs.new_points > 0;
+                    tags = carry_tags(&tags, n, &refined.faces);
                     mesh = refined;
                     depth = d;
                     report.refine = Some(rs);
                 }
+            }
+            if mesh.faces != before {
+                topo = None;
             }
             if let Some(mut seed) = seed {
                 mark_refined(&mut seed, n, &mesh.faces, mesh.num_vertices());
@@ -386,6 +588,10 @@ pub fn fit_stages(
         if stop == StageStop::Tolerance {
             break;
         }
+        if !room {
+            stop = StageStop::Limit;
+            break;
+        }
         if !changed {
             stop = if mesh.num_vertices() >= stages.max_control_points {
                 StageStop::Budget
@@ -396,26 +602,18 @@ pub fn fit_stages(
         }
         lambda = next_lambda;
     }
-    // The last stage may have changed the mesh after its fit: report the errors of what is
-    // returned.
-    let last = if reports
-        .last()
-        .is_some_and(|r| r.refine.is_some_and(|x| x.new_points > 0) || r.flips_kept > 0)
-    {
-        let opts = FitOptions {
-            lambda,
-            ..base.clone()
-        };
-        Fitter::new(target, &mesh.faces, mesh.num_vertices(), &tags, &opts)?
-            .evaluate(&mesh.positions)
-    } else {
-        reports.last().map(|r| r.fit.last()).unwrap_or_default()
-    };
+    let (initial, initial_two_sided) = initial.unwrap_or_default();
+    let best = best.ok_or_else(|| FitError::BadInput("no stage was run".into()))?;
     Ok(StagesResult {
-        mesh,
+        mesh: best.mesh,
+        tags: best.tags,
         report: StagesReport {
-            initial: initial.unwrap_or_default(),
-            last,
+            initial,
+            initial_two_sided,
+            last: best.errors,
+            two_sided: best.two_sided,
+            best_stage: best.stage,
+            data_samples: data.kind,
             stages: reports,
             stop,
             time: t0.elapsed(),
@@ -423,72 +621,51 @@ pub fn fit_stages(
     })
 }
 
-/// Squared sample errors with fresh foot points, gathered per control face.
-fn sample_face_errors(target: &Target, mesh: &PolyMesh, fitter: &Fitter<'_>) -> Vec<FaceError> {
-    let op = fitter.sampling_operator();
-    let samples = op.position.apply(&mesh.positions);
-    let err2 = squared_errors(target, fitter.options().foot_points, &samples);
-    face_errors(&mesh.faces, op, &err2)
-}
-
-fn squared_errors(target: &Target, source: FootPointSource, samples: &[[f64; 3]]) -> Vec<f64> {
-    let feet = crate::feet::foot_points(target, source, samples);
-    samples
-        .par_iter()
-        .zip(feet.par_iter())
-        .map(|(s, f)| (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum())
-        .collect()
-}
-
 /// How far above the tolerance a face is (`> 1`: too large), counting only the tolerances the
-/// whole surface does not meet yet: once `E_rms` is within its tolerance, a face whose own RMS
-/// is above it needs no refinement for it (the budget goes where `E_max` is still missed).
-fn face_score(e: &FaceError, stages: &StageOptions, last: &ErrorStats) -> f64 {
-    let rms_unmet = stages.tolerance_rms > 0.0 && last.e_rms > stages.tolerance_rms;
-    let max_unmet = stages.tolerance_max > 0.0 && last.e_max > stages.tolerance_max;
+/// whole surface does not meet yet (`unmet`: RMS, max): once `E_rms` is within its tolerance,
+/// a face whose own RMS is above it needs no refinement for it (the budget goes where `E_max`
+/// is still missed).
+fn face_score(e: &FaceError, stages: &StageOptions, unmet: (bool, bool)) -> f64 {
     let mut s: f64 = 0.0;
-    if rms_unmet {
+    if unmet.0 {
         s = s.max(e.rms() / stages.tolerance_rms);
     }
-    if max_unmet {
+    if unmet.1 {
         s = s.max(e.max / stages.tolerance_max);
-    }
-    if stages.tolerance_rms <= 0.0 && stages.tolerance_max <= 0.0 {
-        // No tolerance: refine where the error is above the current RMS.
-        s = e.rms() / last.e_rms.max(f64::MIN_POSITIVE);
     }
     s
 }
 
 /// Tries independent edge flips on faces scoring above the tolerance with the current
-/// control points (no re-fit): a flip is kept when the squared error summed over the faces
-/// whose limit it changes goes down. Returns (tried, kept, per-face errors of the result).
+/// control points (no re-fit): a flip is kept when the squared surface → data error summed
+/// over the faces whose limit it changes goes down; the scores of those faces are updated.
+/// Returns (tried, kept).
 fn flip_pass(
     target: &Target,
     mesh: &mut PolyMesh,
-    errors: Vec<FaceError>,
+    (surface, data): (&[FaceError], &[FaceError]),
+    score: &mut [f64],
     stages: &StageOptions,
+    unmet: (bool, bool),
     base: &FitOptions,
-    last: &ErrorStats,
-) -> Result<(usize, usize, Vec<FaceError>), FitError> {
-    let score: Vec<f64> = errors.iter().map(|e| face_score(e, stages, last)).collect();
-    let flips = independent_flips(&mesh.faces, mesh.num_vertices(), &score, 1.0);
+) -> Result<(usize, usize), FitError> {
+    let flips = independent_flips(&mesh.faces, mesh.num_vertices(), score, 1.0);
     if flips.is_empty() {
-        return Ok((0, 0, errors));
+        return Ok((0, 0));
     }
     let flipped = apply_flips(&mesh.faces, &flips);
     let op = sampling_operator(
         &flipped,
         mesh.num_vertices(),
-        &Tags::new(),
-        &Options::new(base.scheme),
+        &base.tags,
+        &base.subdivision(),
         base.sample_level,
     )?;
     let samples = op.position.apply(&mesh.positions);
     let new_errors = face_errors(
         &flipped,
         &op,
-        &squared_errors(target, base.foot_points, &samples),
+        &crate::feet::squared_errors(target, base.foot_points, &samples),
     );
     // Faces incident to each vertex of the old mesh (the same faces are incident to a, b, c,
     // d in both meshes).
@@ -499,7 +676,6 @@ fn flip_pass(
         }
     }
     let mut kept = Vec::new();
-    let mut result = errors.clone();
     for fl in &flips {
         let mut region: Vec<u32> = [fl.a, fl.b, fl.c, fl.d]
             .iter()
@@ -507,30 +683,31 @@ fn flip_pass(
             .collect();
         region.sort_unstable();
         region.dedup();
-        let before: f64 = region.iter().map(|&f| errors[f as usize].sum_sq).sum();
+        let before: f64 = region.iter().map(|&f| surface[f as usize].sum_sq).sum();
         let after: f64 = region.iter().map(|&f| new_errors[f as usize].sum_sq).sum();
         if after < before {
             kept.push(*fl);
             for &f in &region {
-                result[f as usize] = new_errors[f as usize];
+                let f = f as usize;
+                score[f] = face_score(&new_errors[f], stages, unmet)
+                    .max(face_score(&data[f], stages, unmet));
             }
         }
     }
     if !kept.is_empty() {
         mesh.faces = apply_flips(&mesh.faces, &kept);
     }
-    Ok((flips.len(), kept.len(), result))
+    Ok((flips.len(), kept.len()))
 }
 
-/// Marks the faces above the tolerance, worst first, within the growth and control-point
-/// budget and the refinement depth, and refines them with red-green closure. Returns the new
-/// mesh, what was done, and the depth of every new face.
+/// Marks the faces scoring above 1, worst first, within the growth and control-point budget
+/// and the refinement depth, and refines them with red-green closure. Returns the new mesh,
+/// what was done, and the depth of every new face.
 fn refine_step(
     mesh: &PolyMesh,
-    errors: &[FaceError],
+    score: &[f64],
     depth: &[u8],
     stages: &StageOptions,
-    last: &ErrorStats,
 ) -> Option<(PolyMesh, RefineStats, Vec<u8>)> {
     let n = mesh.num_vertices();
     let room = stages.max_control_points.saturating_sub(n);
@@ -538,11 +715,11 @@ fn refine_step(
     if allowed == 0 {
         return None;
     }
-    let mut order: Vec<(f64, usize)> = errors
+    let mut order: Vec<(f64, usize)> = score
         .iter()
         .enumerate()
         .filter(|&(f, _)| depth[f] < stages.max_depth)
-        .map(|(f, e)| (face_score(e, stages, last), f))
+        .map(|(f, &s)| (s, f))
         .filter(|(s, _)| *s > 1.0)
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
@@ -584,5 +761,89 @@ fn refine_step(
             return Some((refined, rs, d));
         }
         take = (take * 3 / 4).max(1);
+    }
+}
+
+/// The tags of a cage carried to its refinement (`faces`, whose first `old_n` points are the
+/// cage's): a tagged edge that is still an edge keeps its tag; a split one passes it to both
+/// halves, through its new midpoint (the new point joined to both ends). Corners keep theirs.
+fn carry_tags(tags: &Tags, old_n: usize, faces: &Polygons) -> Tags {
+    if tags.is_empty() {
+        return Tags::new();
+    }
+    let mut edges: HashSet<(u32, u32)> = HashSet::new();
+    for f in faces.iter() {
+        for i in 0..f.len() {
+            let (a, b) = (f[i], f[(i + 1) % f.len()]);
+            edges.insert((a.min(b), a.max(b)));
+        }
+    }
+    let has = |a: u32, b: u32| edges.contains(&(a.min(b), a.max(b)));
+    // New points by their neighbours among the old ones.
+    let mut by_ends: std::collections::HashMap<(u32, u32), u32> = Default::default();
+    let mut nbrs: Vec<Vec<u32>> = Vec::new();
+    for &(a, b) in &edges {
+        for (o, m) in [(a, b), (b, a)] {
+            if (m as usize) >= old_n && (o as usize) < old_n {
+                let k = m as usize - old_n;
+                if nbrs.len() <= k {
+                    nbrs.resize(k + 1, Vec::new());
+                }
+                nbrs[k].push(o);
+            }
+        }
+    }
+    for (k, ns) in nbrs.iter().enumerate() {
+        for (i, &a) in ns.iter().enumerate() {
+            for &b in &ns[i + 1..] {
+                by_ends.insert((a.min(b), a.max(b)), (old_n + k) as u32);
+            }
+        }
+    }
+    let mut out = Tags::new();
+    for ((a, b), s) in tags.creases() {
+        if has(a, b) {
+            out.set_crease(a, b, s);
+        } else if let Some(&m) = by_ends.get(&(a.min(b), a.max(b))) {
+            out.set_crease(a, m, s);
+            out.set_crease(m, b, s);
+        }
+    }
+    for (v, s) in tags.corners() {
+        out.set_corner(v, s);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::adapt::refine_red_green;
+    use subfit_mesh::shapes::octahedron_mesh;
+
+    /// A crease on a split edge passes to both halves; one on an unsplit edge stays.
+    #[test]
+    fn tags_survive_refinement() {
+        let mesh = octahedron_mesh(1.0, 1.0, 1.0);
+        let f0 = mesh.faces.iter().next().unwrap().to_vec();
+        let mut tags = Tags::new();
+        tags.set_crease(f0[0], f0[1], 2.0);
+        tags.set_corner(f0[2], 1.0);
+        let n = mesh.num_vertices();
+        let mut marked = vec![false; mesh.faces.len()];
+        marked[0] = true;
+        let (refined, _) = refine_red_green(&mesh, &marked).unwrap();
+        let out = carry_tags(&tags, n, &refined.faces);
+        let creases = out.creases();
+        assert_eq!(creases.len(), 2, "{creases:?}");
+        for ((a, b), s) in creases {
+            assert_eq!(s, 2.0);
+            let (old, new) = if (a as usize) < n { (a, b) } else { (b, a) };
+            assert!([f0[0], f0[1]].contains(&old) && new as usize >= n);
+        }
+        assert_eq!(out.corner(f0[2]), 1.0);
+        // Nothing split: the tags as they were.
+        let same = carry_tags(&tags, n, &mesh.faces);
+        assert_eq!(same.creases(), tags.creases());
     }
 }

@@ -26,8 +26,7 @@ fn run<'t>(
     opts: &FitOptions,
     active: Option<Vec<bool>>,
 ) -> (Vec<[f64; 3]>, FitReport, Fitter<'t>) {
-    let mut fitter =
-        Fitter::new(target, &mesh.faces, mesh.num_vertices(), &Tags::new(), opts).expect("fitter");
+    let mut fitter = Fitter::new(target, &mesh.faces, mesh.num_vertices(), opts).expect("fitter");
     fitter.set_active(active).expect("active set");
     let mut p = mesh.positions.clone();
     let report = fitter.run(&mut p, None).expect("fit");
@@ -107,14 +106,7 @@ fn subset_keeps_inactive_points_and_decreases_the_objective() {
 fn changing_the_mask_keeps_the_errors_exact() {
     let (target, mesh) = setup();
     let opts = options(Variant::SdmLm).with_max_iterations(2);
-    let mut fitter = Fitter::new(
-        &target,
-        &mesh.faces,
-        mesh.num_vertices(),
-        &Tags::new(),
-        &opts,
-    )
-    .expect("fitter");
+    let mut fitter = Fitter::new(&target, &mesh.faces, mesh.num_vertices(), &opts).expect("fitter");
     let n = mesh.num_vertices();
     let mut p = mesh.positions.clone();
     let first: Vec<bool> = (0..n).map(|i| i % 2 == 0).collect();
@@ -147,7 +139,6 @@ fn bad_masks_are_typed_errors() {
         &target,
         &mesh.faces,
         mesh.num_vertices(),
-        &Tags::new(),
         &options(Variant::SdmLm),
     )
     .expect("fitter");

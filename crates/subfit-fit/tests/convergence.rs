@@ -94,14 +94,7 @@ fn fitter_stops_at_tolerance_with_smoothing() {
         .with_lambda(1e-5)
         .with_tolerance_rms(TOL)
         .with_max_iterations(20);
-    let mut fitter = Fitter::new(
-        &target,
-        &mesh.faces,
-        mesh.num_vertices(),
-        &Tags::new(),
-        &opts,
-    )
-    .unwrap();
+    let mut fitter = Fitter::new(&target, &mesh.faces, mesh.num_vertices(), &opts).unwrap();
     let mut p = mesh.positions.clone();
     let mut calls = 0;
     let mut cb = |_: &subfit_fit::IterationRow| calls += 1;

@@ -23,14 +23,7 @@ fn non_finite_and_empty_input_are_typed() {
     let target = common::ellipsoid_target(3_000);
     let mesh = common::normalized(&target, &common::fourteen_vertex_mesh());
     let opts = FitOptions::default();
-    let mut fitter = Fitter::new(
-        &target,
-        &mesh.faces,
-        mesh.num_vertices(),
-        &Tags::new(),
-        &opts,
-    )
-    .unwrap();
+    let mut fitter = Fitter::new(&target, &mesh.faces, mesh.num_vertices(), &opts).unwrap();
     let mut p = mesh.positions.clone();
     p[3][1] = f64::NAN;
     assert!(matches!(
@@ -43,7 +36,7 @@ fn non_finite_and_empty_input_are_typed() {
         Err(FitError::BadInput(_))
     ));
     assert!(matches!(
-        Fitter::new(&target, &Polygons::new(), 0, &Tags::new(), &opts),
+        Fitter::new(&target, &Polygons::new(), 0, &opts),
         Err(FitError::BadInput(_))
     ));
     // Quads are not valid for Loop.

@@ -60,15 +60,9 @@ fn local_stages_optimize_a_region_and_report_whole_surface_errors() {
     // full evaluation of the returned cage.
     let lambda = r.stages.last().unwrap().lambda;
     let opts = FitOptions { lambda, ..base };
-    let fresh = Fitter::new(
-        &target,
-        &out.mesh.faces,
-        out.mesh.num_vertices(),
-        &Tags::new(),
-        &opts,
-    )
-    .unwrap()
-    .evaluate(&out.mesh.positions);
+    let fresh = Fitter::new(&target, &out.mesh.faces, out.mesh.num_vertices(), &opts)
+        .unwrap()
+        .evaluate(&out.mesh.positions);
     let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-300);
     assert!(
         rel(r.last.e_rms, fresh.e_rms) < 1e-9,

@@ -1,16 +1,45 @@
 //! subfit: fit compact subdivision surfaces to dense 3D scans.
 //!
-//! This facade re-exports the workspace crates:
+//! The front door is [`fit_scan`]: the whole pipeline — read or take the scan, analyse it,
+//! build an initial control mesh with its topology, fit it in stages while measuring the error
+//! both ways, keep the best cage — returning a [`Fitted`] cage in the input's coordinates with
+//! a typed [`Report`] (`report.json` is its serialization) that can write every output
+//! ([`Fitted::write_into`], [`OUTPUTS`]). The command-line tool, its demo and benchmarks call
+//! it; none re-implements a step.
+//!
+//! ```no_run
+//! use subfit::{fit_scan, FitScanOptions, Input};
+//!
+//! let mut fitted = fit_scan(Input::File("scan.ply".into()), &FitScanOptions::default(), None)?;
+//! println!("{}", fitted.summary());
+//! std::fs::create_dir_all("out")?;
+//! fitted.write_into(std::path::Path::new("out"))?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! The workspace crates are re-exported:
 //! - [`mesh`]: polygon topology, half-edge view, diagnostics, generated shapes;
-//! - [`io`]: PLY, OBJ, OFF, STL and XYZ readers and writers;
+//! - [`io`]: PLY, OBJ, OFF, STL and XYZ readers and writers, USDA cages;
 //! - [`subdiv`]: subdivision schemes, stencils and limit evaluation;
 //! - [`target`]: the shape being fitted (normals, curvature, foot points);
-//! - [`fit`]: the fitting engine (PDM/TDM/SDM, smoothing, LM and Armijo step control);
-//! - [`init`]: initial control meshes with the target's topology (QEM simplification, contouring).
+//! - [`fit`]: the fitting engine (PDM/TDM/SDM, smoothing, LM and Armijo step control, stages);
+//! - [`init`]: initial control meshes with the target's topology (QEM simplification, contouring);
+//! - [`report`]: two-sided distances, error colours, the limit tessellation, plots.
+
+mod error;
+mod outputs;
+pub mod pipeline_report;
+mod scan;
+
+pub use error::Error;
+pub use outputs::{log_csv, OUTPUTS};
+pub use pipeline_report::Report;
+pub use scan::{fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
 
 pub use subfit_fit as fit;
 pub use subfit_init as init;
 pub use subfit_io as io;
 pub use subfit_mesh as mesh;
+pub use subfit_report as report;
 pub use subfit_subdiv as subdiv;
 pub use subfit_target as target;

@@ -16,7 +16,7 @@ use subfit::mesh::PolyMesh;
 use subfit::target::{Target, TargetOptions};
 
 use crate::cli::{BenchCommand, ConvergenceArgs};
-use crate::plot::{log_chart, Series};
+use subfit::report::plot::{log_chart, Series};
 
 /// The paper's convergence threshold on `E_rms` (unit cube).
 const TOLERANCE: f64 = 0.002;

@@ -1,4 +1,4 @@
-//! `subfit bench fit`: the whole pipeline of `subfit fit` on the models of `$SUBFIT_DATA`, with
+//! `subfit bench fit`: the whole pipeline ([`subfit::fit_scan`]) on the models of `$SUBFIT_DATA`, with
 //! the tolerances and control-point budgets of the papers' tables (DESIGN.md §5), printed as a
 //! table next to the papers' figures and written to `summary.json`. Igea is fitted as a point
 //! cloud (its faces ignored), like Cheng 2007's scan, and once more as a mesh (`igea-mesh`); the
@@ -7,32 +7,51 @@
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use clap::Parser;
 use serde_json::json;
+use subfit::{FitScanOptions, Input};
 
-use crate::cli::{Args, BenchFitArgs, Command};
+use crate::cli::BenchFitArgs;
 
-/// A benchmark model: file, extra `fit` flags, and the paper's row for comparison.
+/// A benchmark model: file, how it is fitted, and the paper's row for comparison.
 struct Model {
     name: &'static str,
     file: &'static str,
-    flags: &'static [&'static str],
+    /// Fit the points only (faces ignored).
+    as_points: bool,
+    /// `E_rms` tolerance (unit cube).
+    tolerance: f64,
+    /// `E_max` tolerance (unit cube), if any.
+    max_error: Option<f64>,
+    /// Control-point budget, if not the default.
+    max_control_points: Option<usize>,
     paper: &'static str,
+}
+
+impl Model {
+    /// The options of the row (both ways unless `one_sided`).
+    fn options(&self, one_sided: bool) -> FitScanOptions {
+        let mut o = FitScanOptions {
+            as_points: self.as_points,
+            ..FitScanOptions::default()
+        };
+        o.stages.tolerance_rms = self.tolerance;
+        o.stages.tolerance_max = self.max_error.unwrap_or(0.0);
+        if let Some(n) = self.max_control_points {
+            o.stages.max_control_points = n;
+        }
+        o.stages.two_sided = !one_sided;
+        o
+    }
 }
 
 const MODELS: &[Model] = &[
     Model {
         name: "igea",
         file: "igea.ply",
-        flags: &[
-            "--as-points",
-            "--tolerance",
-            "0.0005",
-            "--max-error",
-            "0.0036",
-            "--max-control-points",
-            "2385",
-        ],
+        as_points: true,
+        tolerance: 0.0005,
+        max_error: Some(0.0036),
+        max_control_points: Some(2385),
         paper: "Cheng 2007 Tab. IV: 526 → 2,385 cp, E_max 0.0036, E_rms 0.0005, 152 s + 252 s",
     },
     // The same scan fitted to its triangles: the points leave a hole at the bottom of a pit
@@ -42,45 +61,46 @@ const MODELS: &[Model] = &[
     Model {
         name: "igea-mesh",
         file: "igea.ply",
-        flags: &[
-            "--tolerance",
-            "0.0005",
-            "--max-error",
-            "0.0036",
-            "--max-control-points",
-            "2385",
-        ],
+        as_points: false,
+        tolerance: 0.0005,
+        max_error: Some(0.0036),
+        max_control_points: Some(2385),
         paper: "as igea (E_max 0.0036 also required), foot points on the scan's triangles",
     },
     Model {
         name: "rocker-arm",
         file: "rocker-arm.off",
-        flags: &[
-            "--tolerance",
-            "0.0003",
-            "--max-error",
-            "0.0029",
-            "--max-control-points",
-            "950",
-        ],
+        as_points: false,
+        tolerance: 0.0003,
+        max_error: Some(0.0029),
+        max_control_points: Some(950),
         paper: "Cheng 2007 Tab. IV: 870 → 950 cp, E_max 0.0029, E_rms 0.0003, 78 s + 85 s",
     },
     Model {
         name: "stanford-bunny",
         file: "stanford-bunny.obj",
-        flags: &["--tolerance", "0.0009", "--max-control-points", "996"],
+        as_points: false,
+        tolerance: 0.0009,
+        max_error: None,
+        max_control_points: Some(996),
         paper: "Cheng 2007 Tab. IV (bunny): 919 → 996 cp, E_max 0.0082, E_rms 0.0009, 77 s + 361 s",
     },
     Model {
         name: "fertility",
         file: "fertility.off",
-        flags: &["--tolerance", "0.001"],
-        paper: "issue 6: genus 4 kept, E_rms ≤ 0.001",
+        as_points: false,
+        tolerance: 0.001,
+        max_error: None,
+        max_control_points: None,
+        paper: "genus 4 kept, E_rms ≤ 0.001 (our own target)",
     },
     Model {
         name: "armadillo",
         file: "armadillo.obj",
-        flags: &["--tolerance", "0.001"],
+        as_points: false,
+        tolerance: 0.001,
+        max_error: None,
+        max_control_points: None,
         paper: "Cheng 2004 Tab. 2: 9,602 cp, E_max 0.0212, E_rms 0.0020, 624 s",
     },
 ];
@@ -116,65 +136,72 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
             bail!("{}: missing", file.display());
         }
         let dir = a.output.join(m.name);
-        let mut argv = vec![
-            "subfit",
-            "fit",
-            file.to_str().context("path is not UTF-8")?,
-            "-o",
-            dir.to_str().context("path is not UTF-8")?,
-        ];
-        argv.extend_from_slice(m.flags);
-        let Command::Fit(fit_args) = Args::try_parse_from(&argv)?.command else {
-            unreachable!("parsed a fit command")
+        let options = m.options(a.one_sided);
+        let (mesh, _) = crate::progress::load(&file)?;
+        let input = Input::Mesh {
+            mesh,
+            name: file.display().to_string(),
         };
-        let out = crate::commands::fit::execute(&fit_args)
-            .with_context(|| format!("fitting {}", m.name))?;
-        let r = &out.report;
-        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-        let t = &r["timings_s"];
-        let iterations = r["iterations"].as_array().map_or(0, Vec::len);
+        let mut fitted = crate::commands::fit::run_with_progress(
+            input,
+            &options,
+            options.stages.max_iterations as u64,
+        )
+        .with_context(|| format!("fitting {}", m.name))?;
+        crate::commands::fit::write_outputs(&mut fitted, &dir)?;
+        let r = &fitted.report;
+        let t = &r.timings_s;
+        let two = &r.r#final.two_sided;
         rows.push(format!(
-            "{:<15} {:>7} {:>5} → {:<5} {:>5} {:>10.2e} {:>10.2e} {:>4} {:>6.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2}\n{:<15} paper: {}",
+            "{:<15} {:>7} {:>5} → {:<5} {:>5} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>4} {:>6.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2}\n{:<15} paper: {}",
             m.name,
-            r["target_points"].as_u64().unwrap_or(0),
-            r["init"]["control_points"].as_u64().unwrap_or(0),
-            r["control_points"].as_u64().unwrap_or(0),
-            iterations,
-            f(&r["final"]["e_max"]),
-            f(&r["final"]["e_rms"]),
-            if out.reached { "yes" } else { "no" },
-            f(&t["preprocess"]),
-            f(&t["init"]),
-            f(&t["fit"]),
-            f(&t["output"]),
-            f(&t["total"]),
+            r.target_points,
+            r.init.control_points,
+            r.control_points,
+            r.iterations.len(),
+            r.r#final.e_max,
+            r.r#final.e_rms,
+            two.e_max,
+            two.e_rms,
+            if fitted.reached() { "yes" } else { "no" },
+            t.preprocess,
+            t.init,
+            t.fit,
+            t.output,
+            t.total,
             "",
             m.paper
         ));
         summary.push(json!({
             "model": m.name,
             "file": m.file,
-            "flags": m.flags,
+            "as_points": m.as_points,
+            "tolerance": m.tolerance,
+            "max_error": m.max_error,
+            "max_control_points": m.max_control_points,
+            "two_sided": !a.one_sided,
             "paper": m.paper,
-            "tolerance_reached": out.reached,
-            "target_points": r["target_points"],
-            "init_control_points": r["init"]["control_points"],
-            "control_points": r["control_points"],
-            "genus": { "target": r["init"]["genus_target"], "cage": r["init"]["genus"] },
-            "iterations": iterations,
-            "stages": r["stages"].as_array().map_or(0, Vec::len),
-            "final": r["final"],
-            "timings_s": r["timings_s"],
+            "tolerance_reached": fitted.reached(),
+            "target_points": r.target_points,
+            "init_control_points": r.init.control_points,
+            "control_points": r.control_points,
+            "genus": { "target": r.init.genus_target, "cage": r.init.genus },
+            "iterations": r.iterations.len(),
+            "stages": r.stages.len(),
+            "final": r.r#final,
+            "timings_s": r.timings_s,
         }));
     }
     println!(
-        "{:<15} {:>7} {:>13} {:>5} {:>10} {:>10} {:>4} {:>6} {:>6} {:>6} {:>6} {:>7}",
+        "{:<15} {:>7} {:>13} {:>5} {:>10} {:>10} {:>10} {:>10} {:>4} {:>6} {:>6} {:>6} {:>6} {:>7}",
         "model",
         "points",
         "control pts",
         "iters",
         "E_max",
         "E_rms",
+        "2s E_max",
+        "2s E_rms",
         "met",
         "prep s",
         "init s",
@@ -185,7 +212,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
     for r in rows {
         println!("{r}");
     }
-    println!("(errors in unit-cube units; `met`: the row's tolerance and budget were met)");
+    println!("(errors in unit-cube units; E_max/E_rms surface → data as in the papers, 2s: the worse of both directions; `met`: the row's tolerances held {})", if a.one_sided { "surface → data" } else { "both ways" });
     crate::interrupt::watch_dir(&a.output.join("summary.json"));
     subfit::io::write_atomic(
         &a.output.join("summary.json"),

@@ -1,17 +1,17 @@
 //! `subfit demo`: the whole pipeline on the built-in shapes, with no input. Samples the paper
 //! ellipsoid (semi-axes 0.25/0.5/1.0), a torus and a genus-2 surface as point clouds (binary
-//! PLY with normals), fits each with `subfit fit`'s defaults (automatic initial mesh of the
+//! PLY with normals), fits each with [`subfit::fit_scan`]'s defaults (those of `subfit fit`) (automatic initial mesh of the
 //! shape's genus, multi-stage SDM to `E_rms ≤ 5e-4`) into `DIR/fit-<shape>/`, and prints a
 //! summary table.
 
 use std::process::ExitCode;
 
 use anyhow::{bail, Context};
-use clap::Parser;
 use subfit::io::{Encoding, Format, WriteOptions};
 use subfit::mesh::shapes::Shape;
+use subfit::{FitScanOptions, Input};
 
-use crate::cli::{Args, Command, DemoArgs};
+use crate::cli::DemoArgs;
 
 pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
     if !(a.noise.is_finite() && (0.0..0.1).contains(&a.noise)) {
@@ -49,33 +49,34 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
             continue;
         }
         let dir = a.output.join(format!("fit-{name}"));
-        let argv = [
-            "subfit",
-            "fit",
-            path.to_str().context("output path is not UTF-8")?,
-            "-o",
-            dir.to_str().context("output path is not UTF-8")?,
-        ];
-        let Command::Fit(fit_args) = Args::try_parse_from(argv)?.command else {
-            unreachable!("parsed a fit command")
+        let input = Input::Mesh {
+            mesh: cloud.clone(),
+            name: path.display().to_string(),
         };
-        let out = crate::commands::fit::execute(&fit_args)
-            .with_context(|| format!("fitting the {name}"))?;
-        all_reached &= out.reached;
-        let r = &out.report;
-        let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+        let options = FitScanOptions::default();
+        let mut fitted = crate::commands::fit::run_with_progress(
+            input,
+            &options,
+            options.stages.max_iterations as u64,
+        )
+        .with_context(|| format!("fitting the {name}"))?;
+        crate::commands::fit::write_outputs(&mut fitted, &dir)?;
+        all_reached &= fitted.reached();
+        let r = &fitted.report;
         rows.push(format!(
-            "{:<10} {:>5} {:>5} {:>9} {:>6} → {:<6} {:>6} {:>10.2e} {:>10.2e} {:>7.1}  {}",
+            "{:<10} {:>5} {:>5} {:>9} {:>6} → {:<6} {:>6} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>7.1}  {}",
             name,
             shape.genus(),
-            r["init"]["genus"].as_u64().unwrap_or(0),
+            r.init.genus,
             cloud.num_vertices(),
-            r["init"]["control_points"].as_u64().unwrap_or(0),
-            r["control_points"].as_u64().unwrap_or(0),
-            r["stages"].as_array().map_or(0, Vec::len),
-            f(&r["final"]["e_rms"]),
-            f(&r["final"]["e_max"]),
-            f(&r["timings_s"]["total"]),
+            r.init.control_points,
+            r.control_points,
+            r.stages.len(),
+            r.r#final.e_rms,
+            r.r#final.e_max,
+            r.r#final.two_sided.e_rms,
+            r.r#final.two_sided.e_max,
+            r.timings_s.total,
             dir.display()
         ));
     }
@@ -86,7 +87,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         );
     } else {
         println!(
-            "{:<10} {:>5} {:>5} {:>9} {:>15} {:>6} {:>10} {:>10} {:>7}  output",
+            "{:<10} {:>5} {:>5} {:>9} {:>15} {:>6} {:>10} {:>10} {:>10} {:>10} {:>7}  output",
             "shape",
             "genus",
             "cage",
@@ -95,6 +96,8 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
             "stages",
             "E_rms",
             "E_max",
+            "2s E_rms",
+            "2s E_max",
             "time s"
         );
     }
@@ -102,7 +105,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         println!("{r}");
     }
     if !a.no_fit {
-        println!("(errors in unit-cube units: the shape scaled so that its longest side is 1)");
+        println!("(errors in unit-cube units: the shape scaled so that its longest side is 1; E_rms/E_max surface → data, 2s: the worse of both directions)");
     }
     Ok(if all_reached {
         ExitCode::SUCCESS

@@ -1,0 +1,130 @@
+//! Distance statistics, one way and both ways (DESIGN.md decision 11).
+//!
+//! Surface → data is Cheng et al.'s measure (2007 §II-B step 7): samples of the limit surface
+//! against their foot points on the data. Alone it reports success on shapes the surface
+//! leaves uncovered — boundaries that shrink, holes capped, rounded sharp edges — so a fit is
+//! also measured data → surface, from the data's points to their exact closest points on the
+//! limit surface, and a tolerance holds only when it holds both ways.
+
+use serde::{Deserialize, Serialize};
+
+/// Statistics of a set of distances (normalized units unless stated).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DistanceStats {
+    /// Number of distances.
+    pub samples: usize,
+    /// Root mean square.
+    pub rms: f64,
+    /// Mean.
+    pub mean: f64,
+    /// Largest.
+    pub max: f64,
+}
+
+impl DistanceStats {
+    /// Statistics of `d` (summed in order: deterministic for any thread count). Empty: all 0.
+    pub fn of(d: &[f64]) -> Self {
+        if d.is_empty() {
+            return Self::default();
+        }
+        let (mut s, mut s2, mut max) = (0.0, 0.0, 0.0f64);
+        for &x in d {
+            s += x;
+            s2 += x * x;
+            max = max.max(x);
+        }
+        let n = d.len() as f64;
+        Self {
+            samples: d.len(),
+            rms: (s2 / n).sqrt(),
+            mean: s / n,
+            max,
+        }
+    }
+
+    /// Statistics from squared distances.
+    pub fn of_squared(d2: &[f64]) -> Self {
+        let d: Vec<f64> = d2.iter().map(|x| x.max(0.0).sqrt()).collect();
+        Self::of(&d)
+    }
+
+    /// Whether the tolerances that are set (`> 0`) hold: RMS ≤ `tolerance_rms`, max ≤
+    /// `tolerance_max`; false when none is set.
+    pub fn within(&self, tolerance_rms: f64, tolerance_max: f64) -> bool {
+        let any = tolerance_rms > 0.0 || tolerance_max > 0.0;
+        any && (tolerance_rms <= 0.0 || self.rms <= tolerance_rms)
+            && (tolerance_max <= 0.0 || self.max <= tolerance_max)
+    }
+
+    /// The same scaled by `s` (e.g. normalized → original units).
+    pub fn scaled(self, s: f64) -> Self {
+        Self {
+            samples: self.samples,
+            rms: self.rms * s,
+            mean: self.mean * s,
+            max: self.max * s,
+        }
+    }
+}
+
+/// Distances both ways between a limit surface and its data.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwoSided {
+    /// Limit-surface samples to the data (Cheng's measure).
+    pub surface_to_data: DistanceStats,
+    /// Data points to their exact closest points on the limit surface.
+    pub data_to_surface: DistanceStats,
+}
+
+impl TwoSided {
+    /// The worse RMS of the two directions.
+    pub fn rms(&self) -> f64 {
+        self.surface_to_data.rms.max(self.data_to_surface.rms)
+    }
+
+    /// The worse maximum of the two directions (the Hausdorff distance of the two sample sets).
+    pub fn max(&self) -> f64 {
+        self.surface_to_data.max.max(self.data_to_surface.max)
+    }
+
+    /// Whether both directions meet the tolerances that are set (`> 0`); false when none is.
+    pub fn within(&self, tolerance_rms: f64, tolerance_max: f64) -> bool {
+        self.surface_to_data.within(tolerance_rms, tolerance_max)
+            && self.data_to_surface.within(tolerance_rms, tolerance_max)
+    }
+
+    /// The same scaled by `s`.
+    pub fn scaled(self, s: f64) -> Self {
+        Self {
+            surface_to_data: self.surface_to_data.scaled(s),
+            data_to_surface: self.data_to_surface.scaled(s),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_and_the_worse_direction() {
+        let a = DistanceStats::of(&[3.0, 4.0]);
+        assert_eq!(a.samples, 2);
+        assert!((a.rms - 12.5f64.sqrt()).abs() < 1e-15);
+        assert_eq!((a.mean, a.max), (3.5, 4.0));
+        assert_eq!(DistanceStats::of_squared(&[9.0, 16.0]), a);
+        assert_eq!(DistanceStats::of(&[]), DistanceStats::default());
+        let b = DistanceStats::of(&[1.0, 5.0, 0.0]);
+        let t = TwoSided {
+            surface_to_data: a,
+            data_to_surface: b,
+        };
+        assert_eq!(t.max(), 5.0);
+        assert_eq!(t.rms(), a.rms.max(b.rms));
+        assert!(t.within(4.0, 0.0));
+        assert!(!t.within(4.0, 4.5));
+        assert!(t.within(0.0, 5.0));
+        assert!(!t.within(0.0, 0.0), "no tolerance set is never reached");
+        assert_eq!(t.scaled(2.0).data_to_surface.max, 10.0);
+    }
+}

@@ -1,0 +1,53 @@
+//! Why [`crate::fit_scan`] failed (STYLE.md rule 5): each variant names the input and what is
+//! wrong with it, so that a front end prints one line and exits.
+
+/// Why the pipeline failed.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An option is invalid or options contradict each other (nothing was read).
+    #[error("{0}")]
+    Options(String),
+    /// A file could not be read or written.
+    #[error(transparent)]
+    Io(#[from] subfit_io::Error),
+    /// The target cannot be used (the message names the file and the element).
+    #[error("{name}: {message}")]
+    Input {
+        /// The input's name (its file).
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A budget the user gave cannot be honoured (e.g. the initial cage already has more
+    /// control points).
+    #[error("{0}")]
+    Budget(String),
+    /// Building the initial control mesh failed.
+    #[error("{name}: cannot build an initial control mesh: {source}")]
+    Init {
+        /// The input's name.
+        name: String,
+        /// The cause.
+        source: subfit_init::InitError,
+    },
+    /// Fitting failed.
+    #[error("{name}: fitting failed: {source}")]
+    Fit {
+        /// The input's name.
+        name: String,
+        /// The cause.
+        source: subfit_fit::FitError,
+    },
+    /// The outputs could not be built.
+    #[error("cannot build the outputs: {0}")]
+    Output(String),
+}
+
+impl Error {
+    pub(crate) fn input(name: &str, message: impl std::fmt::Display) -> Self {
+        Self::Input {
+            name: name.to_string(),
+            message: message.to_string(),
+        }
+    }
+}

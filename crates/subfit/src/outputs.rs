@@ -1,0 +1,197 @@
+//! The files a fit writes, in the input's coordinates ([`OUTPUTS`], in the order a front end
+//! moves them into place, the report last): the cage as OBJ and as a UsdGeom Mesh with its
+//! scheme and tags, the limit tessellation with normals, the same coloured by the distance to
+//! the target (Cheng 2007 §IV-D colours), the per-iteration log and the report.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use subfit_fit::StagesReport;
+use subfit_io::ply::VertexProperty;
+use subfit_io::usda::{UsdBoundary, UsdScheme};
+use subfit_io::{Encoding, WriteOptions};
+use subfit_mesh::PolyMesh;
+use subfit_report::error_color;
+use subfit_subdiv::{BoundaryRule, Scheme};
+
+use crate::error::Error;
+use crate::scan::Fitted;
+
+/// The files [`Fitted::write_into`] writes, in the order to move them into place.
+pub const OUTPUTS: [&str; 6] = [
+    "control.obj",
+    "control.usda",
+    "limit.ply",
+    "error.ply",
+    "log.csv",
+    "report.json",
+];
+
+impl Fitted {
+    /// Writes every file of [`OUTPUTS`] into `dir` (which must exist; each file atomically,
+    /// the report last) and completes the report with the colour scale and the output time.
+    /// A front end that wants all or none in place writes into a staging directory and
+    /// renames them (the CLI does).
+    ///
+    /// Errors: a file that cannot be written; a tessellation that cannot be built.
+    pub fn write_into(&mut self, dir: &Path) -> Result<(), Error> {
+        let t = Instant::now();
+        let ascii = WriteOptions {
+            format: None,
+            encoding: Encoding::Ascii,
+            single_precision: false,
+        };
+        subfit_io::write_file(&dir.join("control.obj"), &self.cage, &ascii)?;
+        let usd_scheme = match self.scheme {
+            Scheme::Loop => UsdScheme::Loop,
+            _ => UsdScheme::CatmullClark,
+        };
+        let usd_boundary = match self.fit.boundary {
+            BoundaryRule::EdgeOnly => UsdBoundary::EdgeOnly,
+            BoundaryRule::EdgeAndCorner => UsdBoundary::EdgeAndCorner,
+        };
+        subfit_io::write_usda_file(
+            &dir.join("control.usda"),
+            &self.cage,
+            &self.tags,
+            usd_scheme,
+            usd_boundary,
+        )?;
+        let last = self.stages.report.last;
+        let limit = self.limit.clone();
+        let local = &self.local_error;
+        let scale = self
+            .report
+            .error_color_scale_or(last.e_max)
+            .max(f64::MIN_POSITIVE);
+        let limit = PolyMesh {
+            positions: limit
+                .positions
+                .iter()
+                .map(|&p| self.target.to_original(p))
+                .collect(),
+            ..limit
+        };
+        let binary = WriteOptions {
+            format: None,
+            encoding: Encoding::BinaryLittleEndian,
+            single_precision: false,
+        };
+        subfit_io::write_file(&dir.join("limit.ply"), &limit, &binary)?;
+        let unit = self.report.normalized_unit_in_original_units;
+        let error_original: Vec<f64> = local.iter().map(|e| e * unit).collect();
+        let colored = PolyMesh {
+            colors: Some(local.iter().map(|&e| error_color(e / scale)).collect()),
+            ..limit
+        };
+        subfit_io::write_ply_with_properties(
+            &dir.join("error.ply"),
+            &colored,
+            &[
+                VertexProperty {
+                    name: "error",
+                    values: &error_original,
+                },
+                VertexProperty {
+                    name: "error_unit_cube",
+                    values: local,
+                },
+            ],
+            &binary,
+        )?;
+        subfit_io::write_atomic(
+            &dir.join("log.csv"),
+            log_csv(&self.stages.report).as_bytes(),
+        )?;
+        self.report.error_color_scale_unit_cube = scale;
+        self.report.timings_s.output = t.elapsed().as_secs_f64();
+        self.report.timings_s.total += self.report.timings_s.output;
+        let json =
+            serde_json::to_string_pretty(&self.report).map_err(|e| Error::Output(e.to_string()))?;
+        subfit_io::write_atomic(&dir.join("report.json"), (json + "\n").as_bytes())?;
+        Ok(())
+    }
+
+    /// One line: control points, stages, iterations, why it stopped, errors both ways.
+    pub fn summary(&self) -> String {
+        let r = &self.report;
+        let two = &r.r#final.two_sided;
+        format!(
+            "{} → {} control points, {} stages, {} iterations ({}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (surface → data); two-sided E_rms {:.3e}, E_max {:.3e} ({:.2e} / {:.2e} of the diagonal; unit cube)",
+            r.init.control_points,
+            r.control_points,
+            r.stages.len(),
+            r.iterations.len(),
+            r.stop,
+            r.initial.e_rms,
+            r.r#final.e_rms,
+            r.initial.e_max,
+            r.r#final.e_max,
+            two.e_rms,
+            two.e_max,
+            two.e_rms_fraction_of_diagonal,
+            two.e_max_fraction_of_diagonal,
+        )
+    }
+}
+
+impl crate::pipeline_report::Report {
+    /// The error colour scale: the one asked for, else `default`.
+    fn error_color_scale_or(&self, default: f64) -> f64 {
+        if self.error_color_scale_unit_cube > 0.0 {
+            self.error_color_scale_unit_cube
+        } else {
+            default
+        }
+    }
+}
+
+/// The per-iteration table of all stages as CSV (unit-cube units; times in seconds): a row
+/// for the initial mesh (iteration 0), then one per iteration, numbered across stages.
+pub fn log_csv(r: &StagesReport) -> String {
+    let mut s = String::from(
+        "stage,iteration,lambda,control_points,accepted,e_max,e_rms,e_max_diag,e_rms_diag,objective,trial_objective,damping,step_length,gain_ratio,t_sample,t_project,t_assemble,t_solve,t_evaluate\n",
+    );
+    let i = &r.initial;
+    let (lambda0, n0) = r
+        .stages
+        .first()
+        .map_or((0.0, 0), |s| (s.lambda, s.num_control_points));
+    let _ = writeln!(
+        s,
+        "0,0,{lambda0},{n0},true,{},{},{},{},{},{},,,,,,,,",
+        i.e_max, i.e_rms, i.e_max_diag, i.e_rms_diag, i.objective, i.objective
+    );
+    let mut k = 0;
+    for st in &r.stages {
+        for row in &st.fit.iterations {
+            k += 1;
+            let e = &row.errors;
+            let t = &row.timings;
+            let _ = writeln!(
+                s,
+                "{},{k},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                st.stage,
+                st.lambda,
+                st.num_control_points,
+                row.accepted,
+                e.e_max,
+                e.e_rms,
+                e.e_max_diag,
+                e.e_rms_diag,
+                e.objective,
+                row.trial_objective,
+                row.damping,
+                row.step_length,
+                row.gain_ratio,
+                t.sample.as_secs_f64(),
+                t.project.as_secs_f64(),
+                t.assemble.as_secs_f64(),
+                t.solve.as_secs_f64(),
+                t.evaluate.as_secs_f64()
+            );
+        }
+    }
+    s
+}

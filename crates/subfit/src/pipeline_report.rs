@@ -1,0 +1,448 @@
+//! The typed report of [`crate::fit_scan`]; `report.json` is its serialization (serde).
+//!
+//! Errors are in the target's normalized units (the unit cube its longest side is scaled to,
+//! as in the papers) unless a field says otherwise; `*_fraction_of_diagonal` divides by the
+//! target's bounding-box diagonal in the same units; `*_original_units` multiplies by
+//! [`Report::normalized_unit_in_original_units`].
+
+use serde::{Deserialize, Serialize};
+use subfit_fit::{ErrorStats, IterationRow, StageReport};
+use subfit_report::{DistanceStats, TwoSided};
+
+/// Errors of one cage, surface → data, as the fitter measures them (Cheng 2007 §II-B step 7).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Errors {
+    /// `E_max`.
+    pub e_max: f64,
+    /// `E_rms`.
+    pub e_rms: f64,
+    /// `E_max` / diagonal.
+    pub e_max_fraction_of_diagonal: f64,
+    /// `E_rms` / diagonal.
+    pub e_rms_fraction_of_diagonal: f64,
+    /// The objective `E_rms² + λ/n Σ|W(P_i)|²`.
+    pub objective: f64,
+}
+
+impl From<&ErrorStats> for Errors {
+    fn from(s: &ErrorStats) -> Self {
+        Self {
+            e_max: s.e_max,
+            e_rms: s.e_rms,
+            e_max_fraction_of_diagonal: s.e_max_diag,
+            e_rms_fraction_of_diagonal: s.e_rms_diag,
+            objective: s.objective,
+        }
+    }
+}
+
+/// Distances both ways (DESIGN.md decision 11): `e_rms` and `e_max` are the worse of the two
+/// directions; each direction is given too.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwoSidedErrors {
+    /// The worse RMS of the two directions.
+    pub e_rms: f64,
+    /// The worse maximum (the Hausdorff distance of the two sample sets).
+    pub e_max: f64,
+    /// `e_rms` / diagonal.
+    pub e_rms_fraction_of_diagonal: f64,
+    /// `e_max` / diagonal.
+    pub e_max_fraction_of_diagonal: f64,
+    /// `e_rms` in the input's units.
+    pub e_rms_original_units: f64,
+    /// `e_max` in the input's units.
+    pub e_max_original_units: f64,
+    /// Limit-surface samples to the data.
+    pub surface_to_data: DistanceStats,
+    /// Data samples to their exact closest points on the limit surface.
+    pub data_to_surface: DistanceStats,
+}
+
+impl TwoSidedErrors {
+    /// From both directions, with the diagonal (normalized units) and the size of one
+    /// normalized unit in the input's units.
+    pub fn new(t: &TwoSided, diagonal: f64, unit: f64) -> Self {
+        let d = diagonal.max(f64::MIN_POSITIVE);
+        Self {
+            e_rms: t.rms(),
+            e_max: t.max(),
+            e_rms_fraction_of_diagonal: t.rms() / d,
+            e_max_fraction_of_diagonal: t.max() / d,
+            e_rms_original_units: t.rms() * unit,
+            e_max_original_units: t.max() * unit,
+            surface_to_data: t.surface_to_data,
+            data_to_surface: t.data_to_surface,
+        }
+    }
+}
+
+/// Genus and boundary loops of a surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Topology {
+    /// Genus.
+    pub genus: u32,
+    /// Boundary loops.
+    pub boundary_loops: usize,
+}
+
+/// Faces of a mesh target turned to agree with their neighbours.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Reorientation {
+    /// Faces flipped.
+    pub faces_flipped: usize,
+    /// Connected components in which faces were flipped.
+    pub components_changed: usize,
+}
+
+/// The initial control mesh.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InitSummary {
+    /// `"Mesh"` (QEM simplification of the target's mesh), `"Contour"` (IMLS contour, then
+    /// simplification) or `"File"` (given).
+    pub source: String,
+    /// The file, when given.
+    pub file: Option<String>,
+    /// Control points asked of the automatic initial mesh.
+    pub requested_control_points: Option<usize>,
+    /// Control points.
+    pub control_points: usize,
+    /// Faces.
+    pub faces: usize,
+    /// The target's genus (as the initial mesh saw it).
+    pub genus_target: u32,
+    /// The cage's genus.
+    pub genus: u32,
+    /// Whether they match.
+    pub genus_matches: bool,
+    /// Boundary loops of the target and of the cage.
+    pub boundary_loops: BoundaryLoops,
+    /// Seconds per step (contour, simplify, total).
+    pub timings_s: InitTimings,
+}
+
+/// Boundary loops of the target and the cage.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct BoundaryLoops {
+    /// The target's.
+    pub target: usize,
+    /// The cage's.
+    pub cage: usize,
+}
+
+/// Seconds spent building the initial mesh.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InitTimings {
+    /// Contouring (point clouds).
+    pub contour: f64,
+    /// Simplification.
+    pub simplify: f64,
+    /// All of it.
+    pub total: f64,
+}
+
+/// The options the fit ran with.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct OptionsSummary {
+    /// Subdivision scheme.
+    pub scheme: String,
+    /// Error term.
+    pub method: String,
+    /// Step control.
+    pub step: String,
+    /// `λ` of the first stage.
+    pub lambda_start: f64,
+    /// Smallest `λ`.
+    pub lambda_end: f64,
+    /// Factor per stage.
+    pub lambda_factor: f64,
+    /// Sample level.
+    pub sample_level: usize,
+    /// Iterations over all stages at most.
+    pub max_iterations: usize,
+    /// Iterations per stage at most.
+    pub stage_iterations: usize,
+    /// `E_rms` tolerance.
+    pub tolerance_rms: f64,
+    /// `E_max` tolerance, if any.
+    pub tolerance_max: Option<f64>,
+    /// Whether the tolerances are judged both ways.
+    pub two_sided: bool,
+    /// The control-point budget.
+    pub max_control_points: usize,
+    /// Local refinement.
+    pub refine: bool,
+    /// Edge flips.
+    pub edge_flips: bool,
+    /// Refinement depth at most.
+    pub max_depth: u8,
+    /// Local stages.
+    pub local: bool,
+    /// Rings around a local change.
+    pub local_rings: usize,
+}
+
+/// One stage.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageSummary {
+    /// 0-based stage.
+    pub stage: usize,
+    /// `λ`.
+    pub lambda: f64,
+    /// Control points during its fit.
+    pub control_points: usize,
+    /// Faces during its fit.
+    pub faces: usize,
+    /// Iterations.
+    pub iterations: usize,
+    /// Why its fit stopped.
+    pub stop: String,
+    /// Errors before its fit.
+    pub initial: Errors,
+    /// Errors after its fit.
+    pub r#final: Errors,
+    /// Both ways after its fit.
+    pub two_sided: TwoSided,
+    /// Samples.
+    pub samples: usize,
+    /// Setup seconds (sampling operator, pattern, symbolic analysis; 0 when reused).
+    pub setup_s: f64,
+    /// Edge flips tried.
+    pub flips_tried: usize,
+    /// Edge flips kept.
+    pub flips_kept: usize,
+    /// Control points optimized in a local stage.
+    pub active_points: Option<usize>,
+    /// Refinement after the fit: faces marked, red and green splits, new points.
+    pub refine: Option<RefineSummary>,
+    /// Seconds.
+    pub time_s: f64,
+}
+
+/// A local refinement.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RefineSummary {
+    /// Faces marked.
+    pub marked: usize,
+    /// Red (1-to-4) splits.
+    pub red: usize,
+    /// Green (closure) splits.
+    pub green: usize,
+    /// New control points.
+    pub new_points: usize,
+}
+
+impl From<&StageReport> for StageSummary {
+    fn from(s: &StageReport) -> Self {
+        Self {
+            stage: s.stage,
+            lambda: s.lambda,
+            control_points: s.num_control_points,
+            faces: s.num_faces,
+            iterations: s.fit.iterations.len(),
+            stop: format!("{:?}", s.fit.stop),
+            initial: (&s.fit.initial).into(),
+            r#final: (&s.fit.last()).into(),
+            two_sided: s.two_sided,
+            samples: s.fit.num_samples,
+            setup_s: s.fit.setup.as_secs_f64(),
+            flips_tried: s.flips_tried,
+            flips_kept: s.flips_kept,
+            active_points: s.active_points,
+            refine: s.refine.map(|r| RefineSummary {
+                marked: r.marked,
+                red: r.red,
+                green: r.green,
+                new_points: r.new_points,
+            }),
+            time_s: s.time.as_secs_f64(),
+        }
+    }
+}
+
+/// One iteration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct IterationSummary {
+    /// Stage.
+    pub stage: usize,
+    /// Iteration within the stage (1-based).
+    pub iteration: usize,
+    /// Whether the step was taken.
+    pub accepted: bool,
+    /// Errors after it.
+    pub errors: Errors,
+    /// Objective at the trial point.
+    pub trial_objective: f64,
+    /// LM damping.
+    pub damping: f64,
+    /// Step length.
+    pub step_length: f64,
+    /// LM gain ratio.
+    pub gain_ratio: f64,
+    /// Seconds per phase.
+    pub timings_s: IterationTimings,
+}
+
+/// Seconds per phase of an iteration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct IterationTimings {
+    /// `S = C·P`.
+    pub sample: f64,
+    /// Foot points.
+    pub project: f64,
+    /// Filling `H`.
+    pub assemble: f64,
+    /// Solving.
+    pub solve: f64,
+    /// Error statistics.
+    pub evaluate: f64,
+}
+
+impl IterationSummary {
+    /// From a row of `stage`.
+    pub fn new(stage: usize, r: &IterationRow) -> Self {
+        let t = &r.timings;
+        Self {
+            stage,
+            iteration: r.iteration,
+            accepted: r.accepted,
+            errors: (&r.errors).into(),
+            trial_objective: r.trial_objective,
+            damping: r.damping,
+            step_length: r.step_length,
+            gain_ratio: r.gain_ratio,
+            timings_s: IterationTimings {
+                sample: t.sample.as_secs_f64(),
+                project: t.project.as_secs_f64(),
+                assemble: t.assemble.as_secs_f64(),
+                solve: t.solve.as_secs_f64(),
+                evaluate: t.evaluate.as_secs_f64(),
+            },
+        }
+    }
+}
+
+/// The limit tessellation written to `limit.ply` / `error.ply`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TessellationSummary {
+    /// Refinement level.
+    pub level: usize,
+    /// Vertices.
+    pub vertices: usize,
+    /// Predicted chordal error (max, RMS).
+    pub predicted_chordal_error: RmsMax,
+    /// A tenth of the fitting error (max, RMS).
+    pub goal: RmsMax,
+    /// Whether the chordal error is within the goal.
+    pub goal_met: bool,
+}
+
+/// An RMS and a maximum.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RmsMax {
+    /// Maximum.
+    pub max: f64,
+    /// Root mean square.
+    pub rms: f64,
+}
+
+/// Seconds per phase of the whole run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    /// Reading the input.
+    pub read: f64,
+    /// Target analysis (normals, orientation, curvature, indices).
+    pub preprocess: f64,
+    /// The initial control mesh.
+    pub init: f64,
+    /// The stages.
+    pub fit: f64,
+    /// Measuring the cage written both ways (its tessellation, foot points, data distances).
+    pub measure: f64,
+    /// Building the outputs (tessellation, error colours).
+    pub output: f64,
+    /// Everything.
+    pub total: f64,
+}
+
+/// `report.json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Report {
+    /// The target's name (its file).
+    pub target: String,
+    /// Distinct target points.
+    pub target_points: usize,
+    /// The target mesh's topology (`None` for a point cloud).
+    pub target_topology: Option<Topology>,
+    /// Faces of the target re-oriented to agree with their neighbours, if any.
+    pub reoriented: Option<Reorientation>,
+    /// One normalized unit in the input's units.
+    pub normalized_unit_in_original_units: f64,
+    /// The target's bounding-box diagonal in normalized units.
+    pub bbox_diagonal_unit_cube: f64,
+    /// Where the data → surface distances are measured from: `points` or `mesh_area`.
+    pub data_samples: String,
+    /// The initial control mesh.
+    pub init: InitSummary,
+    /// Options.
+    pub options: OptionsSummary,
+    /// Control points of the cage written.
+    pub control_points: usize,
+    /// Faces of the cage written.
+    pub control_faces: usize,
+    /// Crease edges and corners of the cage written.
+    pub tags: TagCounts,
+    /// Surface → data errors of the initial cage.
+    pub initial: Errors,
+    /// Both ways, the initial cage.
+    pub initial_two_sided: TwoSidedErrors,
+    /// Surface → data errors of the cage written.
+    pub r#final: FinalErrors,
+    /// The stage whose cage is written (the best measured).
+    pub best_stage: usize,
+    /// Why the stages stopped: `Tolerance`, `Budget`, `Stalled` or `Limit`.
+    pub stop: String,
+    /// Whether the tolerances hold for the cage written (both ways unless `options.two_sided`
+    /// is false).
+    pub tolerance_reached: bool,
+    /// Warnings (also given to the progress callback).
+    pub warnings: Vec<String>,
+    /// Stages.
+    pub stages: Vec<StageSummary>,
+    /// Iterations, all stages.
+    pub iterations: Vec<IterationSummary>,
+    /// The limit tessellation written (`limit.ply`), on which the final errors both ways are
+    /// measured: they differ from the distances to the exact limit surface by at most its
+    /// chordal error.
+    pub limit_tessellation: TessellationSummary,
+    /// The error that maps to red in `error.ply` (normalized units).
+    pub error_color_scale_unit_cube: f64,
+    /// Seconds per phase.
+    pub timings_s: Timings,
+}
+
+/// Tag counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TagCounts {
+    /// Crease edges.
+    pub creases: usize,
+    /// Corners.
+    pub corners: usize,
+}
+
+/// The errors of the cage written: surface → data (Cheng's measure, the fields of [`Errors`],
+/// at the fitter's samples), and both ways on the tessellation written (`two_sided`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FinalErrors {
+    /// `E_max` surface → data.
+    pub e_max: f64,
+    /// `E_rms` surface → data.
+    pub e_rms: f64,
+    /// `E_max` / diagonal.
+    pub e_max_fraction_of_diagonal: f64,
+    /// `E_rms` / diagonal.
+    pub e_rms_fraction_of_diagonal: f64,
+    /// The objective.
+    pub objective: f64,
+    /// Both ways.
+    pub two_sided: TwoSidedErrors,
+}

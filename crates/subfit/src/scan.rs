@@ -1,0 +1,626 @@
+//! The whole pipeline behind every front end (DESIGN.md §1, §2 `subfit`): read or take the
+//! target, analyse it (Cheng 2007 §II-C), build an initial control mesh with its topology
+//! (§II-A; QEM simplification or IMLS contouring), fit it in stages (Cheng 2004 §4.4–4.6,
+//! Cheng 2007 §II-F) while measuring both ways (DESIGN.md decision 11), and return the best
+//! cage measured (decision 12) in the input's coordinates with a typed [`Report`].
+//!
+//! The CLI's `fit`, `demo` and `bench fit`, the tests and (later) the Python package call
+//! [`fit_scan`]; none re-implements a step. Nothing here prints: progress and warnings go to the
+//! callback.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use subfit_fit::{
+    fit_stages, FitOptions, IterationRow, StageEvent, StageOptions, StageReport, StagesResult,
+};
+use subfit_init::{default_control_points, initial_control_mesh, InitOptions, InitReport};
+use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons, Tags};
+use subfit_subdiv::Scheme;
+use subfit_target::{Target, TargetOptions};
+
+use crate::error::Error;
+use subfit_report::{data_samples, limit_tessellation, DistanceStats, MeshDistance, TwoSided};
+
+use crate::pipeline_report::{
+    BoundaryLoops, Errors, FinalErrors, InitSummary, InitTimings, IterationSummary, OptionsSummary,
+    Report, RmsMax, StageSummary, TagCounts, TessellationSummary, Timings, Topology,
+    TwoSidedErrors,
+};
+
+/// The scan to fit.
+#[derive(Clone, Debug)]
+pub enum Input {
+    /// A file of any supported format (read with [`subfit_io::read_file`]).
+    File(PathBuf),
+    /// A mesh or point cloud already in memory, with a name for messages and the report.
+    Mesh {
+        /// Positions (and optional normals) and faces (none for a point cloud).
+        mesh: PolyMesh,
+        /// The name used in messages (e.g. its file).
+        name: String,
+    },
+}
+
+/// The initial control mesh.
+#[derive(Clone, Debug, Default)]
+pub enum InitialCage {
+    /// Built with the target's topology (QEM simplification of a mesh target, IMLS contour of
+    /// a point cloud), with [`FitScanOptions::control_points`] points.
+    #[default]
+    Auto,
+    /// Given, in the target's coordinates; its genus and boundary loops must match a mesh
+    /// target's.
+    Given {
+        /// The cage.
+        mesh: PolyMesh,
+        /// Its crease and corner tags.
+        tags: Tags,
+        /// Its name (file) for messages.
+        name: String,
+    },
+}
+
+/// Options of [`fit_scan`]. Lengths are in the target's normalized units (the unit cube).
+#[derive(Clone, Debug)]
+pub struct FitScanOptions {
+    /// The initial control mesh. Default [`InitialCage::Auto`].
+    pub init: InitialCage,
+    /// Control points of the automatic initial mesh. Default `None`: `clamp(round(1.5·√points),
+    /// 200, 2000)`, capped by the budget [`StageOptions::max_control_points`].
+    pub control_points: Option<usize>,
+    /// Ignore the target's faces and fit its points (and normals), as for a scan; the faces'
+    /// genus still tells the initial mesh what to aim for. Default false.
+    pub as_points: bool,
+    /// Subdivision scheme; `None` (default): Loop for an all-triangle cage, Catmull-Clark
+    /// otherwise.
+    pub scheme: Option<Scheme>,
+    /// Per-iteration options (method, step control, sample level, solver). Its scheme, tags,
+    /// `λ`, tolerances and iteration caps are set by the pipeline.
+    pub fit: FitOptions,
+    /// The stages: `λ` schedule, tolerances (two-sided by default), budgets, refinement.
+    pub stages: StageOptions,
+    /// Target analysis options.
+    pub target: TargetOptions,
+    /// Initial-mesh options (`expected_genus` is set from the faces with `as_points`).
+    pub init_options: InitOptions,
+    /// The error mapped to red in `error.ply` (normalized units). Default `None`: the final
+    /// two-sided `E_max`.
+    pub error_scale: Option<f64>,
+}
+
+impl Default for FitScanOptions {
+    fn default() -> Self {
+        Self {
+            init: InitialCage::Auto,
+            control_points: None,
+            as_points: false,
+            scheme: None,
+            fit: FitOptions::default(),
+            stages: StageOptions::default(),
+            target: TargetOptions::default(),
+            init_options: InitOptions::default(),
+            error_scale: None,
+        }
+    }
+}
+
+/// A step of [`fit_scan`], for progress display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// Reading the input file.
+    Read,
+    /// Target analysis: normals, orientation, curvature, indices.
+    Analyse,
+    /// Building the initial control mesh.
+    Init,
+    /// The fitting stages.
+    Fit,
+}
+
+/// What [`fit_scan`] tells its caller while it works.
+#[derive(Clone, Copy, Debug)]
+pub enum Progress<'a> {
+    /// A step starts.
+    Step(Step),
+    /// An iteration ended.
+    Iteration {
+        /// Stage.
+        stage: usize,
+        /// The row.
+        row: &'a IterationRow,
+    },
+    /// A stage ended.
+    Stage(&'a StageReport),
+    /// Something the user should know (also kept in the report).
+    Warning(&'a str),
+}
+
+/// The result of [`fit_scan`]: the cage in the input's coordinates, what is needed to write
+/// the outputs, and the report.
+pub struct Fitted {
+    /// The cage: positions in the input's coordinates, faces.
+    pub cage: PolyMesh,
+    /// Its crease and corner tags.
+    pub tags: Tags,
+    /// Its subdivision scheme.
+    pub scheme: Scheme,
+    /// The report (`report.json`).
+    pub report: Report,
+    pub(crate) target: Target,
+    pub(crate) normalized: PolyMesh,
+    pub(crate) stages: StagesResult,
+    pub(crate) fit: FitOptions,
+    /// The limit tessellation (normalized units) and the distance of each of its vertices to
+    /// the target.
+    pub(crate) limit: PolyMesh,
+    pub(crate) local_error: Vec<f64>,
+}
+
+impl Fitted {
+    /// Whether the cage meets the tolerances (both ways unless one-sided was asked).
+    pub fn reached(&self) -> bool {
+        self.report.tolerance_reached
+    }
+
+    /// The cage in the target's normalized units.
+    pub fn normalized_cage(&self) -> &PolyMesh {
+        &self.normalized
+    }
+
+    /// The analysed target.
+    pub fn target(&self) -> &Target {
+        &self.target
+    }
+}
+
+/// Fits a subdivision surface to `input`: the whole pipeline (see the module docs).
+///
+/// Errors: invalid options ([`Error::Options`]), an unreadable or unusable input
+/// ([`Error::Io`], [`Error::Input`] naming the element), a budget that cannot be honoured
+/// ([`Error::Budget`]), a failed initial mesh or fit. On error nothing is returned; nothing
+/// is written in any case (see [`Fitted::write_into`]).
+pub fn fit_scan(
+    input: Input,
+    options: &FitScanOptions,
+    mut progress: Option<&mut dyn FnMut(Progress<'_>)>,
+) -> Result<Fitted, Error> {
+    validate(options)?;
+    let mut warnings: Vec<String> = Vec::new();
+    let mut warn = |msg: String, progress: &mut Option<&mut dyn FnMut(Progress<'_>)>| {
+        if let Some(p) = progress.as_mut() {
+            p(Progress::Warning(&msg));
+        }
+        warnings.push(msg);
+    };
+    let step = |s: Step, progress: &mut Option<&mut dyn FnMut(Progress<'_>)>| {
+        if let Some(p) = progress.as_mut() {
+            p(Progress::Step(s));
+        }
+    };
+    let t0 = Instant::now();
+    step(Step::Read, &mut progress);
+    let (mut mesh, name) = match input {
+        Input::File(path) => {
+            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            (m, path.display().to_string())
+        }
+        Input::Mesh { mesh, name } => (mesh, name),
+    };
+    let read = t0.elapsed().as_secs_f64();
+
+    // With `as_points` the faces are dropped, but their genus still tells the initial mesh
+    // what topology to aim for.
+    let mut init_options = options.init_options.clone();
+    if options.as_points && !mesh.faces.is_empty() {
+        init_options.expected_genus = topology(&mesh).ok().map(|t| t.genus);
+        mesh.faces = Polygons::new();
+    }
+    let target_topology = if mesh.faces.is_empty() {
+        None
+    } else {
+        Some(topology(&mesh).map_err(|e| Error::input(&name, e))?)
+    };
+
+    step(Step::Analyse, &mut progress);
+    let target = Target::build(&mesh, &options.target, None).map_err(|e| Error::input(&name, e))?;
+    let preprocess = target.stats().timings.total.as_secs_f64();
+
+    step(Step::Init, &mut progress);
+    let t_init = Instant::now();
+    let budget = options.stages.max_control_points;
+    let (control, tags, init) = match &options.init {
+        InitialCage::Given {
+            mesh: c,
+            tags,
+            name: cname,
+        } => {
+            let topo = topology(c).map_err(|e| Error::input(cname, e))?;
+            if let Some(t) = target_topology {
+                if t != topo {
+                    return Err(Error::input(
+                        cname,
+                        format!(
+                            "the control mesh has genus {} and {} boundary loop(s), the target {name} has genus {} and {} — their topologies must match",
+                            topo.genus, topo.boundary_loops, t.genus, t.boundary_loops
+                        ),
+                    ));
+                }
+            }
+            if c.num_vertices() > budget {
+                return Err(Error::Budget(format!(
+                    "{cname}: the initial control mesh has {} control points, more than the budget of {budget}",
+                    c.num_vertices()
+                )));
+            }
+            let normalized = PolyMesh::new(
+                c.positions
+                    .iter()
+                    .map(|&p| target.to_normalized(p))
+                    .collect(),
+                c.faces.clone(),
+            );
+            let summary = InitSummary {
+                source: "File".into(),
+                file: Some(cname.clone()),
+                requested_control_points: None,
+                control_points: c.num_vertices(),
+                faces: c.faces.len(),
+                genus_target: target_topology.map_or(topo.genus, |t| t.genus),
+                genus: topo.genus,
+                genus_matches: target_topology.is_none_or(|t| t.genus == topo.genus),
+                boundary_loops: BoundaryLoops {
+                    target: target_topology.map_or(topo.boundary_loops, |t| t.boundary_loops),
+                    cage: topo.boundary_loops,
+                },
+                timings_s: InitTimings::default(),
+            };
+            (normalized, tags.clone(), summary)
+        }
+        InitialCage::Auto => {
+            let n = match options.control_points {
+                Some(n) if n > budget => {
+                    return Err(Error::Budget(format!(
+                        "{n} initial control points asked for, more than the budget of {budget} (--max-control-points)"
+                    )))
+                }
+                Some(n) => n,
+                None => default_control_points(target.len()).min(budget),
+            };
+            let dense = (!mesh.faces.is_empty()).then_some(&mesh);
+            let (m, r) = initial_control_mesh(&target, dense, n, &init_options).map_err(|e| {
+                match e {
+                    subfit_init::InitError::TooFewForTopology { .. } if options.control_points.is_none() => {
+                        Error::Budget(format!("{name}: the budget of {budget} control points is too small for this target: {e}"))
+                    }
+                    e => Error::Init { name: name.clone(), source: e },
+                }
+            })?;
+            if m.num_vertices() > budget {
+                return Err(Error::Budget(format!(
+                    "{name}: the initial control mesh keeps {} control points (no legal simplification below it for this topology), more than the budget of {budget}",
+                    m.num_vertices()
+                )));
+            }
+            if !r.genus_matches {
+                warn(
+                    format!(
+                        "the initial control mesh has genus {}, the target {}",
+                        r.genus_after, r.genus_target
+                    ),
+                    &mut progress,
+                );
+            }
+            let summary = init_summary(&r, n, &m);
+            (m, Tags::new(), summary)
+        }
+    };
+    let init_time = t_init.elapsed().as_secs_f64();
+
+    let scheme = options.scheme.unwrap_or(if control.faces.is_triangles() {
+        Scheme::Loop
+    } else {
+        Scheme::CatmullClark
+    });
+    if options.stages.refine && scheme != Scheme::Loop {
+        warn(
+            "local refinement is implemented for Loop cages only; this Catmull-Clark cage keeps its connectivity".into(),
+            &mut progress,
+        );
+    }
+    let fit = FitOptions {
+        scheme,
+        tags,
+        ..options.fit.clone()
+    };
+
+    step(Step::Fit, &mut progress);
+    let t_fit = Instant::now();
+    let result = {
+        let mut on_event = |e: StageEvent<'_>| {
+            if let Some(p) = progress.as_mut() {
+                match e {
+                    StageEvent::Iteration { stage, row } => p(Progress::Iteration { stage, row }),
+                    StageEvent::Stage(s) => p(Progress::Stage(s)),
+                }
+            }
+        };
+        fit_stages(
+            &target,
+            &control,
+            &fit,
+            &options.stages,
+            Some(&mut on_event),
+        )
+        .map_err(|e| Error::Fit {
+            name: name.clone(),
+            source: e,
+        })?
+    };
+    let fit_time = t_fit.elapsed().as_secs_f64();
+
+    let unit = target.normalization().length_to_original(1.0);
+    let last = result.report.last;
+    let diagonal = bbox_diagonal(target.points());
+    // The cage written, measured both ways on the tessellation written with it (chordal error
+    // a tenth of the fitting error, reported): what a user measures on limit.ply.
+    let t_measure = Instant::now();
+    let tessellation = limit_tessellation(
+        &result.mesh.faces,
+        &result.mesh.positions,
+        &result.tags,
+        &fit.subdivision(),
+        last.e_rms,
+        last.e_max,
+    )
+    .map_err(|e| Error::Output(e.to_string()))?;
+    let local: Vec<f64> =
+        subfit_fit::feet::squared_errors(&target, fit.foot_points, &tessellation.mesh.positions)
+            .into_iter()
+            .map(f64::sqrt)
+            .collect();
+    let data = data_samples(&target, options.stages.data_samples);
+    let to_surface: Vec<f64> =
+        MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces)
+            .distances(&data.points)
+            .iter()
+            .map(|p| p.distance)
+            .collect();
+    let final_two = TwoSided {
+        surface_to_data: DistanceStats::of(&local),
+        data_to_surface: DistanceStats::of(&to_surface),
+    };
+    let measure_time = t_measure.elapsed().as_secs_f64();
+    let two = TwoSidedErrors::new(&final_two, diagonal, unit);
+    let reached = options.stages.met(&last, &final_two);
+    let cage = PolyMesh::new(
+        result
+            .mesh
+            .positions
+            .iter()
+            .map(|&p| target.to_original(p))
+            .collect(),
+        result.mesh.faces.clone(),
+    );
+    let st = &options.stages;
+    let report = Report {
+        target: name,
+        target_points: target.len(),
+        target_topology,
+        reoriented: None,
+        normalized_unit_in_original_units: unit,
+        bbox_diagonal_unit_cube: diagonal,
+        data_samples: match result.report.data_samples {
+            subfit_report::data_samples::SampleKind::Points => "points".into(),
+            subfit_report::data_samples::SampleKind::MeshArea => "mesh_area".into(),
+        },
+        init,
+        options: OptionsSummary {
+            scheme: format!("{scheme:?}"),
+            method: format!("{:?}", fit.method).to_uppercase(),
+            step: format!("{:?}", fit.step),
+            lambda_start: st.lambda_start,
+            lambda_end: st.lambda_end,
+            lambda_factor: st.lambda_factor,
+            sample_level: fit.sample_level,
+            max_iterations: st.max_iterations,
+            stage_iterations: st.iterations_per_stage,
+            tolerance_rms: st.tolerance_rms,
+            tolerance_max: (st.tolerance_max > 0.0).then_some(st.tolerance_max),
+            two_sided: st.two_sided,
+            max_control_points: st.max_control_points,
+            refine: st.refine,
+            edge_flips: st.edge_flips,
+            max_depth: st.max_depth,
+            local: st.local,
+            local_rings: st.local_rings,
+        },
+        control_points: result.mesh.num_vertices(),
+        control_faces: result.mesh.faces.len(),
+        tags: TagCounts {
+            creases: result.tags.creases().len(),
+            corners: result.tags.corners().len(),
+        },
+        initial: (&result.report.initial).into(),
+        initial_two_sided: TwoSidedErrors::new(&result.report.initial_two_sided, diagonal, unit),
+        r#final: {
+            let e = Errors::from(&last);
+            FinalErrors {
+                e_max: e.e_max,
+                e_rms: e.e_rms,
+                e_max_fraction_of_diagonal: e.e_max_fraction_of_diagonal,
+                e_rms_fraction_of_diagonal: e.e_rms_fraction_of_diagonal,
+                objective: e.objective,
+                two_sided: two,
+            }
+        },
+        best_stage: result.report.best_stage,
+        stop: format!("{:?}", result.report.stop),
+        tolerance_reached: reached,
+        warnings,
+        stages: result
+            .report
+            .stages
+            .iter()
+            .map(StageSummary::from)
+            .collect(),
+        iterations: result
+            .report
+            .stages
+            .iter()
+            .flat_map(|s| {
+                s.fit
+                    .iterations
+                    .iter()
+                    .map(move |r| IterationSummary::new(s.stage, r))
+            })
+            .collect(),
+        limit_tessellation: {
+            let c = tessellation.chordal;
+            TessellationSummary {
+                level: tessellation.level,
+                vertices: tessellation.mesh.positions.len(),
+                predicted_chordal_error: RmsMax {
+                    max: c.max,
+                    rms: c.rms,
+                },
+                goal: RmsMax {
+                    max: 0.1 * last.e_max,
+                    rms: 0.1 * last.e_rms,
+                },
+                goal_met: c.max <= 0.1 * last.e_max && c.rms <= 0.1 * last.e_rms,
+            }
+        },
+        error_color_scale_unit_cube: options.error_scale.unwrap_or(0.0),
+        timings_s: Timings {
+            read,
+            preprocess,
+            init: init_time,
+            fit: fit_time,
+            measure: measure_time,
+            output: 0.0,
+            total: t0.elapsed().as_secs_f64(),
+        },
+    };
+    Ok(Fitted {
+        cage,
+        tags: result.tags.clone(),
+        scheme,
+        report,
+        target,
+        normalized: result.mesh.clone(),
+        stages: result,
+        fit,
+        limit: tessellation.mesh,
+        local_error: local,
+    })
+}
+
+fn validate(o: &FitScanOptions) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::Options(m));
+    let st = &o.stages;
+    if !(st.lambda_start.is_finite() && st.lambda_start >= 0.0) {
+        return bad(format!(
+            "--lambda must be a finite number ≥ 0, got {}",
+            st.lambda_start
+        ));
+    }
+    if !(st.lambda_end.is_finite() && st.lambda_end >= 0.0 && st.lambda_end <= st.lambda_start) {
+        return bad(format!(
+            "--lambda-end must be a finite number in [0, --lambda = {}], got {}",
+            st.lambda_start, st.lambda_end
+        ));
+    }
+    for (name, v) in [
+        ("--tolerance", st.tolerance_rms),
+        ("--max-error", st.tolerance_max),
+    ] {
+        if v != 0.0 && !(v.is_finite() && v > 0.0 && v < 1.0) {
+            return bad(format!(
+                "{name} must be in (0, 1) (unit-cube units), got {v}"
+            ));
+        }
+    }
+    if let Some(v) = o.error_scale {
+        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+            return bad(format!(
+                "--error-scale must be in (0, 1) (unit-cube units), got {v}"
+            ));
+        }
+    }
+    if matches!(o.init, InitialCage::Given { .. }) && o.control_points.is_some() {
+        return bad("--control-points sets the size of the automatic initial mesh; it cannot be used with --init FILE".into());
+    }
+    if let Some(n) = o.control_points {
+        if n < 4 {
+            return bad(format!("--control-points must be at least 4, got {n}"));
+        }
+    }
+    if st.max_control_points < 4 {
+        return bad(format!(
+            "--max-control-points must be at least 4, got {}",
+            st.max_control_points
+        ));
+    }
+    Ok(())
+}
+
+/// Genus and boundary loops of a mesh with faces; the error names the element that makes it
+/// unusable.
+fn topology(m: &PolyMesh) -> Result<Topology, subfit_mesh::TopologyError> {
+    let h = HalfEdgeMesh::from_mesh(m)?;
+    Ok(Topology {
+        genus: h.genus(),
+        boundary_loops: h.boundary_loops().len(),
+    })
+}
+
+fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
+    InitSummary {
+        source: format!("{:?}", r.source),
+        file: None,
+        requested_control_points: Some(requested),
+        control_points: m.num_vertices(),
+        faces: m.faces.len(),
+        genus_target: r.genus_target,
+        genus: r.genus_after,
+        genus_matches: r.genus_matches,
+        boundary_loops: BoundaryLoops {
+            target: r.boundary_loops.0,
+            cage: r.boundary_loops.1,
+        },
+        timings_s: InitTimings {
+            contour: r.timings.contour.as_secs_f64(),
+            simplify: r.timings.simplify.as_secs_f64(),
+            total: r.timings.total.as_secs_f64(),
+        },
+    }
+}
+
+fn bbox_diagonal(p: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for x in p {
+        for a in 0..3 {
+            lo[a] = lo[a].min(x[a]);
+            hi[a] = hi[a].max(x[a]);
+        }
+    }
+    (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// Reads `path` as a cage for [`InitialCage::Given`].
+pub fn read_cage(path: &Path) -> Result<InitialCage, Error> {
+    let (mesh, _) = subfit_io::read_file(path, &subfit_io::ReadOptions::default())?;
+    if mesh.faces.is_empty() {
+        return Err(Error::input(
+            &path.display().to_string(),
+            "has no faces; an initial control mesh is needed",
+        ));
+    }
+    Ok(InitialCage::Given {
+        mesh,
+        tags: Tags::new(),
+        name: path.display().to_string(),
+    })
+}
