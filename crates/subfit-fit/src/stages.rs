@@ -462,6 +462,7 @@ pub fn fit_stages(
             tags: tags.clone(),
             ..base.clone()
         };
+        let fresh = topo.is_none();
         let t = match &mut topo {
             Some(t) => t,
             None => topo.insert(Topo::new(target, &mesh, &stage_opts)?),
@@ -496,7 +497,12 @@ pub fn fit_stages(
                     p(StageEvent::Iteration { stage, row });
                 }
             };
-            t.fitter.run(&mut mesh.positions, Some(&mut cb))?
+            let mut fit = t.fitter.run(&mut mesh.positions, Some(&mut cb))?;
+            if !fresh {
+                // The operator, pattern and symbolic analysis of the last stage were reused.
+                fit.setup = Duration::ZERO;
+            }
+            fit
         };
         used += fit.iterations.len().max(1);
         let last = fit.last();
