@@ -60,6 +60,10 @@ fn igea_as_a_point_cloud_reaches_table_iv_within_its_control_point_budget() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("igea");
     let igea = data.join("igea.ply");
+    // Table IV's figures are Cheng's surface → data measure: judged so here (`--one-sided`),
+    // both directions reported and the two-sided RMS asserted too. Both ways, E_max stays
+    // above 0.0036 (4.2e-3): scan points at the bottom of a pit near the chin that the
+    // surface bridges (s2d's foot points blend across the gap; data → surface sees it).
     let flags = [
         "--as-points",
         "--tolerance",
@@ -68,9 +72,16 @@ fn igea_as_a_point_cloud_reaches_table_iv_within_its_control_point_budget() {
         "0.0036",
         "--max-control-points",
         "2385",
+        "--one-sided",
     ];
     let (rep, e_rms, e_max, n) = fit_ok(&igea, &flags, &out);
-    println!("igea (points): {n} control points, E_rms {e_rms:.3e}, E_max {e_max:.3e}");
+    let two = &rep["final"]["two_sided"];
+    let (r2, m2) = (
+        two["e_rms"].as_f64().unwrap(),
+        two["e_max"].as_f64().unwrap(),
+    );
+    println!("igea (points): {n} control points, E_rms {e_rms:.3e}, E_max {e_max:.3e}; two-sided E_rms {r2:.3e}, E_max {m2:.3e}");
+    assert!(r2 <= 0.0005, "two-sided E_rms {r2}");
     assert!(e_rms <= 0.0005, "{e_rms}");
     assert!(e_max <= 0.0036, "{e_max}");
     assert!(n <= 2385, "{n}");

@@ -404,6 +404,10 @@ pub struct Report {
     /// Whether the tolerances hold for the cage written (both ways unless `options.two_sided`
     /// is false).
     pub tolerance_reached: bool,
+    /// Whether the tolerances hold surface → data (Cheng's measure, the papers' tables).
+    pub tolerance_reached_surface_to_data: bool,
+    /// Whether they hold both ways.
+    pub tolerance_reached_two_sided: bool,
     /// Warnings (also given to the progress callback).
     pub warnings: Vec<String>,
     /// Stages.

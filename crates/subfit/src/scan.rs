@@ -393,6 +393,9 @@ pub fn fit_scan(
     let measure_time = t_measure.elapsed().as_secs_f64();
     let two = TwoSidedErrors::new(&final_two, diagonal, unit);
     let reached = options.stages.met(&last, &final_two);
+    let reached_one_sided = options.stages.reached(&last);
+    let reached_two_sided = reached_one_sided
+        && final_two.within(options.stages.tolerance_rms, options.stages.tolerance_max);
     let cage = PolyMesh::new(
         result
             .mesh
@@ -457,6 +460,8 @@ pub fn fit_scan(
         best_stage: result.report.best_stage,
         stop: format!("{:?}", result.report.stop),
         tolerance_reached: reached,
+        tolerance_reached_surface_to_data: reached_one_sided,
+        tolerance_reached_two_sided: reached_two_sided,
         warnings,
         stages: result
             .report
