@@ -5,8 +5,6 @@
 //! tempted to leave uncovered, such as the rim around a hole — weigh as much as their area,
 //! which is what an independent measurement over the surface sees.
 
-use rand::rngs::StdRng;
-use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
 use subfit_target::Target;
 
@@ -35,57 +33,72 @@ const SEED: u64 = 0x5eed_da7a;
 /// The data → surface samples of `target`: its points for a point cloud; for a mesh,
 /// `count` points uniform by area on its triangles (`count = 0`: as many as it has points).
 ///
-/// Cost: O(#triangles + count).
+/// Cost: O(#triangles + count log #triangles).
 pub fn data_samples(target: &Target, count: usize) -> DataSamples {
-    let Some(bvh) = target.mesh() else {
-        return DataSamples {
-            points: target.points().to_vec(),
-            kind: SampleKind::Points,
-        };
+    let cloud = || DataSamples {
+        points: target.points().to_vec(),
+        kind: SampleKind::Points,
     };
-    let (v, tris) = (bvh.vertices(), bvh.triangles());
-    let corner = |t: &[u32; 3]| [v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]];
-    // Cumulative areas for inverse-CDF sampling.
-    let mut cum = Vec::with_capacity(tris.len());
-    let mut total = 0.0;
-    for t in tris {
-        let [a, b, c] = corner(t);
-        let (e1, e2): ([f64; 3], [f64; 3]) = (
-            std::array::from_fn(|k| b[k] - a[k]),
-            std::array::from_fn(|k| c[k] - a[k]),
-        );
-        let n = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        total += 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        cum.push(total);
-    }
+    let Some(bvh) = target.mesh() else {
+        return cloud();
+    };
     let count = if count == 0 { target.len() } else { count };
-    if !(total > 0.0) {
-        return DataSamples {
-            points: target.points().to_vec(),
-            kind: SampleKind::Points,
-        };
+    let points = area_samples(bvh.vertices(), bvh.triangles(), count, SEED);
+    if points.is_empty() {
+        return cloud();
     }
-    let mut rng = StdRng::seed_from_u64(SEED);
-    let points = (0..count)
-        .map(|_| {
-            let x = rng.random::<f64>() * total;
-            let i = cum.partition_point(|&c| c < x).min(tris.len() - 1);
-            let [a, b, c] = corner(&tris[i]);
-            let (mut r1, mut r2): (f64, f64) = (rng.random(), rng.random());
-            if r1 + r2 > 1.0 {
-                (r1, r2) = (1.0 - r1, 1.0 - r2);
-            }
-            std::array::from_fn(|k| a[k] + r1 * (b[k] - a[k]) + r2 * (c[k] - a[k]))
-        })
-        .collect();
     DataSamples {
         points,
         kind: SampleKind::MeshArea,
     }
+}
+
+/// `n` points uniformly by area on the triangles `tris` over `p` (seeded SplitMix64; inverse
+/// CDF over the cumulative areas, then uniform barycentric coordinates). Empty when the total
+/// area is zero or not finite. Cost O(T + n log T).
+pub fn area_samples(p: &[[f64; 3]], tris: &[[u32; 3]], n: usize, seed: u64) -> Vec<[f64; 3]> {
+    let area = |t: &[u32; 3]| {
+        let (a, b, c) = (p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
+        let (u, v) = (
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        );
+        let w = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
+    };
+    let mut cum = Vec::with_capacity(tris.len());
+    let mut total = 0.0;
+    for t in tris {
+        total += area(t);
+        cum.push(total);
+    }
+    if !(total > 0.0 && total.is_finite()) {
+        return Vec::new();
+    }
+    let mut state = seed;
+    let mut next = move || {
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| {
+            let r = next() * total;
+            let i = cum.partition_point(|&c| c < r).min(tris.len() - 1);
+            let (mut s, mut t) = (next(), next());
+            if s + t > 1.0 {
+                (s, t) = (1.0 - s, 1.0 - t);
+            }
+            let [a, b, c] = tris[i].map(|v| p[v as usize]);
+            std::array::from_fn(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]))
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -15,6 +15,8 @@ use anyhow::{bail, Context};
 use rayon::prelude::*;
 use serde::Serialize;
 use subfit::mesh::{PolyMesh, Tags};
+use subfit::report::data_samples::area_samples;
+use subfit::report::DistanceStats;
 use subfit::subdiv::{random_samples, ClosestOptions, ClosestPointFinder, Evaluator, Options};
 use subfit::target::{PointIndex, TriangleBvh};
 
@@ -43,19 +45,11 @@ impl Query {
 }
 
 #[derive(Serialize)]
-struct Direction {
-    samples: usize,
-    rms: f64,
-    mean: f64,
-    max: f64,
-}
-
-#[derive(Serialize)]
 struct Comparison {
     a: String,
     b: String,
-    a_to_b: Direction,
-    b_to_a: Direction,
+    a_to_b: DistanceStats,
+    b_to_a: DistanceStats,
     two_sided_rms: f64,
     hausdorff: f64,
     /// B's bounding-box diagonal; the `*_fraction` values divide by it.
@@ -112,7 +106,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         (dab, dba)
     };
     sp.finish_and_clear();
-    let (ab, ba) = (stats(&dab), stats(&dba));
+    let (ab, ba) = (DistanceStats::of(&dab), DistanceStats::of(&dba));
     let n = (dab.len() + dba.len()) as f64;
     let two_sided_rms =
         ((ab.rms * ab.rms * dab.len() as f64 + ba.rms * ba.rms * dba.len() as f64) / n).sqrt();
@@ -150,16 +144,6 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn stats(d: &[f64]) -> Direction {
-    let n = d.len().max(1) as f64;
-    Direction {
-        samples: d.len(),
-        rms: (d.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
-        mean: d.iter().sum::<f64>() / n,
-        max: d.iter().copied().fold(0.0, f64::max),
-    }
-}
-
 fn surface(m: &PolyMesh, n: usize, seed: u64) -> anyhow::Result<Surface> {
     if m.positions.is_empty() {
         bail!("no points");
@@ -172,7 +156,7 @@ fn surface(m: &PolyMesh, n: usize, seed: u64) -> anyhow::Result<Surface> {
         });
     }
     let tris = m.faces.triangulate_fan();
-    let samples = sample_triangles(&m.positions, &tris, n, seed);
+    let samples = area_samples(&m.positions, &tris, n, seed);
     if samples.is_empty() {
         bail!("all faces have zero area");
     }
@@ -180,51 +164,4 @@ fn surface(m: &PolyMesh, n: usize, seed: u64) -> anyhow::Result<Surface> {
         samples,
         query: Query::Mesh(TriangleBvh::new(m.positions.clone(), tris)),
     })
-}
-
-/// `n` points uniformly by area on the triangles (seeded SplitMix64; inverse CDF over the
-/// cumulative areas, then uniform barycentric coordinates).
-fn sample_triangles(p: &[[f64; 3]], tris: &[[u32; 3]], n: usize, seed: u64) -> Vec<[f64; 3]> {
-    let area = |t: &[u32; 3]| {
-        let (a, b, c) = (p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
-        let (u, v) = (
-            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-        );
-        let w = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        0.5 * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
-    };
-    let mut cum = Vec::with_capacity(tris.len());
-    let mut total = 0.0;
-    for t in tris {
-        total += area(t);
-        cum.push(total);
-    }
-    if !(total > 0.0 && total.is_finite()) {
-        return Vec::new();
-    }
-    let mut state = seed;
-    let mut next = move || {
-        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    };
-    (0..n)
-        .map(|_| {
-            let r = next() * total;
-            let i = cum.partition_point(|&c| c < r).min(tris.len() - 1);
-            let (mut s, mut t) = (next(), next());
-            if s + t > 1.0 {
-                (s, t) = (1.0 - s, 1.0 - t);
-            }
-            let [a, b, c] = tris[i].map(|v| p[v as usize]);
-            std::array::from_fn(|k| a[k] + s * (b[k] - a[k]) + t * (c[k] - a[k]))
-        })
-        .collect()
 }
