@@ -1,6 +1,7 @@
 //! Regression tests of defects found by trying `subfit fit` as a new user: a worse cage written
 //! than the one reached, budgets not honoured, success judged one way only, messy meshes
 //! refused.
+#![allow(clippy::print_stdout)]
 
 mod common;
 

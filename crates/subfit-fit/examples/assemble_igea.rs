@@ -24,7 +24,6 @@ use subfit_fit::smooth::Laplacian;
 use subfit_fit::terms::{error_matrix, Method};
 use subfit_fit::{FitOptions, Fitter, Variant};
 use subfit_init::{simplify, SimplifyOptions};
-use subfit_mesh::Tags;
 use subfit_target::{Target, TargetOptions};
 
 /// User + system CPU time of this process (all threads), from `/proc/self/stat`.

@@ -45,7 +45,7 @@ use std::time::{Duration, Instant};
 
 use subfit_fit::{FillOrdering, FitOptions, Fitter, LinearSolver, Variant};
 use subfit_init::{simplify, SimplifyOptions};
-use subfit_mesh::{PolyMesh, Tags};
+use subfit_mesh::PolyMesh;
 use subfit_target::{Target, TargetOptions};
 
 fn env<T: std::str::FromStr>(name: &str, default: T) -> T {

@@ -5,7 +5,7 @@
 mod common;
 
 use subfit_fit::{FitError, FitOptions, FitReport, Fitter, Variant};
-use subfit_mesh::{PolyMesh, Tags};
+use subfit_mesh::PolyMesh;
 use subfit_target::Target;
 
 fn setup() -> (Target, PolyMesh) {

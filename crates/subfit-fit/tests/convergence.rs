@@ -87,7 +87,6 @@ fn armijo_is_monotone() {
 #[test]
 fn fitter_stops_at_tolerance_with_smoothing() {
     use subfit_fit::{Fitter, StopReason};
-    use subfit_mesh::Tags;
     let target = common::ellipsoid_target(12_000);
     let mesh = common::normalized(&target, &common::fourteen_vertex_mesh());
     let opts = FitOptions::variant(Variant::SdmLm)

@@ -4,7 +4,7 @@ mod common;
 
 use subfit_fit::{fit, FitError, FitOptions, Fitter, Variant};
 use subfit_mesh::shapes::cube_mesh;
-use subfit_mesh::{Polygons, Tags};
+use subfit_mesh::Polygons;
 use subfit_subdiv::Scheme;
 
 #[test]

@@ -5,7 +5,6 @@ mod common;
 
 use subfit_fit::adapt::refine_red_green;
 use subfit_fit::{fit_stages, FitOptions, Fitter, StageOptions};
-use subfit_mesh::Tags;
 
 use common::{ellipsoid_target, fourteen_vertex_mesh, normalized};
 

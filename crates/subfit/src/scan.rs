@@ -43,6 +43,8 @@ pub enum Input {
 }
 
 /// The initial control mesh.
+// Built once per run: the size of the `Given` variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, Default)]
 pub enum InitialCage {
     /// Built with the target's topology (QEM simplification of a mesh target, IMLS contour of
