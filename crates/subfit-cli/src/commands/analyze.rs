@@ -98,6 +98,7 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         } else {
             NormalSource::Auto
         },
+        cancel: crate::interrupt::token(),
         ..TargetOptions::default()
     };
 
@@ -107,6 +108,9 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
 
     let bar = crate::progress::bar(1, "analysing");
     let on_progress = |p: Progress| {
+        if p.done == 0 {
+            crate::progress::phase(phase_name(p.phase));
+        }
         bar.set_message(phase_name(p.phase));
         bar.set_length(p.total.max(1) as u64);
         bar.set_position(p.done as u64);

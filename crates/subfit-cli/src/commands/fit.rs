@@ -122,7 +122,11 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
     let target_topology = mesh_topology(&target_mesh)
         .with_context(|| format!("{}: the target mesh is not usable", a.target.display()))?;
     let sp = crate::progress::spinner("analysing the target");
-    let target = Target::build(&target_mesh, &TargetOptions::default(), None)
+    let target_options = TargetOptions {
+        cancel: crate::interrupt::token(),
+        ..TargetOptions::default()
+    };
+    let target = Target::build(&target_mesh, &target_options, None)
         .with_context(|| format!("{}: cannot use as a target", a.target.display()))?;
     sp.finish_and_clear();
     let preprocess = target.stats().timings.total;
@@ -168,6 +172,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
             let mesh = (!target_mesh.faces.is_empty()).then_some(&target_mesh);
             let init_options = InitOptions {
                 expected_genus,
+                cancel: crate::interrupt::token(),
                 ..InitOptions::default()
             };
             let (m, r) =
@@ -207,6 +212,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
         sample_level: a.sample_level as usize,
         method,
         step,
+        cancel: crate::interrupt::token(),
         ..FitOptions::default()
     };
     let stages = StageOptions {
