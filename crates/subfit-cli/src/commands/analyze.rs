@@ -103,7 +103,8 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     };
 
     let t_read = std::time::Instant::now();
-    let (mesh, _) = crate::progress::load(&a.target)?;
+    let (mut mesh, _) = crate::progress::load(&a.target)?;
+    crate::commands::reorient_target(&mut mesh, &a.target);
     let read = t_read.elapsed().as_secs_f64();
 
     let bar = crate::progress::bar(1, "analysing");

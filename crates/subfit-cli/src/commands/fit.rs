@@ -97,6 +97,7 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Outcome> {
 
     let t0 = Instant::now();
     let (mut target_mesh, _) = crate::progress::load(&a.target)?;
+    crate::commands::reorient_target(&mut target_mesh, &a.target);
     // With --as-points the file's faces are dropped, but their genus still tells the initial
     // mesh what topology to aim for.
     let mut expected_genus = None;
