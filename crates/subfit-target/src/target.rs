@@ -131,6 +131,8 @@ impl Target {
         report(Phase::Validate, n_in, n_in);
 
         // Normalize.
+        let cancel = &options.cancel;
+        cancel.check()?;
         let t = Instant::now();
         report(Phase::Normalize, 0, n_in);
         let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
@@ -151,6 +153,7 @@ impl Target {
         report(Phase::Normalize, n_in, n_in);
 
         // Merge exact duplicates.
+        cancel.check()?;
         let t = Instant::now();
         report(Phase::Merge, 0, n_in);
         let (points, input_to_point) = merge_duplicates(&normalized);
@@ -169,6 +172,7 @@ impl Target {
         report(Phase::Merge, n_in, n_in);
 
         // kd-tree.
+        cancel.check()?;
         let t = Instant::now();
         report(Phase::Index, 0, points.len());
         let index = PointIndex::new(&points).ok_or(TargetError::TooFewPoints {
@@ -192,7 +196,6 @@ impl Target {
             graph_k: options.orientation_k,
             degree: options.jet_degree,
         };
-        let cancel = &options.cancel;
         cancel.check()?;
         let (estimates, graph) =
             estimate_all(&points, &index, &prescribed, &params, &tick, cancel)?;
