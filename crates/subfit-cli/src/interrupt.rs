@@ -1,14 +1,31 @@
-//! Interrupted runs (Ctrl-C, SIGTERM, SIGHUP) leave no partial output.
+//! Interrupted runs (Ctrl-C, SIGTERM, SIGHUP) stop within a second and leave no partial output.
 //!
 //! Every file is written to a temporary name beside its destination and renamed
 //! ([`subfit::io::write_atomic`]), so an interruption can only leave such a temporary file, or,
-//! for `subfit fit`, a staging directory holding a complete set of outputs not yet moved into
-//! place. The commands register where they write ([`watch_dir`], [`Staging`]); the signal handler
-//! removes this process's temporary files there and the staging directories, then exits with
-//! code 130 (128 + SIGINT, as shells report an interrupted command).
+//! for `subfit fit`, a staging directory holding outputs not yet moved into place. The commands
+//! register where they write ([`watch_dir`], [`Staging`]).
+//!
+//! On a signal the handler cancels the process-wide [`token`], which the commands put into the
+//! options of every long phase (target analysis, initial mesh, fitting): the phase returns its
+//! `Interrupted` error, the command returns, and `main` calls [`conclude`], which removes this
+//! process's temporary files and the staging directories and exits with code 130 (128 + SIGINT,
+//! as shells report an interrupted command). As a safety net for a phase that does not poll the
+//! token, the handler itself cleans up and exits 130 when the process is still there
+//! [`GRACE`] after the signal.
+//!
+//! All of it is serialized by one lock over the registry: creating and registering a staging
+//! directory, moving the staged outputs into place, and cleaning up then exiting each happen
+//! while holding it, and the clean-up keeps it until the process is gone. So an interruption
+//! sees a staging directory either not yet created or registered, and the outputs either all
+//! moved or none; and once `main` has concluded a finished run, a late signal can no longer
+//! remove anything.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
+use std::process::ExitCode;
+use std::sync::{Mutex, MutexGuard, OnceLock};
+use std::time::Duration;
+
+use subfit::mesh::Cancel;
 
 /// What the handler cleans up.
 enum Watched {
@@ -20,22 +37,57 @@ enum Watched {
 
 static WATCHED: Mutex<Vec<Watched>> = Mutex::new(Vec::new());
 
+static TOKEN: OnceLock<Cancel> = OnceLock::new();
+
 /// Exit code of an interrupted run.
 pub const EXIT_INTERRUPTED: i32 = 130;
+
+/// How long after a signal the handler waits for the command to stop by itself before it cleans
+/// up and exits on its own.
+pub const GRACE: Duration = Duration::from_millis(500);
+
+/// The process-wide cancellation token that the signal handler cancels; the commands put clones
+/// of it into the options of their long phases.
+pub fn token() -> Cancel {
+    TOKEN.get_or_init(Cancel::new).clone()
+}
 
 /// Installs the handler (once, at start-up). Failure to install (e.g. a handler already set)
 /// only loses the clean-up, so it is ignored.
 pub fn install() {
     let _ = ctrlc::set_handler(|| {
-        clean_up();
-        eprintln!("subfit: interrupted; no partial output left");
-        std::process::exit(EXIT_INTERRUPTED);
+        token().cancel();
+        // The command normally notices within milliseconds and `main` exits through
+        // `conclude`; this only runs on when a phase does not poll the token.
+        std::thread::sleep(GRACE);
+        exit_interrupted(watched(), " (the running step did not stop in time)");
     });
 }
 
-fn watched() -> std::sync::MutexGuard<'static, Vec<Watched>> {
+fn watched() -> MutexGuard<'static, Vec<Watched>> {
     // A panic while holding the lock cannot leave the list inconsistent: keep using it.
     WATCHED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes everything registered and exits with [`EXIT_INTERRUPTED`], holding the registry
+/// lock (`w`) until the process is gone. `how` completes the message on stderr.
+fn exit_interrupted(w: MutexGuard<'static, Vec<Watched>>, how: &str) -> ! {
+    clean_up(&w);
+    eprintln!("subfit: interrupted{how}; no partial output left");
+    std::process::exit(EXIT_INTERRUPTED);
+}
+
+/// Ends a run, given what the command returned: when the run was interrupted (the token is
+/// cancelled) and the command failed, cleans up and exits 130; otherwise returns `result`,
+/// keeping the registry locked for good, so that a signal arriving from now on waits for the
+/// process to exit instead of removing finished outputs.
+pub fn conclude(result: anyhow::Result<ExitCode>) -> anyhow::Result<ExitCode> {
+    let w = watched();
+    if token().is_cancelled() && result.is_err() {
+        exit_interrupted(w, "");
+    }
+    std::mem::forget(w);
+    result
 }
 
 /// Registers the directory that `path` (a file about to be written) lives in: on interruption,
@@ -54,13 +106,21 @@ pub fn watch_dir(path: &Path) {
     }
 }
 
-/// Removes everything registered (called by the handler; also used by tests).
-fn clean_up() {
+/// Removes everything registered in `w`. A staging directory is first renamed (to
+/// `.subfit-PID.removing` beside it), so that files the command may still be writing under the
+/// old name cannot reappear in it while it is removed.
+fn clean_up(w: &[Watched]) {
     let suffix = format!(".{}.tmp", std::process::id());
-    for w in watched().iter() {
-        match w {
+    for x in w {
+        match x {
             Watched::Staging(d) => {
-                let _ = std::fs::remove_dir_all(d);
+                let trash = d.with_extension("removing");
+                let gone = if std::fs::rename(d, &trash).is_ok() {
+                    &trash
+                } else {
+                    d
+                };
+                let _ = std::fs::remove_dir_all(gone);
             }
             Watched::TempFilesIn(d) => {
                 let Ok(entries) = std::fs::read_dir(d) else {
@@ -86,11 +146,13 @@ pub struct Staging {
 }
 
 impl Staging {
-    /// Creates `OUT/.subfit-PID/` (and `OUT` if needed) and registers it.
+    /// Creates `OUT/.subfit-PID/` (and `OUT` if needed) and registers it, both under the
+    /// registry lock: an interruption sees it either registered or not created.
     pub fn new(out: &Path) -> std::io::Result<Self> {
         let dir = out.join(format!(".subfit-{}", std::process::id()));
+        let mut w = watched();
         std::fs::create_dir_all(&dir)?;
-        watched().push(Watched::Staging(dir.clone()));
+        w.push(Watched::Staging(dir.clone()));
         Ok(Self {
             dir,
             out: out.to_path_buf(),
@@ -102,20 +164,32 @@ impl Staging {
         self.dir.join(name)
     }
 
-    /// Moves the staged files `names` into the output directory (one rename each, in order)
-    /// and removes the staging directory.
+    /// Moves the staged files `names` into the output directory (one rename each, in order) and
+    /// removes the staging directory, under the registry lock: an interruption sees all of them
+    /// moved or none. Refuses (an `Interrupted` I/O error, nothing moved) once the run has been
+    /// interrupted.
     pub fn commit(self, names: &[&str]) -> std::io::Result<()> {
+        let mut w = watched();
+        if token().is_cancelled() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::Interrupted,
+                "interrupted",
+            ));
+        }
         for n in names {
             std::fs::rename(self.dir.join(n), self.out.join(n))?;
         }
+        let _ = std::fs::remove_dir_all(&self.dir);
+        w.retain(|x| !matches!(x, Watched::Staging(d) if *d == self.dir));
         Ok(())
     }
 }
 
 impl Drop for Staging {
     fn drop(&mut self) {
+        let mut w = watched();
         let _ = std::fs::remove_dir_all(&self.dir);
-        watched().retain(|w| !matches!(w, Watched::Staging(d) if *d == self.dir));
+        w.retain(|x| !matches!(x, Watched::Staging(d) if *d == self.dir));
     }
 }
 
@@ -139,10 +213,11 @@ mod tests {
         let s = Staging::new(&d.path().join("out")).unwrap();
         std::fs::write(s.path("report.json"), b"{}").unwrap();
         let staged = s.path("");
-        clean_up();
+        clean_up(&watched());
         assert!(!ours.exists());
         assert!(other.exists() && kept.exists());
         assert!(!staged.exists());
+        assert_eq!(std::fs::read_dir(d.path().join("out")).unwrap().count(), 0);
         drop(s);
         watched().clear();
 
@@ -157,5 +232,6 @@ mod tests {
         assert_eq!(std::fs::read(d.path().join("a")).unwrap(), b"1");
         assert_eq!(std::fs::read(d.path().join("b")).unwrap(), b"2");
         assert!(!staged.exists());
+        assert!(watched().is_empty());
     }
 }

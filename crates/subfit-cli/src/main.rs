@@ -29,7 +29,8 @@ fn main() -> ExitCode {
         }
     };
     interrupt::install();
-    match commands::run(args) {
+    // An interrupted run exits 130 inside `conclude`, after removing what it had begun to write.
+    match interrupt::conclude(commands::run(args)) {
         Ok(code) => code,
         Err(e) => {
             eprintln!("subfit: error: {}", one_line(&e));

@@ -3,6 +3,7 @@
 
 use std::io::Read;
 use std::path::Path;
+use std::sync::OnceLock;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -10,8 +11,24 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 /// Files smaller than this are read without a bar.
 const BAR_THRESHOLD: u64 = 8 << 20;
 
+/// Environment variable: when set (to anything but empty or `0`), the start of every phase is
+/// printed on stderr as `subfit: phase: NAME`, for tests and scripts that need to know where a
+/// run is (e.g. to interrupt it in a given phase).
+pub const PHASE_LOG_ENV: &str = "SUBFIT_PHASE_LOG";
+
+/// Announces the start of a phase (see [`PHASE_LOG_ENV`]); spinners and bars call it.
+pub fn phase(name: &str) {
+    static ON: OnceLock<bool> = OnceLock::new();
+    let on = *ON
+        .get_or_init(|| std::env::var_os(PHASE_LOG_ENV).is_some_and(|v| !v.is_empty() && v != "0"));
+    if on {
+        eprintln!("subfit: phase: {name}");
+    }
+}
+
 /// A spinner with a message, on stderr.
 pub fn spinner(msg: &str) -> ProgressBar {
+    phase(msg);
     let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
     pb.set_style(
         ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("valid template"),
@@ -23,6 +40,7 @@ pub fn spinner(msg: &str) -> ProgressBar {
 
 /// A bar counting `len` items, on stderr.
 pub fn bar(len: u64, msg: &str) -> ProgressBar {
+    phase(msg);
     let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
     pb.set_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} [{elapsed}<{eta}]")

@@ -64,4 +64,13 @@ pub enum FitError {
     /// Another failure of the sparse solver (memory, …).
     #[error("sparse solver: {0}")]
     Solver(String),
+    /// [`crate::FitOptions::cancel`] was cancelled.
+    #[error("interrupted")]
+    Interrupted,
+}
+
+impl From<subfit_mesh::Cancelled> for FitError {
+    fn from(_: subfit_mesh::Cancelled) -> Self {
+        FitError::Interrupted
+    }
 }

@@ -426,6 +426,7 @@ impl<'t> Fitter<'t> {
         let mut stale = true;
         let mut trial_p = control.to_vec();
         for it in 1..=opts.max_iterations {
+            opts.cancel.check()?;
             let mut t = PhaseTimings::default();
             if stale {
                 let t0 = Instant::now();
@@ -546,6 +547,7 @@ impl<'t> Fitter<'t> {
         let mut step_length = 1.0;
         let mut backtracks = 0;
         loop {
+            opts.cancel.check()?;
             match &self.active {
                 None => {
                     for ((p, c), d) in trial_p.iter_mut().zip(control).zip(dir.delta) {

@@ -1,6 +1,6 @@
 //! Options of the fitting loop (Cheng et al. 2007, §II-B, §II-E, §III-C; DESIGN.md §3.4).
 
-use subfit_mesh::Tags;
+use subfit_mesh::{Cancel, Tags};
 use subfit_subdiv::{BoundaryRule, Options, Scheme};
 
 use crate::feet::FootPointSource;
@@ -164,6 +164,10 @@ pub struct FitOptions {
     /// Where foot points come from: the target's triangles when it has them (default), or
     /// always the local quadrics.
     pub foot_points: FootPointSource,
+    /// Cancellation token, polled at the start of every iteration and of every LM / Armijo
+    /// trial; once cancelled, [`crate::Fitter::run`] (and [`crate::fit`], [`crate::fit_stages`])
+    /// return [`crate::FitError::Interrupted`]. Default: a fresh token, never cancelled.
+    pub cancel: Cancel,
 }
 
 impl Default for FitOptions {
@@ -191,6 +195,7 @@ impl Default for FitOptions {
             pcg_tolerance: 1e-2,
             pcg_max_iterations: 500,
             foot_points: FootPointSource::Auto,
+            cancel: Cancel::default(),
         }
     }
 }

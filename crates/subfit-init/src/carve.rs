@@ -16,7 +16,7 @@
 //!
 //! Cost: one nearest-point query per grid node (parallel), `O(N³)` flags for an `N`-cell grid.
 
-use subfit_mesh::{HalfEdgeMesh, PolyMesh};
+use subfit_mesh::{Cancel, HalfEdgeMesh, PolyMesh};
 use subfit_target::Target;
 
 use crate::contour::{bounds, keep_components, ContourError, ContourReport};
@@ -34,6 +34,27 @@ pub fn carve(
     resolution: usize,
     radius: f64,
     min_component_fraction: f64,
+) -> Result<(PolyMesh, ContourReport), ContourError> {
+    carve_cancellable(
+        target,
+        resolution,
+        radius,
+        min_component_fraction,
+        &Cancel::default(),
+    )
+}
+
+/// Nodes per batch of nearest-point queries (`cancel` is polled between batches).
+const QUERY_BATCH: usize = 1 << 16;
+
+/// [`carve`] polling `cancel` per batch of nearest-point queries, during the flood fill and
+/// per slab of the marching; [`ContourError::Interrupted`] once it is cancelled.
+pub(crate) fn carve_cancellable(
+    target: &Target,
+    resolution: usize,
+    radius: f64,
+    min_component_fraction: f64,
+    cancel: &Cancel,
 ) -> Result<(PolyMesh, ContourReport), ContourError> {
     if !(radius.is_finite() && radius > 0.0) {
         return Err(ContourError::InvalidOption("carving radius must be > 0"));
@@ -56,14 +77,20 @@ pub fn carve(
     let grid = Grid { dims, origin, cell };
     let n_nodes = dims[0] * dims[1] * dims[2];
 
-    let nodes: Vec<[f64; 3]> = (0..n_nodes).map(|i| grid.pos(i)).collect();
-    let dist: Vec<f64> = target
-        .index()
-        .nearest_batch(&nodes)
-        .iter()
-        .map(|n| n.distance)
-        .collect();
-    drop(nodes);
+    let mut dist: Vec<f64> = Vec::with_capacity(n_nodes);
+    for start in (0..n_nodes).step_by(QUERY_BATCH) {
+        cancel.check()?;
+        let nodes: Vec<[f64; 3]> = (start..(start + QUERY_BATCH).min(n_nodes))
+            .map(|i| grid.pos(i))
+            .collect();
+        dist.extend(
+            target
+                .index()
+                .nearest_batch(&nodes)
+                .iter()
+                .map(|n| n.distance),
+        );
+    }
 
     // Outside: reachable from the grid boundary through nodes farther than `radius`.
     let mut outside = vec![false; n_nodes];
@@ -73,7 +100,12 @@ pub fn carve(
     for &i in &stack {
         outside[i] = true;
     }
+    let mut popped = 0usize;
     while let Some(i) = stack.pop() {
+        popped += 1;
+        if popped % (1 << 20) == 0 {
+            cancel.check()?;
+        }
         for j in grid.neighbors6(i) {
             if !outside[j] && dist[j] > radius {
                 outside[j] = true;
@@ -95,7 +127,7 @@ pub fn carve(
         })
         .collect();
 
-    let (positions, tris) = march_grid(&grid, &value);
+    let (positions, tris) = march_grid(&grid, &value, cancel)?;
     if tris.is_empty() {
         return Err(ContourError::Empty(resolution));
     }

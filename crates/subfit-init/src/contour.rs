@@ -41,7 +41,7 @@
 //! a finer resolution, a few layers of finest cells around the zero set) plus one IMLS
 //! evaluation per band point (parallel in `subfit-target`).
 
-use subfit_mesh::{face_components, HalfEdgeMesh, PolyMesh, Polygons};
+use subfit_mesh::{face_components, Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons};
 use subfit_target::Target;
 
 use crate::march::Marcher;
@@ -78,6 +78,11 @@ pub struct ContourOptions {
     /// Components with fewer faces than this fraction of the largest one are removed.
     /// Default 0.05 (valid `[0, 1]`; 1 keeps only the largest).
     pub min_component_fraction: f64,
+    /// Cancellation token, polled per octree level, per batch of IMLS evaluations and per
+    /// batch of leaves marched; once cancelled, [`contour`] returns
+    /// [`ContourError::Interrupted`]. Default: a fresh token, never cancelled.
+    /// ([`crate::initial_control_mesh`] uses [`crate::InitOptions::cancel`] instead.)
+    pub cancel: Cancel,
 }
 
 impl Default for ContourOptions {
@@ -89,6 +94,7 @@ impl Default for ContourOptions {
             band_cells: None,
             refine_margin: 0.5,
             min_component_fraction: 0.05,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -146,6 +152,15 @@ pub enum ContourError {
     /// Internal error: the contour is not manifold (a bug).
     #[error("internal error: the contour is not manifold: {0}")]
     NotManifold(String),
+    /// The cancellation token ([`ContourOptions::cancel`]) was cancelled.
+    #[error("interrupted")]
+    Interrupted,
+}
+
+impl From<Cancelled> for ContourError {
+    fn from(_: Cancelled) -> Self {
+        ContourError::Interrupted
+    }
 }
 
 /// Contours the target's IMLS function on an adaptive octree (see the module docs). Returns a
@@ -154,13 +169,15 @@ pub enum ContourError {
 ///
 /// Errors: [`ContourError::InvalidOption`] for an option out of its documented range,
 /// [`ContourError::Empty`] when the function has no zero crossing, [`ContourError::NotManifold`]
-/// (a bug). Cost: see the module docs.
+/// (a bug), [`ContourError::Interrupted`]. Cost: see the module docs.
 pub fn contour(
     target: &Target,
     options: &ContourOptions,
 ) -> Result<(PolyMesh, ContourReport), ContourError> {
     validate(options)?;
+    let cancel = &options.cancel;
     let frame = Frame::new(target, options)?;
+    cancel.check()?;
     let band = Band::new(target.points(), &frame);
     let mut tree = Octree::new(frame.root_level);
     let mut points = Points::default();
@@ -173,24 +190,36 @@ pub fn contour(
         &mut points,
         &mut values,
         options.refine_margin,
-    );
+        cancel,
+    )?;
+    cancel.check()?;
     let parents = band.ring.iter().map(|&k| pack(unpack(k).map(|c| c >> 1)));
     tree.split(frame.band_level + 1, parents);
     tree.balance();
+    cancel.check()?;
     let leaves = tree.leaves();
     let sampled = Sampled::new(&leaves, &mut points);
+    cancel.check()?;
 
     let in_band = band_points(&leaves, &sampled, &points, &band);
     values.resize(points.len(), f64::NAN);
     let fresh: Vec<u32> = (0..points.len() as u32)
         .filter(|&i| in_band[i as usize] && values[i as usize].is_nan())
         .collect();
-    evaluate(target, &frame, &points, &fresh, &mut values);
+    evaluate(target, &frame, &points, &fresh, &mut values, cancel)?;
     let (flipped, enclosed) = classify(&frame, &sampled, &points, &in_band, &mut values);
+    cancel.check()?;
 
     let pos = |i: usize| frame.position(points.keys[i]);
-    let (positions, tris, cut_leaves_per_level) =
-        march_octree(&leaves, &sampled, &points, &values, &pos, frame.root_level);
+    let (positions, tris, cut_leaves_per_level) = march_octree(
+        &leaves,
+        &sampled,
+        &points,
+        &values,
+        &pos,
+        frame.root_level,
+        cancel,
+    )?;
     if tris.is_empty() {
         return Err(ContourError::Empty(frame.resolution));
     }
@@ -405,22 +434,39 @@ impl Points {
     }
 }
 
+/// Points per batch of IMLS evaluations (a few tens of milliseconds): `cancel` is polled
+/// between batches.
+const EVALUATION_BATCH: usize = 1 << 14;
+
 /// IMLS values at the points `ids` into `values` (grown with NaN as needed); exact zeros are
-/// nudged to `1e-300` (outside).
-fn evaluate(target: &Target, frame: &Frame, points: &Points, ids: &[u32], values: &mut Vec<f64>) {
+/// nudged to `1e-300` (outside). Polls `cancel` per [`EVALUATION_BATCH`] points.
+fn evaluate(
+    target: &Target,
+    frame: &Frame,
+    points: &Points,
+    ids: &[u32],
+    values: &mut Vec<f64>,
+    cancel: &Cancel,
+) -> Result<(), Cancelled> {
     values.resize(points.len(), f64::NAN);
-    let xs: Vec<[f64; 3]> = ids
-        .iter()
-        .map(|&i| frame.position(points.keys[i as usize]))
-        .collect();
-    for (&i, v) in ids.iter().zip(target.imls_batch(&xs)) {
-        values[i as usize] = if v.value == 0.0 { 1e-300 } else { v.value };
+    for batch in ids.chunks(EVALUATION_BATCH) {
+        cancel.check()?;
+        let xs: Vec<[f64; 3]> = batch
+            .iter()
+            .map(|&i| frame.position(points.keys[i as usize]))
+            .collect();
+        for (&i, v) in batch.iter().zip(target.imls_batch(&xs)) {
+            values[i as usize] = if v.value == 0.0 { 1e-300 } else { v.value };
+        }
     }
+    Ok(())
 }
 
 /// Below the band level: splits band cells level by level where the zero set may pass
 /// (corner values of both signs, or some `|f|` below `margin` edges), evaluating the IMLS
-/// function at the corners of the cells it examines.
+/// function at the corners of the cells it examines. Polls `cancel` per level and per batch of
+/// evaluations.
+#[allow(clippy::too_many_arguments)]
 fn refine_band(
     target: &Target,
     frame: &Frame,
@@ -429,9 +475,11 @@ fn refine_band(
     points: &mut Points,
     values: &mut Vec<f64>,
     margin: f64,
-) {
+    cancel: &Cancel,
+) -> Result<(), Cancelled> {
     let mut current = band.cells.clone();
     for l in (1..=frame.band_level).rev() {
+        cancel.check()?;
         let mut fresh = Vec::new();
         let ids: Vec<[u32; 8]> = current
             .iter()
@@ -449,7 +497,7 @@ fn refine_band(
                 })
             })
             .collect();
-        evaluate(target, frame, points, &fresh, values);
+        evaluate(target, frame, points, &fresh, values, cancel)?;
         let edge = margin * frame.cell * f64::from(1u32 << l);
         let split: Vec<u64> = current
             .iter()
@@ -471,6 +519,7 @@ fn refine_band(
             .collect();
         current.sort_unstable();
     }
+    Ok(())
 }
 
 /// The leaves' points: corner ids, which hanging nodes each leaf has, and the extra points
@@ -570,10 +619,13 @@ impl Sampled {
     }
 }
 
+/// Vertices, triangles and cut leaves per level of [`march_octree`].
+type Marched = (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<usize>);
+
 /// Marching tetrahedra over the conforming tetrahedralization of the leaves (see the octree
 /// module), skipping leaves whose points all have one sign. `values` and `pos` are indexed by
 /// point id. Returns the vertices, the outward triangles and the cut leaves per level
-/// (`0..=root_level`).
+/// (`0..=root_level`). Polls `cancel` every 2^16 leaves.
 fn march_octree(
     leaves: &[Leaf],
     sampled: &Sampled,
@@ -581,12 +633,16 @@ fn march_octree(
     values: &[f64],
     pos: &dyn Fn(usize) -> [f64; 3],
     root_level: u32,
-) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<usize>) {
+    cancel: &Cancel,
+) -> Result<Marched, Cancelled> {
     let order = |i: usize| points.keys[i];
     let mut marcher = Marcher::new(values, pos, &order);
     let mut cut = vec![0; root_level as usize + 1];
     let mut tets = Vec::new();
     for (f, leaf) in leaves.iter().enumerate() {
+        if f % (1 << 16) == 0 {
+            cancel.check()?;
+        }
         let ids = &sampled.corners[f];
         if sampled.masks[f] == CORNER_MASK {
             let neg = ids.iter().filter(|&&i| values[i as usize] < 0.0).count();
@@ -611,7 +667,7 @@ fn march_octree(
             marcher.tet(t.map(|i| loc[i] as usize));
         }
     }
-    (marcher.positions, marcher.tris, cut)
+    Ok((marcher.positions, marcher.tris, cut))
 }
 
 /// Union-find with path halving.
@@ -811,7 +867,16 @@ mod tests {
             .map(|v| if v == 0.0 { 1e-300 } else { v })
             .collect();
         let pos = |i: usize| unpack(points.keys[i]).map(|c| c as f64);
-        let (positions, tris, cut) = march_octree(&leaves, &sampled, &points, &values, &pos, root);
+        let (positions, tris, cut) = march_octree(
+            &leaves,
+            &sampled,
+            &points,
+            &values,
+            &pos,
+            root,
+            &Cancel::default(),
+        )
+        .unwrap();
         assert!(cut[0] > 0 && cut[1] > 0 && cut[2] > 0, "{cut:?}");
         let cut_transitions = leaves
             .iter()

@@ -8,10 +8,10 @@
 
 use std::time::{Duration, Instant};
 
-use subfit_mesh::{HalfEdgeMesh, PolyMesh, TopologyError};
+use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, TopologyError};
 use subfit_target::Target;
 
-use crate::carve::carve;
+use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
 use crate::simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
 
@@ -37,6 +37,12 @@ pub struct InitOptions {
     /// [`ContourOptions::max_resolution`]), so that the simplification has room to place the
     /// control vertices. Default 8.
     pub contour_vertices_per_control: f64,
+    /// Cancellation token for every step (contouring, the carving fallback, simplification;
+    /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
+    /// level and per batch of cells, evaluations and edge collapses; once cancelled,
+    /// [`initial_control_mesh`] returns [`InitError::Interrupted`]. Default: a fresh token,
+    /// never cancelled.
+    pub cancel: Cancel,
 }
 
 impl Default for InitOptions {
@@ -47,6 +53,7 @@ impl Default for InitOptions {
             expected_genus: None,
             require_genus: false,
             contour_vertices_per_control: 8.0,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -163,10 +170,10 @@ pub enum InitError {
     },
     /// The mesh target cannot be simplified.
     #[error("simplification failed: {0}")]
-    Simplify(#[from] SimplifyError),
+    Simplify(SimplifyError),
     /// The point cloud cannot be contoured.
     #[error("contouring failed: {0}")]
-    Contour(#[from] ContourError),
+    Contour(ContourError),
     /// The result is not manifold (an internal error).
     #[error("internal error: the initial mesh is not manifold: {0}")]
     Topology(#[from] TopologyError),
@@ -178,6 +185,33 @@ pub enum InitError {
         /// The result's genus.
         got: u32,
     },
+    /// [`InitOptions::cancel`] was cancelled (in any step).
+    #[error("interrupted")]
+    Interrupted,
+}
+
+impl From<SimplifyError> for InitError {
+    fn from(e: SimplifyError) -> Self {
+        match e {
+            SimplifyError::Interrupted => InitError::Interrupted,
+            e => InitError::Simplify(e),
+        }
+    }
+}
+
+impl From<ContourError> for InitError {
+    fn from(e: ContourError) -> Self {
+        match e {
+            ContourError::Interrupted => InitError::Interrupted,
+            e => InitError::Contour(e),
+        }
+    }
+}
+
+impl From<Cancelled> for InitError {
+    fn from(_: Cancelled) -> Self {
+        InitError::Interrupted
+    }
 }
 
 /// An initial triangle control mesh with about `n_vertices` vertices and the target's topology.
@@ -196,8 +230,8 @@ pub enum InitError {
 /// [`InitError::NonFinite`] for a bad mesh target, [`InitError::TooFewForTopology`] when
 /// `n_vertices` is below [`min_vertices_for_topology`] of the surface (checked after contouring
 /// for point clouds), [`InitError::Contour`], [`InitError::GenusMismatch`] (only with
-/// [`InitOptions::require_genus`]). A target with too few points fails earlier, in
-/// [`Target`]'s constructor.
+/// [`InitOptions::require_genus`]), [`InitError::Interrupted`] once [`InitOptions::cancel`] is
+/// cancelled. A target with too few points fails earlier, in [`Target`]'s constructor.
 ///
 /// Cost: contouring `O(n log n + n·k)` for the `n` octree points (proportional to the band around
 /// the data, see [`crate::contour()`]) and `k` points per IMLS neighbourhood, simplification
@@ -223,7 +257,7 @@ pub fn initial_control_mesh(
             let t = Instant::now();
             let (m, c) = contour_for(target, n_vertices, options)?;
             let (m, c) = match options.expected_genus {
-                Some(g) if c.genus != g => match carve_for(target, &c, g) {
+                Some(g) if c.genus != g => match carve_for(target, &c, g, &options.cancel)? {
                     Some((cm, cc, r)) => {
                         report.carve_radius = Some(r);
                         (cm, cc)
@@ -249,10 +283,12 @@ pub fn initial_control_mesh(
     let loops_before = before.boundary_loops().len();
     check_topology_allows(&before, n_vertices)?;
     drop(before);
+    options.cancel.check()?;
 
     let t = Instant::now();
     let sopt = SimplifyOptions {
         target_vertices: n_vertices,
+        cancel: options.cancel.clone(),
         ..options.simplify.clone()
     };
     let (out, srep) = simplify(&dense, &sopt)?;
@@ -307,7 +343,11 @@ fn contour_for(
     n_vertices: usize,
     options: &InitOptions,
 ) -> Result<(PolyMesh, ContourReport), InitError> {
-    let (m, c) = contour(target, &options.contour)?;
+    let coarse = ContourOptions {
+        cancel: options.cancel.clone(),
+        ..options.contour.clone()
+    };
+    let (m, c) = contour(target, &coarse)?;
     let wanted = options.contour_vertices_per_control * n_vertices as f64;
     if options.contour.resolution.is_some()
         || !(wanted > c.vertices as f64)
@@ -321,7 +361,7 @@ fn contour_for(
         .clamp(c.resolution + 1, options.contour.max_resolution);
     let finer = ContourOptions {
         resolution: Some(res),
-        ..options.contour.clone()
+        ..coarse
     };
     // A finer resolution resolves more of the IMLS function's noise: on thin parts it can open
     // spurious handles (the armadillo at 2.5 cells per radius). The coarse contour's topology
@@ -330,6 +370,7 @@ fn contour_for(
         Ok((fm, fc)) if fc.genus == c.genus && fc.components_kept == c.components_kept => {
             Ok((fm, fc))
         }
+        Err(ContourError::Interrupted) => Err(InitError::Interrupted),
         _ => Ok((m, c)),
     }
 }
@@ -341,20 +382,23 @@ const MAX_CARVE_RESOLUTION: usize = 320;
 
 /// The space-carving fallback: carving radii of 1, 1.5, 2 and 3 IMLS-contour cells on a grid
 /// twice as fine (at most [`MAX_CARVE_RESOLUTION`]); the first result of genus `genus` with one
-/// component, if any, with its radius.
+/// component, if any, with its radius. Only [`InitError::Interrupted`] is an error.
 fn carve_for(
     target: &Target,
     imls: &ContourReport,
     genus: u32,
-) -> Option<(PolyMesh, ContourReport, f64)> {
+    cancel: &Cancel,
+) -> Result<Option<(PolyMesh, ContourReport, f64)>, InitError> {
     let res = (2 * imls.resolution).clamp(32, MAX_CARVE_RESOLUTION);
-    [1.0, 1.5, 2.0, 3.0].into_iter().find_map(|k| {
+    for k in [1.0, 1.5, 2.0, 3.0] {
         let r = k * imls.cell_size;
-        match carve(target, res, r, 1.0) {
-            Ok((m, c)) if c.genus == genus && c.components_kept == 1 => Some((m, c, r)),
-            _ => None,
+        match carve_cancellable(target, res, r, 1.0, cancel) {
+            Ok((m, c)) if c.genus == genus && c.components_kept == 1 => return Ok(Some((m, c, r))),
+            Err(ContourError::Interrupted) => return Err(InitError::Interrupted),
+            _ => {}
         }
-    })
+    }
+    Ok(None)
 }
 
 /// [`InitError::TooFewForTopology`] when `n_vertices` is below the sum over the components of

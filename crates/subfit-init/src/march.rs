@@ -5,6 +5,8 @@
 //! callers nudge zeros to a tiny positive number. Used on the octree of
 //! [`crate::contour()`] and on the uniform grid of [`crate::carve()`].
 
+use subfit_mesh::{Cancel, Cancelled};
+
 use crate::octree::{KeyMap, KUHN};
 use crate::simplify::{cross, dot, sub};
 
@@ -149,9 +151,17 @@ impl Grid {
     }
 }
 
+/// Vertices and outward triangles of a marched grid.
+pub(crate) type Surface = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// Marching tetrahedra over every grid cell with a sign change, each cell cut into the 6 Kuhn
-/// tetrahedra ([`KUHN`]). Returns vertices and outward triangles. Cost `O(#nodes)`.
-pub(crate) fn march_grid(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+/// tetrahedra ([`KUHN`]). Returns vertices and outward triangles. Cost `O(#nodes)`; `cancel`
+/// polled per slab of cells.
+pub(crate) fn march_grid(
+    grid: &Grid,
+    value: &[f64],
+    cancel: &Cancel,
+) -> Result<Surface, Cancelled> {
     let [nx, ny, nz] = grid.dims;
     let corner_off: [usize; 8] =
         std::array::from_fn(|c| (c & 1) + nx * (((c >> 1) & 1) + ny * ((c >> 2) & 1)));
@@ -159,6 +169,7 @@ pub(crate) fn march_grid(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32
     let order = |i: usize| i as u64;
     let mut m = Marcher::new(value, &pos, &order);
     for z in 0..nz - 1 {
+        cancel.check()?;
         for y in 0..ny - 1 {
             for x in 0..nx - 1 {
                 let base = x + nx * (y + ny * z);
@@ -173,5 +184,5 @@ pub(crate) fn march_grid(grid: &Grid, value: &[f64]) -> (Vec<[f64; 3]>, Vec<[u32
             }
         }
     }
-    (m.positions, m.tris)
+    Ok((m.positions, m.tris))
 }

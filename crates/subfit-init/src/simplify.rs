@@ -27,7 +27,7 @@
 
 use std::cmp::Ordering;
 
-use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons, TopologyError};
+use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, TopologyError};
 
 /// Options of [`simplify`]. Lengths are in the mesh's units; the checks are scale-invariant.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,7 +43,15 @@ pub struct SimplifyOptions {
     /// Weight of the boundary constraint planes relative to face planes (both are multiplied by
     /// an area: face area, or boundary edge length²). Default 100.
     pub boundary_weight: f64,
+    /// Cancellation token, polled every 1024 candidate collapses; once cancelled,
+    /// [`simplify`] returns [`SimplifyError::Interrupted`]. Default: a fresh token, never
+    /// cancelled. ([`crate::initial_control_mesh`] uses [`crate::InitOptions::cancel`] instead.)
+    pub cancel: Cancel,
 }
+
+/// Candidate collapses examined between two polls of [`SimplifyOptions::cancel`] (well under a
+/// millisecond of work).
+const COLLAPSE_BATCH: usize = 1024;
 
 impl Default for SimplifyOptions {
     fn default() -> Self {
@@ -52,6 +60,7 @@ impl Default for SimplifyOptions {
             max_normal_rotation_deg: 75.0,
             min_triangle_quality: 0.02,
             boundary_weight: 100.0,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -103,6 +112,15 @@ pub enum SimplifyError {
     /// The input is not a manifold, consistently oriented surface.
     #[error("the mesh is not an oriented manifold: {0}")]
     Topology(#[from] TopologyError),
+    /// The cancellation token ([`SimplifyOptions::cancel`]) was cancelled.
+    #[error("interrupted")]
+    Interrupted,
+}
+
+impl From<Cancelled> for SimplifyError {
+    fn from(_: Cancelled) -> Self {
+        SimplifyError::Interrupted
+    }
 }
 
 /// Simplifies a manifold, oriented polygon mesh (faces are fan-triangulated) by
@@ -111,7 +129,8 @@ pub enum SimplifyError {
 /// preserved; unreferenced input vertices are dropped.
 ///
 /// Returns a compact triangle mesh (`#V' by 3` positions, re-indexed; attributes dropped) and a
-/// report. Cost: `O(E log E)` time, `O(V + F)` memory.
+/// report. Cost: `O(E log E)` time, `O(V + F)` memory. [`SimplifyError::Interrupted`] once
+/// [`SimplifyOptions::cancel`] is cancelled.
 pub fn simplify(
     mesh: &PolyMesh,
     options: &SimplifyOptions,
@@ -130,8 +149,10 @@ pub fn simplify(
     let polys = Polygons::from_triangles(&tris);
     HalfEdgeMesh::new(&polys, mesh.num_vertices())?;
 
+    let cancel = &options.cancel;
+    cancel.check()?;
     let mut c = Collapser::new(mesh.positions.clone(), tris, options);
-    c.run(options.target_vertices);
+    c.run(options.target_vertices, cancel)?;
     // Stuck before the target: retry the rejected collapses with relaxed geometric checks
     // (never beyond a 90° normal rotation or a zero-area face).
     for (deg, quality) in [(85.0, 0.25), (89.0, 0.02)] {
@@ -142,7 +163,7 @@ pub fn simplify(
             options.max_normal_rotation_deg.max(deg),
             options.min_triangle_quality * quality,
         );
-        c.run(options.target_vertices);
+        c.run(options.target_vertices, cancel)?;
     }
     Ok(c.finish())
 }
@@ -491,8 +512,15 @@ impl Collapser {
         }
     }
 
-    fn run(&mut self, target: usize) {
+    /// Collapses cheapest first until `target` vertices remain or the heap is empty; polls
+    /// `cancel` every [`COLLAPSE_BATCH`] candidates.
+    fn run(&mut self, target: usize, cancel: &Cancel) -> Result<(), Cancelled> {
+        let mut examined = 0usize;
         while self.alive_vertices > target {
+            if examined % COLLAPSE_BATCH == 0 {
+                cancel.check()?;
+            }
+            examined += 1;
             let Some(e) = self.heap.pop() else { break };
             let (k, r) = (e.keep as usize, e.remove as usize);
             if self.stamp[k] != e.stamp_keep
@@ -539,6 +567,7 @@ impl Collapser {
             }
         }
         self.report.reached_target = self.alive_vertices <= target;
+        Ok(())
     }
 
     /// Faces containing both `a` and `b`, and their third vertices.

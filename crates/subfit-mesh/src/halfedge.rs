@@ -651,7 +651,7 @@ impl Iterator for Outgoing<'_> {
 
 /// Checks face sizes, vertex ranges and repeated vertices. Cost `O(#H)` (faces above 16
 /// vertices are sorted).
-fn validate_faces(faces: &Polygons, num_vertices: usize) -> Result<(), TopologyError> {
+pub(crate) fn validate_faces(faces: &Polygons, num_vertices: usize) -> Result<(), TopologyError> {
     let mut scratch = Vec::new();
     for (f, poly) in faces.iter().enumerate() {
         let face = FaceId(f as u32);

@@ -4,20 +4,26 @@
 //! beside it. [`Polygons`] is the compressed-row face list passed between crates and [`PolyMesh`]
 //! bundles it with positions and optional attributes. [`HalfEdgeMesh`] is a derived view for
 //! navigating manifold meshes; [`diagnose()`] reports on any polygon soup (boundary loops,
-//! manifoldness, orientation, components, Euler characteristic, genus).
+//! manifoldness, orientation, components, Euler characteristic, genus); [`reorient_faces`] repairs
+//! inconsistently oriented faces. [`Cancel`] is the cancellation token that the long phases of
+//! the other crates poll.
 
+pub mod cancel;
 pub mod components;
 pub mod diagnose;
 mod edges;
 pub mod halfedge;
 pub mod ids;
 pub mod polygons;
+pub mod reorient;
 pub mod shapes;
 pub mod tags;
 
+pub use cancel::{Cancel, Cancelled};
 pub use components::{euler_characteristic, face_components, genus, Components};
 pub use diagnose::{diagnose, diagnose_mesh, ComponentReport, IssueExamples, MeshReport};
 pub use halfedge::{HalfEdgeMesh, Outgoing, TopologyError};
 pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
 pub use polygons::{bounding_box, PolyMesh, Polygons};
+pub use reorient::{reorient_faces, ReorientError, ReorientReport};
 pub use tags::{Tags, SHARPNESS_INFINITE};

@@ -72,6 +72,9 @@ pub enum TargetError {
         /// Number of vertices.
         vertices: usize,
     },
+    /// [`crate::TargetOptions::cancel`] was cancelled: construction stopped early.
+    #[error("interrupted")]
+    Interrupted,
     /// An option is out of its valid range.
     #[error("invalid option {name}: {reason}")]
     InvalidOption {
@@ -80,4 +83,10 @@ pub enum TargetError {
         /// What is wrong with it.
         reason: String,
     },
+}
+
+impl From<subfit_mesh::Cancelled> for TargetError {
+    fn from(_: subfit_mesh::Cancelled) -> Self {
+        TargetError::Interrupted
+    }
 }

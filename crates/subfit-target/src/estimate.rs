@@ -4,6 +4,7 @@
 //! the fitted quadric at the data point. Orientation is decided elsewhere ([`crate::orient`]).
 
 use rayon::prelude::*;
+use subfit_mesh::{Cancel, Cancelled};
 
 use crate::neighbors::{morton_order, Neighbor, PointIndex};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
@@ -197,15 +198,17 @@ pub(crate) fn graph_stride(params: &EstimateParams) -> usize {
 /// [`estimate_point`] for all points in parallel, in chunks, calling `tick(done)` after each.
 /// Points are visited in Morton order (kd-tree locality); results are in point order, with the
 /// nearest-neighbour graph as rows of [`graph_stride`] entries (sorted by distance, padded with
-/// `u32::MAX`).
+/// `u32::MAX`). `cancel` is polled before each chunk.
 pub(crate) fn estimate_all(
     points: &[[f64; 3]],
     index: &PointIndex,
     prescribed: &[Option<[f64; 3]>],
     params: &EstimateParams,
     tick: &(dyn Fn(usize) + Sync),
-) -> (Vec<PointEstimate>, Vec<u32>) {
-    const CHUNK: usize = 1 << 15;
+    cancel: &Cancel,
+) -> Result<(Vec<PointEstimate>, Vec<u32>), Cancelled> {
+    // 8192 points: tens of milliseconds per chunk, so a cancellation is seen quickly.
+    const CHUNK: usize = 1 << 13;
     let n = points.len();
     let k = graph_stride(params);
     let order = morton_order(points);
@@ -213,6 +216,7 @@ pub(crate) fn estimate_all(
     let mut graph_sorted = vec![u32::MAX; n * k];
     let mut start = 0;
     while start < n {
+        cancel.check()?;
         let end = (start + CHUNK).min(n);
         let part: Vec<PointEstimate> = order[start..end]
             .par_iter()
@@ -247,5 +251,5 @@ pub(crate) fn estimate_all(
             let r = r as usize;
             row.copy_from_slice(&graph_sorted[r * k..(r + 1) * k]);
         });
-    (estimates, graph)
+    Ok((estimates, graph))
 }

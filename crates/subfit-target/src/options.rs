@@ -2,6 +2,8 @@
 
 use std::time::Duration;
 
+use subfit_mesh::Cancel;
+
 pub use crate::estimate::Neighborhood;
 
 /// Where the target's normals come from.
@@ -42,6 +44,11 @@ pub struct TargetOptions {
     pub imls_radius: Option<f64>,
     /// Build the triangle BVH for exact closest points when the input has faces. Default true.
     pub mesh_closest_point: bool,
+    /// Cancellation token, polled by every long step of construction (per chunk of the
+    /// per-point fits, per pass of the orientation and its winding-number and field checks);
+    /// once cancelled, construction returns [`crate::TargetError::Interrupted`] within a few
+    /// tens of milliseconds of work per thread. Default: a fresh token, never cancelled.
+    pub cancel: Cancel,
 }
 
 impl Default for TargetOptions {
@@ -55,6 +62,7 @@ impl Default for TargetOptions {
             ambiguity_ratio: 0.5,
             imls_radius: None,
             mesh_closest_point: true,
+            cancel: Cancel::default(),
         }
     }
 }

@@ -34,6 +34,7 @@
 //! of `C` points and O(A log P) per iteration on `A` active points, the rest O(E).
 
 use rayon::prelude::*;
+use subfit_mesh::{Cancel, Cancelled};
 
 use crate::neighbors::morton_order;
 use crate::regularize::{self, FieldInput};
@@ -89,6 +90,9 @@ pub struct OrientInput<'a> {
     /// winding field at the sample spacing mostly sees the noise (measured: on the noisy
     /// analytic shapes it flipped 2–13 correct normals). Empty: none.
     pub trusted: &'a [bool],
+    /// Polled between the steps and inside the long loops of every step; once cancelled,
+    /// [`orient_normals`] returns [`Cancelled`] (the normals are then partly oriented).
+    pub cancel: &'a Cancel,
 }
 
 /// Estimation neighbourhoods larger than this make a normal trusted (see
@@ -109,13 +113,16 @@ const VOLUME_DECISIVE: f64 = 0.2;
 
 /// Orients `normals` (unit, `#P by 3`) in place; see the module doc. The work is done on a copy
 /// renumbered in Morton order of the points (memory locality; points are expected in the unit
-/// cube, others still work, with less locality).
+/// cube, others still work, with less locality), so `normals` is only written at the end.
+///
+/// Errors: [`Cancelled`] when [`OrientInput::cancel`] is cancelled (`normals` unchanged).
 pub fn orient_normals(
     points: &[[f64; 3]],
     normals: &mut [[f64; 3]],
     graph: KnnGraph<'_>,
     input: &OrientInput<'_>,
-) -> Orientation {
+) -> Result<Orientation, Cancelled> {
+    let cancel = input.cancel;
     let n = points.len();
     let k = graph.stride;
     let order = morton_order(points);
@@ -133,6 +140,7 @@ pub fn orient_normals(
     } else {
         gather(input.trusted)
     };
+    cancel.check()?;
     let mut targets = vec![u32::MAX; n * k];
     targets
         .par_chunks_mut(k)
@@ -155,11 +163,12 @@ pub fn orient_normals(
         area: &area,
         tangent_penalty: input.tangent_penalty,
         trusted: &trusted,
+        cancel,
     };
-    let tree = spanning_tree(&pts, &nrm, graph, &input);
+    let tree = spanning_tree(&pts, &nrm, graph, &input)?;
     let mut closed = vec![false; n];
     let components = propagate(&pts, &mut nrm, &tree, &input, &mut closed);
-    consensus(&pts, &mut nrm, graph, &input);
+    consensus(&pts, &mut nrm, graph, &input)?;
     let eligible: Vec<bool> = closed
         .iter()
         .zip(input.fixed)
@@ -182,6 +191,7 @@ pub fn orient_normals(
             (a, d2.sqrt() * EXCLUDE_WIDEN)
         })
         .unzip();
+    cancel.check()?;
     let mut dipoles = DipoleTree::new(&pts, &nrm, &wn_area);
     let winding_flips = winding::refine(
         &mut nrm,
@@ -194,7 +204,8 @@ pub fn orient_normals(
             eligible: &eligible,
         },
         &mut dipoles,
-    );
+        cancel,
+    )?;
     let spacing: Vec<f64> = exclude.par_iter().map(|&e| e / EXCLUDE_WIDEN).collect();
     let scale: Vec<f64> = area.par_iter().map(|&a| a.max(0.0).sqrt()).collect();
     let field_eligible: Vec<bool> = eligible
@@ -214,7 +225,8 @@ pub fn orient_normals(
             eligible: &field_eligible,
         },
         &mut dipoles,
-    );
+        cancel,
+    )?;
     let redirected = if field.redirected > 0 {
         rank.iter()
             .map(|&r| redirected_sorted[r as usize])
@@ -232,7 +244,7 @@ pub fn orient_normals(
             f
         })
         .collect();
-    Orientation {
+    Ok(Orientation {
         flipped,
         components,
         winding_flips,
@@ -240,7 +252,7 @@ pub fn orient_normals(
         field_iterations: field.iterations,
         field_flips: field.flips,
         redirected,
-    }
+    })
 }
 
 /// Edge cost (see the module doc), as an `f32` whose bits order like its value.
@@ -281,20 +293,26 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
     x
 }
 
-/// Kruskal's algorithm on the kNN graph, fixed points pre-merged into one root.
+/// Kruskal's algorithm on the kNN graph, fixed points pre-merged into one root. Polls
+/// `inp.cancel` after the sort and every 2^16 edges.
 fn spanning_tree(
     points: &[[f64; 3]],
     normals: &[[f64; 3]],
     graph: KnnGraph<'_>,
     inp: &OrientInput<'_>,
-) -> Tree {
+) -> Result<Tree, Cancelled> {
     let n = points.len();
     let k = graph.stride;
     // key = cost bits << 32 | slot (i * k + s).
     let mut keys: Vec<u64> = (0..n)
         .into_par_iter()
         .flat_map_iter(|i| {
-            let row = &graph.targets[i * k..(i + 1) * k];
+            // Cancelled: no more keys (the caller checks after the loop).
+            let row = if inp.cancel.is_cancelled() {
+                &[][..]
+            } else {
+                &graph.targets[i * k..(i + 1) * k]
+            };
             row.iter().enumerate().filter_map(move |(s, &j)| {
                 let j = j as usize;
                 // Keep one direction of mutual edges.
@@ -309,7 +327,9 @@ fn spanning_tree(
             })
         })
         .collect();
+    inp.cancel.check()?;
     keys.par_sort_unstable();
+    inp.cancel.check()?;
     let mut parent: Vec<u32> = (0..n as u32).collect();
     let mut size = vec![1u32; n];
     if let Some(f0) = inp.fixed.iter().position(|&f| f) {
@@ -318,7 +338,10 @@ fn spanning_tree(
         }
     }
     let mut edges: Vec<(u32, u32)> = Vec::with_capacity(n);
-    for key in keys {
+    for (e, key) in keys.into_iter().enumerate() {
+        if e % (1 << 16) == 0 {
+            inp.cancel.check()?;
+        }
         let slot = (key & 0xffff_ffff) as usize;
         let (a, b) = ((slot / k) as u32, graph.targets[slot]);
         let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
@@ -353,7 +376,7 @@ fn spanning_tree(
         adj[fill[b as usize]] = a;
         fill[b as usize] += 1;
     }
-    Tree { off, adj }
+    Ok(Tree { off, adj })
 }
 
 /// Traverses the forest: components holding fixed points from those, the others from their
@@ -478,12 +501,13 @@ fn component_sign(
 }
 
 /// Flips points that disagree with the weighted majority of their neighbours, until stable.
+/// Polls `inp.cancel` before each sweep.
 fn consensus(
     points: &[[f64; 3]],
     normals: &mut [[f64; 3]],
     graph: KnnGraph<'_>,
     inp: &OrientInput<'_>,
-) {
+) -> Result<(), Cancelled> {
     let n = points.len();
     let k = graph.stride;
     // Edge weights do not depend on the signs: computed once, in parallel.
@@ -510,6 +534,7 @@ fn consensus(
             .collect()
     };
     for _ in 0..CONSENSUS_SWEEPS {
+        inp.cancel.check()?;
         let mut changed = 0usize;
         for i in 0..n {
             if inp.fixed[i] {
@@ -536,4 +561,5 @@ fn consensus(
             break;
         }
     }
+    Ok(())
 }

@@ -38,6 +38,7 @@
 //! then per iteration O(A log P) for `A` active points plus O(P) to refresh the tree.
 
 use rayon::prelude::*;
+use subfit_mesh::{Cancel, Cancelled};
 
 use crate::vec3::{add, dot, norm, normalize, scale, sub};
 use crate::winding::DipoleTree;
@@ -104,6 +105,8 @@ pub(crate) struct FieldOutcome {
 struct Ctx<'a> {
     inp: &'a FieldInput<'a>,
     sigma: Vec<f64>,
+    /// Polled per point evaluated; the loops return [`Cancelled`] after their parallel part.
+    cancel: &'a Cancel,
 }
 
 /// The field at the points of an evaluation set.
@@ -118,12 +121,15 @@ const FOUR_PI: f64 = 4.0 * std::f64::consts::PI;
 
 /// Refines `normals` (unit, Morton order) in place, see the module doc. `tree` is built over
 /// `inp.points` and `inp.area` with moments from `normals`; it is left refreshed with the result.
-/// Returns what was done and, per point, whether its direction was replaced (`#P`).
+/// Returns what was done and, per point, whether its direction was replaced (`#P`), or
+/// [`Cancelled`] once `cancel` is (polled per point evaluated; `normals` are then partly
+/// refined).
 pub(crate) fn refine(
     normals: &mut [[f64; 3]],
     inp: &FieldInput<'_>,
     tree: &mut DipoleTree,
-) -> (FieldOutcome, Vec<bool>) {
+    cancel: &Cancel,
+) -> Result<(FieldOutcome, Vec<bool>), Cancelled> {
     let n = inp.points.len();
     let mut out = FieldOutcome::default();
     let mut redirected = vec![false; n];
@@ -135,23 +141,24 @@ pub(crate) fn refine(
             .zip(inp.scale)
             .map(|(&h, &r)| SIGMA * h.max(r))
             .collect(),
+        cancel,
     };
     let checked = check_set(normals, inp);
     out.checked = checked.len();
     let mut active = vec![false; n];
-    for i in suspicious(&ctx, tree, normals, &checked) {
+    for i in suspicious(&ctx, tree, normals, &checked)? {
         active[i as usize] = true;
         out.suspicious += 1;
     }
     if out.suspicious == 0 {
-        return (out, redirected);
+        return Ok((out, redirected));
     }
     for _ in 0..RINGS {
         let marked = members(&active);
         add_neighbours(&mut active, &marked, inp);
     }
     let original = normals.to_vec();
-    let act = iterate(&ctx, tree, normals, &mut active, &mut out);
+    let act = iterate(&ctx, tree, normals, &mut active, &mut out)?;
     out.active = act.len();
     // Final normals: the estimate's direction with the field's sign where they agree within
     // 30°, else the field's.
@@ -170,7 +177,7 @@ pub(crate) fn refine(
         }
     }
     tree.refresh(normals, inp.area);
-    (out, redirected)
+    Ok((out, redirected))
 }
 
 /// The points the check evaluates: an even subsample of the eligible points (every
@@ -194,11 +201,20 @@ fn check_set(normals: &[[f64; 3]], inp: &FieldInput<'_>) -> Vec<u32> {
 }
 
 /// The points of `set` failing the check (see the module doc).
-fn suspicious(ctx: &Ctx<'_>, tree: &DipoleTree, normals: &[[f64; 3]], set: &[u32]) -> Vec<u32> {
+fn suspicious(
+    ctx: &Ctx<'_>,
+    tree: &DipoleTree,
+    normals: &[[f64; 3]],
+    set: &[u32],
+) -> Result<Vec<u32>, Cancelled> {
     let inp = ctx.inp;
-    set.par_iter()
+    let out = set
+        .par_iter()
         .copied()
         .filter(|&i| {
+            if ctx.cancel.is_cancelled() {
+                return false;
+            }
             let i = i as usize;
             let (w4, g4) = tree.field(
                 inp.points,
@@ -213,18 +229,21 @@ fn suspicious(ctx: &Ctx<'_>, tree: &DipoleTree, normals: &[[f64; 3]], set: &[u32
             let c = -dot(normals[i], g4) / norm(g4).max(f64::MIN_POSITIVE);
             !(0.0..=1.0).contains(&w) || c < SUSPICIOUS_COS
         })
-        .collect()
+        .collect();
+    ctx.cancel.check()?;
+    Ok(out)
 }
 
 /// The monotone iteration on the `active` points (grown as normals turn). Updates `normals` to
-/// the field's normals at the active points; returns them (sorted).
+/// the field's normals at the active points; returns them (sorted). Polls `ctx.cancel` per
+/// point evaluated, and returns [`Cancelled`] after the parallel loop that saw it.
 fn iterate(
     ctx: &Ctx<'_>,
     tree: &mut DipoleTree,
     normals: &mut [[f64; 3]],
     active: &mut [bool],
     out: &mut FieldOutcome,
-) -> Vec<u32> {
+) -> Result<Vec<u32>, Cancelled> {
     let inp = ctx.inp;
     let n = inp.points.len();
     let mut act = members(active);
@@ -232,12 +251,13 @@ fn iterate(
     // `F` and the charges are restricted to it) and each point's position in it.
     let mut set = with_neighbours(active, inp);
     let mut pos = positions(&set, n);
-    let mut ev = evaluate(ctx, tree, normals, &set);
+    let mut ev = evaluate(ctx, tree, normals, &set)?;
     let mut f = objective(ctx, normals, &ev, &set);
     let mut charges = vec![0.0; n];
     let mut backup: Vec<[f64; 3]> = Vec::with_capacity(act.len());
     let mut step = 1.0;
     while out.iterations < MAX_ITERATIONS {
+        ctx.cancel.check()?;
         out.iterations += 1;
         for (e, &i) in set.iter().enumerate() {
             let i = i as usize;
@@ -249,6 +269,9 @@ fn iterate(
             act.par_iter()
                 .map(|&i| {
                     let i = i as usize;
+                    if ctx.cancel.is_cancelled() {
+                        return normals[i];
+                    }
                     let e =
                         tree.coulomb(inp.points, charges, &ctx.sigma, inp.points[i], ctx.sigma[i]);
                     let g = ev.g[pos[i] as usize];
@@ -256,6 +279,7 @@ fn iterate(
                 })
                 .collect()
         };
+        ctx.cancel.check()?;
         for &i in &set {
             charges[i as usize] = 0.0;
         }
@@ -267,7 +291,7 @@ fn iterate(
                 normals[i as usize] = normalize(add(old, scale(sub(*d, old), step))).unwrap_or(old);
             }
             tree.refresh(normals, inp.area);
-            let ev2 = evaluate(ctx, tree, normals, &set);
+            let ev2 = evaluate(ctx, tree, normals, &set)?;
             let f2 = objective(ctx, normals, &ev2, &set);
             if f2 >= f {
                 break Some((ev2, f2));
@@ -301,13 +325,13 @@ fn iterate(
         if act.len() != before {
             set = with_neighbours(active, inp);
             pos = positions(&set, n);
-            ev = evaluate(ctx, tree, normals, &set);
+            ev = evaluate(ctx, tree, normals, &set)?;
             f = objective(ctx, normals, &ev, &set);
         } else if settled {
             break;
         }
     }
-    act
+    Ok(act)
 }
 
 /// Marks the eligible graph neighbours of the points `of`.
@@ -357,12 +381,20 @@ fn positions(set: &[u32], n: usize) -> Vec<u32> {
 }
 
 /// `4π w` and `4π ∇w` (own dipole included) at the points of `set`; `tree` refreshed from
-/// `normals`.
-fn evaluate(ctx: &Ctx<'_>, tree: &DipoleTree, normals: &[[f64; 3]], set: &[u32]) -> Eval {
+/// `normals`. [`Cancelled`] once `ctx.cancel` is (polled per point).
+fn evaluate(
+    ctx: &Ctx<'_>,
+    tree: &DipoleTree,
+    normals: &[[f64; 3]],
+    set: &[u32],
+) -> Result<Eval, Cancelled> {
     let inp = ctx.inp;
     let (w, g) = set
         .par_iter()
         .map(|&i| {
+            if ctx.cancel.is_cancelled() {
+                return (0.0, [0.0; 3]);
+            }
             let i = i as usize;
             let p = inp.points[i];
             tree.field(
@@ -376,7 +408,8 @@ fn evaluate(ctx: &Ctx<'_>, tree: &DipoleTree, normals: &[[f64; 3]], set: &[u32])
             )
         })
         .unzip();
-    Eval { w, g }
+    ctx.cancel.check()?;
+    Ok(Eval { w, g })
 }
 
 /// `4π F` restricted to the points of `set` (see the module doc).
@@ -418,6 +451,16 @@ mod tests {
         truth: &[[f64; 3]],
         normals: &mut [[f64; 3]],
     ) -> (FieldOutcome, f64) {
+        run_with(points, truth, normals, &Cancel::default()).unwrap()
+    }
+
+    /// [`run`] with a cancellation token.
+    fn run_with(
+        points: &[[f64; 3]],
+        truth: &[[f64; 3]],
+        normals: &mut [[f64; 3]],
+        cancel: &Cancel,
+    ) -> Result<(FieldOutcome, f64), Cancelled> {
         let order = morton_order(points);
         let pts: Vec<[f64; 3]> = order.iter().map(|&i| points[i as usize]).collect();
         let mut nrm: Vec<[f64; 3]> = order.iter().map(|&i| normals[i as usize]).collect();
@@ -450,7 +493,7 @@ mod tests {
             eligible: &eligible,
         };
         let mut tree = DipoleTree::new(&pts, &nrm, &area);
-        let (out, redirected) = refine(&mut nrm, &inp, &mut tree);
+        let (out, redirected) = refine(&mut nrm, &inp, &mut tree, cancel)?;
         assert_eq!(redirected.iter().filter(|&&r| r).count(), out.redirected);
         for (r, &i) in order.iter().enumerate() {
             normals[i as usize] = nrm[r];
@@ -461,7 +504,7 @@ mod tests {
             .filter(|(a, b)| dot(**a, **b) > 0.0)
             .count();
         assert!(normals.iter().all(|v| (norm(*v) - 1.0).abs() < 1e-9));
-        (out, agree as f64 / n as f64)
+        Ok((out, agree as f64 / n as f64))
     }
 
     /// Fibonacci points on the ellipsoid with semi-axes `a` about (0.5, 0.5, 0.5), with exact
@@ -504,6 +547,11 @@ mod tests {
                 *v = scale(*v, -1.0);
             }
         }
+        let messy = nrm.clone();
+        let cancel = Cancel::new();
+        cancel.cancel();
+        assert_eq!(run_with(&pts, &truth, &mut nrm, &cancel), Err(Cancelled));
+        assert_eq!(nrm, messy);
         let (out, agree) = run(&pts, &truth, &mut nrm);
         assert!(out.flips >= 1400, "{out:?}");
         assert!(agree >= 0.995, "{agree} {out:?}");

@@ -5,7 +5,7 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
-use subfit_mesh::PolyMesh;
+use subfit_mesh::{Cancel, Cancelled, PolyMesh};
 
 use crate::closest::TriangleBvh;
 use crate::error::TargetError;
@@ -100,7 +100,8 @@ impl Target {
     ///
     /// Errors: NaN/Inf coordinates or normals (with the input index), fewer than
     /// [`MIN_POINTS`] points or distinct points (this covers duplicate-only input), all points on
-    /// one line, face indices out of range, invalid options. A planar point set is valid: its
+    /// one line, face indices out of range, invalid options; [`TargetError::Interrupted`] once
+    /// [`TargetOptions::cancel`] is cancelled (polled between phases and inside the long ones). A planar point set is valid: its
     /// normals are the plane's (oriented `+z`, or `+x`/`+y` for a vertical plane) and its
     /// curvatures 0.
     ///
@@ -130,6 +131,8 @@ impl Target {
         report(Phase::Validate, n_in, n_in);
 
         // Normalize.
+        let cancel = &options.cancel;
+        cancel.check()?;
         let t = Instant::now();
         report(Phase::Normalize, 0, n_in);
         let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
@@ -150,6 +153,7 @@ impl Target {
         report(Phase::Normalize, n_in, n_in);
 
         // Merge exact duplicates.
+        cancel.check()?;
         let t = Instant::now();
         report(Phase::Merge, 0, n_in);
         let (points, input_to_point) = merge_duplicates(&normalized);
@@ -168,6 +172,7 @@ impl Target {
         report(Phase::Merge, n_in, n_in);
 
         // kd-tree.
+        cancel.check()?;
         let t = Instant::now();
         report(Phase::Index, 0, points.len());
         let index = PointIndex::new(&points).ok_or(TargetError::TooFewPoints {
@@ -191,9 +196,12 @@ impl Target {
             graph_k: options.orientation_k,
             degree: options.jet_degree,
         };
-        let (estimates, graph) = estimate_all(&points, &index, &prescribed, &params, &tick);
+        cancel.check()?;
+        let (estimates, graph) =
+            estimate_all(&points, &index, &prescribed, &params, &tick, cancel)?;
         stats.timings.estimate = t.elapsed();
         summarize_estimates(&estimates, &mut stats);
+        cancel.check()?;
 
         // Orientation.
         let t = Instant::now();
@@ -238,8 +246,9 @@ impl Target {
                     area: &area,
                     tangent_penalty: options.orientation_tangent_penalty,
                     trusted: &trusted,
+                    cancel,
                 },
-            );
+            )?;
             for (q, &f) in quadrics.iter_mut().zip(&o.flipped) {
                 if f {
                     *q = q.flipped();
@@ -253,7 +262,8 @@ impl Target {
                     &o.redirected,
                     &params,
                     &mut quadrics,
-                );
+                    cancel,
+                )?;
             }
             stats.flipped_normals = o.flipped.iter().filter(|&&f| f).count();
             stats.orientation_components = o.components;
@@ -263,6 +273,7 @@ impl Target {
             stats.field_flips = o.field_flips;
             stats.field_redirected = o.redirected.iter().filter(|&&r| r).count();
         }
+        cancel.check()?;
         let radius: Vec<f64> = estimates.iter().map(|e| e.radius).collect();
         let layout = QueryLayout::new(
             &points,
@@ -277,6 +288,7 @@ impl Target {
         report(Phase::Orient, np, np);
 
         // Mesh BVH.
+        cancel.check()?;
         let t = Instant::now();
         let bvh = if options.mesh_closest_point && !mesh.faces.is_empty() {
             report(Phase::MeshIndex, 0, 1);
@@ -505,7 +517,7 @@ impl QueryLayout {
 }
 
 /// Refits the quadric of every redirected point in the frame of its new normal (`normals`,
-/// `redirected`: `#P`). Parallel, O(R·k) for `R` redirected points.
+/// `redirected`: `#P`). Parallel, O(R·k) for `R` redirected points; `cancel` polled per point.
 fn refit_redirected(
     points: &[[f64; 3]],
     index: &PointIndex,
@@ -513,7 +525,8 @@ fn refit_redirected(
     redirected: &[bool],
     params: &EstimateParams,
     quadrics: &mut [LocalQuadric],
-) {
+    cancel: &Cancel,
+) -> Result<(), Cancelled> {
     let stride = graph_stride(params);
     quadrics
         .par_iter_mut()
@@ -522,10 +535,14 @@ fn refit_redirected(
         .for_each_init(
             || (Scratch::default(), vec![u32::MAX; stride]),
             |(scratch, row), (i, q)| {
+                if cancel.is_cancelled() {
+                    return;
+                }
                 let e = estimate_point(points, index, i, Some(normals[i]), params, row, scratch);
                 *q = e.quadric;
             },
         );
+    cancel.check()
 }
 
 /// The first `k` entries of each row of a graph with rows of `stride` entries (`k ≤ stride`);

@@ -17,6 +17,7 @@
 //! flips O(P).
 
 use rayon::prelude::*;
+use subfit_mesh::{Cancel, Cancelled};
 
 use crate::vec3::{add, dot, scale, sub};
 
@@ -353,12 +354,14 @@ const FIRST_PASS_POINTS: usize = 32_768;
 /// module doc), in Jacobi passes: the first over all eligible points, later ones over the
 /// points flipped in the previous pass and their neighbours. `tree` is built over `inp.points`
 /// and `inp.area` with moments from `normals`, and is left refreshed with the result. Returns
-/// the number of flips (a point flipped twice counts twice).
+/// the number of flips (a point flipped twice counts twice), or [`Cancelled`] once `cancel` is
+/// (polled per point evaluated).
 pub(crate) fn refine(
     normals: &mut [[f64; 3]],
     inp: &WindingInput<'_>,
     tree: &mut DipoleTree,
-) -> usize {
+    cancel: &Cancel,
+) -> Result<usize, Cancelled> {
     let n = inp.points.len();
     let k = inp.stride;
     // First pass on a subsample (every `step`-th point in Morton order: spread over the shape),
@@ -369,7 +372,7 @@ pub(crate) fn refine(
         .filter(|&i| inp.eligible[i as usize])
         .collect();
     if active.is_empty() {
-        return 0;
+        return Ok(0);
     }
     let mut total = 0;
     let mut mark = vec![false; n];
@@ -381,6 +384,9 @@ pub(crate) fn refine(
                 .par_iter()
                 .copied()
                 .filter(|&i| {
+                    if cancel.is_cancelled() {
+                        return false;
+                    }
                     let i = i as usize;
                     let p = inp.points[i];
                     let g = tree.gradient(inp.points, normals, inp.area, p, inp.exclude[i]);
@@ -388,6 +394,7 @@ pub(crate) fn refine(
                 })
                 .collect()
         };
+        cancel.check()?;
         if flips.is_empty() {
             break;
         }
@@ -413,7 +420,7 @@ pub(crate) fn refine(
         }
         active.sort_unstable();
     }
-    total
+    Ok(total)
 }
 
 #[cfg(test)]
@@ -535,7 +542,10 @@ mod tests {
         };
         let mut normals = truth.clone();
         let mut tree = DipoleTree::new(&pts, &normals, &area);
-        assert_eq!(refine(&mut normals, &inp, &mut tree), 0);
+        assert_eq!(
+            refine(&mut normals, &inp, &mut tree, &Cancel::default()),
+            Ok(0)
+        );
         assert_eq!(normals, truth);
         // Flip a cap (about 10 % of the points): all of it comes back.
         let cap = |p: &[f64; 3]| p[2] > 0.5 + 0.4 * 0.8;
@@ -547,7 +557,14 @@ mod tests {
         let flipped = pts.iter().filter(|p| cap(p)).count();
         assert!(flipped > n / 20);
         tree.refresh(&normals, &area);
-        assert!(refine(&mut normals, &inp, &mut tree) >= flipped);
+        let (messy, cancel) = (normals.clone(), Cancel::new());
+        cancel.cancel();
+        assert_eq!(
+            refine(&mut normals, &inp, &mut tree, &cancel),
+            Err(Cancelled)
+        );
+        assert_eq!(normals, messy);
+        assert!(refine(&mut normals, &inp, &mut tree, &Cancel::default()).unwrap() >= flipped);
         assert_eq!(normals, truth);
     }
 }

@@ -38,6 +38,9 @@ pub enum Error {
         /// The cause.
         source: subfit_fit::FitError,
     },
+    /// The run was cancelled through [`crate::FitScanOptions::cancel`].
+    #[error("interrupted")]
+    Interrupted,
     /// The outputs could not be built.
     #[error("cannot build the outputs: {0}")]
     Output(String),

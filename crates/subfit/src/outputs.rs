@@ -34,7 +34,8 @@ impl Fitted {
     /// A front end that wants all or none in place writes into a staging directory and
     /// renames them (the CLI does).
     ///
-    /// Errors: a file that cannot be written; a tessellation that cannot be built.
+    /// Errors: a file that cannot be written; [`Error::Interrupted`] when the run's token is
+    /// cancelled (checked before each file).
     pub fn write_into(&mut self, dir: &Path) -> Result<(), Error> {
         let t = Instant::now();
         let ascii = WriteOptions {
@@ -42,6 +43,8 @@ impl Fitted {
             encoding: Encoding::Ascii,
             single_precision: false,
         };
+        let check = || self.cancel.check().map_err(|_| Error::Interrupted);
+        check()?;
         subfit_io::write_file(&dir.join("control.obj"), &self.cage, &ascii)?;
         let usd_scheme = match self.scheme {
             Scheme::Loop => UsdScheme::Loop,
@@ -51,6 +54,7 @@ impl Fitted {
             BoundaryRule::EdgeOnly => UsdBoundary::EdgeOnly,
             BoundaryRule::EdgeAndCorner => UsdBoundary::EdgeAndCorner,
         };
+        check()?;
         subfit_io::write_usda_file(
             &dir.join("control.usda"),
             &self.cage,
@@ -78,6 +82,7 @@ impl Fitted {
             encoding: Encoding::BinaryLittleEndian,
             single_precision: false,
         };
+        check()?;
         subfit_io::write_file(&dir.join("limit.ply"), &limit, &binary)?;
         let unit = self.report.normalized_unit_in_original_units;
         let error_original: Vec<f64> = local.iter().map(|e| e * unit).collect();
@@ -85,6 +90,7 @@ impl Fitted {
             colors: Some(local.iter().map(|&e| error_color(e / scale)).collect()),
             ..limit
         };
+        check()?;
         subfit_io::write_ply_with_properties(
             &dir.join("error.ply"),
             &colored,
@@ -100,6 +106,7 @@ impl Fitted {
             ],
             &binary,
         )?;
+        check()?;
         subfit_io::write_atomic(
             &dir.join("log.csv"),
             log_csv(&self.stages.report).as_bytes(),
@@ -107,6 +114,7 @@ impl Fitted {
         self.report.error_color_scale_unit_cube = scale;
         self.report.timings_s.output = t.elapsed().as_secs_f64();
         self.report.timings_s.total += self.report.timings_s.output;
+        check()?;
         let json =
             serde_json::to_string_pretty(&self.report).map_err(|e| Error::Output(e.to_string()))?;
         subfit_io::write_atomic(&dir.join("report.json"), (json + "\n").as_bytes())?;

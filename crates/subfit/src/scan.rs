@@ -15,7 +15,7 @@ use subfit_fit::{
     fit_stages, FitOptions, IterationRow, StageEvent, StageOptions, StageReport, StagesResult,
 };
 use subfit_init::{default_control_points, initial_control_mesh, InitOptions, InitReport};
-use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons, Tags};
+use subfit_mesh::{reorient_faces, Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::{Target, TargetOptions};
 
@@ -24,7 +24,7 @@ use subfit_report::{data_samples, limit_tessellation, DistanceStats, MeshDistanc
 
 use crate::pipeline_report::{
     BoundaryLoops, Errors, FinalErrors, InitSummary, InitTimings, IterationSummary, OptionsSummary,
-    Report, RmsMax, StageSummary, TagCounts, TessellationSummary, Timings, Topology,
+    Reorientation, Report, RmsMax, StageSummary, TagCounts, TessellationSummary, Timings, Topology,
     TwoSidedErrors,
 };
 
@@ -87,8 +87,12 @@ pub struct FitScanOptions {
     /// Initial-mesh options (`expected_genus` is set from the faces with `as_points`).
     pub init_options: InitOptions,
     /// The error mapped to red in `error.ply` (normalized units). Default `None`: the final
-    /// two-sided `E_max`.
+    /// surface → data `E_max`.
     pub error_scale: Option<f64>,
+    /// Cancels the run from another thread (e.g. a signal handler): every long step polls it
+    /// and the run returns [`Error::Interrupted`]. It replaces the tokens of `target`,
+    /// `init_options` and `fit`. Default: a token nobody cancels.
+    pub cancel: Cancel,
 }
 
 impl Default for FitScanOptions {
@@ -103,6 +107,7 @@ impl Default for FitScanOptions {
             target: TargetOptions::default(),
             init_options: InitOptions::default(),
             error_scale: None,
+            cancel: Cancel::default(),
         }
     }
 }
@@ -157,6 +162,7 @@ pub struct Fitted {
     /// the target.
     pub(crate) limit: PolyMesh,
     pub(crate) local_error: Vec<f64>,
+    pub(crate) cancel: Cancel,
 }
 
 impl Fitted {
@@ -211,9 +217,37 @@ pub fn fit_scan(
     };
     let read = t0.elapsed().as_secs_f64();
 
+    // Faces that disagree with their neighbours (a messy scan) are turned, with a warning;
+    // only what cannot be repaired is refused (non-manifold edges, non-orientable parts),
+    // unless the faces are not used.
+    let mut reoriented = None;
+    if !mesh.faces.is_empty() {
+        match reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions)) {
+            Ok((faces, r)) if r.needed => {
+                warn(
+                    format!(
+                        "re-oriented {} faces in {} components of {name}",
+                        r.flipped_faces, r.repaired_components
+                    ),
+                    &mut progress,
+                );
+                reoriented = Some(Reorientation {
+                    faces_flipped: r.flipped_faces,
+                    components_changed: r.repaired_components,
+                });
+                mesh.faces = faces;
+            }
+            Ok(_) => {}
+            Err(e) if !options.as_points => return Err(Error::input(&name, e)),
+            Err(_) => {}
+        }
+    }
+    options.cancel.check().map_err(|_| Error::Interrupted)?;
+
     // With `as_points` the faces are dropped, but their genus still tells the initial mesh
     // what topology to aim for.
     let mut init_options = options.init_options.clone();
+    init_options.cancel = options.cancel.clone();
     if options.as_points && !mesh.faces.is_empty() {
         init_options.expected_genus = topology(&mesh).ok().map(|t| t.genus);
         mesh.faces = Polygons::new();
@@ -225,7 +259,14 @@ pub fn fit_scan(
     };
 
     step(Step::Analyse, &mut progress);
-    let target = Target::build(&mesh, &options.target, None).map_err(|e| Error::input(&name, e))?;
+    let target_options = TargetOptions {
+        cancel: options.cancel.clone(),
+        ..options.target.clone()
+    };
+    let target = Target::build(&mesh, &target_options, None).map_err(|e| match e {
+        subfit_target::TargetError::Interrupted => Error::Interrupted,
+        e => Error::input(&name, e),
+    })?;
     let preprocess = target.stats().timings.total.as_secs_f64();
 
     step(Step::Init, &mut progress);
@@ -295,6 +336,7 @@ pub fn fit_scan(
                     subfit_init::InitError::TooFewForTopology { .. } if options.control_points.is_none() => {
                         Error::Budget(format!("{name}: the budget of {budget} control points is too small for this target: {e}"))
                     }
+                    subfit_init::InitError::Interrupted => Error::Interrupted,
                     e => Error::Init { name: name.clone(), source: e },
                 }
             })?;
@@ -333,6 +375,7 @@ pub fn fit_scan(
     let fit = FitOptions {
         scheme,
         tags,
+        cancel: options.cancel.clone(),
         ..options.fit.clone()
     };
 
@@ -354,9 +397,12 @@ pub fn fit_scan(
             &options.stages,
             Some(&mut on_event),
         )
-        .map_err(|e| Error::Fit {
-            name: name.clone(),
-            source: e,
+        .map_err(|e| match e {
+            subfit_fit::FitError::Interrupted => Error::Interrupted,
+            e => Error::Fit {
+                name: name.clone(),
+                source: e,
+            },
         })?
     };
     let fit_time = t_fit.elapsed().as_secs_f64();
@@ -364,6 +410,7 @@ pub fn fit_scan(
     let unit = target.normalization().length_to_original(1.0);
     let last = result.report.last;
     let diagonal = bbox_diagonal(target.points());
+    options.cancel.check().map_err(|_| Error::Interrupted)?;
     // The cage written, measured both ways on the tessellation written with it (chordal error
     // a tenth of the fitting error, reported): what a user measures on limit.ply.
     let t_measure = Instant::now();
@@ -412,7 +459,7 @@ pub fn fit_scan(
         target: name,
         target_points: target.len(),
         target_topology,
-        reoriented: None,
+        reoriented,
         normalized_unit_in_original_units: unit,
         bbox_diagonal_unit_cube: diagonal,
         data_samples: match result.report.data_samples {
@@ -520,6 +567,7 @@ pub fn fit_scan(
         fit,
         limit: tessellation.mesh,
         local_error: local,
+        cancel: options.cancel.clone(),
     })
 }
 

@@ -98,15 +98,20 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         } else {
             NormalSource::Auto
         },
+        cancel: crate::interrupt::token(),
         ..TargetOptions::default()
     };
 
     let t_read = std::time::Instant::now();
-    let (mesh, _) = crate::progress::load(&a.target)?;
+    let (mut mesh, _) = crate::progress::load(&a.target)?;
+    crate::commands::reorient_target(&mut mesh, &a.target);
     let read = t_read.elapsed().as_secs_f64();
 
     let bar = crate::progress::bar(1, "analysing");
     let on_progress = |p: Progress| {
+        if p.done == 0 {
+            crate::progress::phase(phase_name(p.phase));
+        }
         bar.set_message(phase_name(p.phase));
         bar.set_length(p.total.max(1) as u64);
         bar.set_position(p.done as u64);

@@ -104,6 +104,11 @@ pub fn run_with_progress(
     options: &FitScanOptions,
     max_iterations: u64,
 ) -> anyhow::Result<Fitted> {
+    let options = FitScanOptions {
+        cancel: crate::interrupt::token(),
+        ..options.clone()
+    };
+    let options = &options;
     let mut spinner: Option<indicatif::ProgressBar> = None;
     let mut bar: Option<indicatif::ProgressBar> = None;
     let mut on = |p: Progress<'_>| match p {

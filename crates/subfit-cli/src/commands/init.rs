@@ -36,7 +36,8 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     }
 
     let t0 = Instant::now();
-    let (input, _) = crate::progress::load(&a.target)?;
+    let (mut input, _) = crate::progress::load(&a.target)?;
+    crate::commands::reorient_target(&mut input, &a.target);
     let read_time = t0.elapsed();
     let use_mesh = !a.from_points && !input.faces.is_empty();
     // The target's own topology, when it has faces.
@@ -47,12 +48,17 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     let built = if use_mesh {
         let opts = TargetOptions {
             mesh_closest_point: false,
+            cancel: crate::interrupt::token(),
             ..TargetOptions::default()
         };
         Target::build(&input, &opts, None)
     } else {
         let cloud = PolyMesh::point_cloud(input.positions.clone(), input.normals.clone());
-        Target::build(&cloud, &TargetOptions::default(), None)
+        let opts = TargetOptions {
+            cancel: crate::interrupt::token(),
+            ..TargetOptions::default()
+        };
+        Target::build(&cloud, &opts, None)
     };
     sp.finish_and_clear();
     let target =
@@ -73,6 +79,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     let options = InitOptions {
         expected_genus,
         require_genus: a.require_genus,
+        cancel: crate::interrupt::token(),
         ..InitOptions::default()
     };
     let sp = crate::progress::spinner(if use_mesh {

@@ -12,7 +12,10 @@ mod info;
 mod init;
 mod subdivide;
 
+use std::path::Path;
 use std::process::ExitCode;
+
+use subfit::mesh::{reorient_faces, PolyMesh};
 
 use crate::cli::{Args, Command};
 
@@ -29,5 +32,30 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Init(a) => init::run(a),
         Command::Compare(a) => compare::run(a),
         Command::Bench(b) => bench::run(b),
+    }
+}
+
+/// Re-orients the faces of a target mesh read from `file` consistently per component
+/// ([`reorient_faces`]; real scans often have a few faces the wrong way round), with a warning
+/// on stderr when any were flipped. A mesh that cannot be repaired (a non-manifold edge, a
+/// non-orientable component) is left as it is, for the command's own checks to accept (e.g.
+/// `analyze`, `init --from-points`) or refuse with their usual one-line error.
+pub fn reorient_target(mesh: &mut PolyMesh, file: &Path) {
+    if mesh.faces.is_empty() {
+        return;
+    }
+    // Not repairable: the command's own checks accept or refuse the mesh as it is.
+    let Ok((faces, r)) = reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions))
+    else {
+        return;
+    };
+    if r.needed {
+        eprintln!(
+            "subfit: warning: re-oriented {} faces in {} components of {}",
+            r.flipped_faces,
+            r.repaired_components,
+            file.display()
+        );
+        mesh.faces = faces;
     }
 }

@@ -1,0 +1,83 @@
+//! A target mesh with a few faces the wrong way round (as real scans have) is repaired, with a
+//! warning, by `init`, `analyze` and `fit`, instead of being refused.
+
+mod common;
+
+use std::path::Path;
+
+use common::subfit;
+use subfit::io::{Encoding, WriteOptions};
+use subfit::mesh::shapes::torus_mesh;
+use subfit::mesh::{PolyMesh, Polygons};
+
+/// A torus mesh (genus 1) with faces 10, 11, 500 and 900 reversed, as OBJ.
+fn messy_torus(dir: &Path) -> std::path::PathBuf {
+    let t = torus_mesh(1.0, 0.4, 48, 24, true);
+    let mut faces = Polygons::new();
+    for (f, poly) in t.faces.iter().enumerate() {
+        if [10, 11, 500, 900].contains(&f) {
+            let r: Vec<u32> = poly.iter().rev().copied().collect();
+            faces.push(&r);
+        } else {
+            faces.push(poly);
+        }
+    }
+    let path = dir.join("messy.obj");
+    let opts = WriteOptions {
+        format: None,
+        encoding: Encoding::Ascii,
+        single_precision: false,
+    };
+    subfit::io::write_file(&path, &PolyMesh::new(t.positions, faces), &opts).unwrap();
+    path
+}
+
+#[test]
+fn inconsistently_oriented_faces_are_repaired_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let messy = messy_torus(d.path());
+    let m = messy.to_str().unwrap();
+    let warning = format!("subfit: warning: re-oriented 4 faces in 1 components of {m}");
+
+    let cage = d.path().join("cage.obj");
+    let r = subfit(&[
+        "init",
+        m,
+        "--control-points",
+        "60",
+        "-o",
+        cage.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    assert!(err.contains(&warning), "{err}");
+    let info: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", cage.to_str().unwrap()]).stdout)
+            .unwrap();
+    assert_eq!(info["topology"]["genus"], 1, "{info}");
+
+    let r = subfit(&["analyze", m]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    assert!(err.contains(&warning), "{err}");
+
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        m,
+        "-o",
+        out.to_str().unwrap(),
+        "--control-points",
+        "60",
+        "--max-iterations",
+        "1",
+        "--sample-level",
+        "2",
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    assert!(err.contains(&warning), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["target_topology"]["genus"], 1, "{report}");
+}
