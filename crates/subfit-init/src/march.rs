@@ -6,7 +6,7 @@
 //! [`crate::contour()`] and on the uniform grid of [`crate::carve()`].
 
 use crate::octree::{KeyMap, KUHN};
-use crate::simplify::{cross, dot, sub};
+use subfit_mesh::vec3::{cross, dot, sub};
 
 /// Accumulates the zero set of tetrahedra over nodes numbered `0..n`.
 pub(crate) struct Marcher<'a> {

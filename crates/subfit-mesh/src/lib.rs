@@ -4,7 +4,8 @@
 //! beside it. [`Polygons`] is the compressed-row face list passed between crates and [`PolyMesh`]
 //! bundles it with positions and optional attributes. [`HalfEdgeMesh`] is a derived view for
 //! navigating manifold meshes; [`diagnose()`] reports on any polygon soup (boundary loops,
-//! manifoldness, orientation, components, Euler characteristic, genus).
+//! manifoldness, orientation, components, Euler characteristic, genus). [`vec3`] holds the
+//! small `[f64; 3]` helpers every crate uses.
 
 pub mod components;
 pub mod diagnose;
@@ -14,6 +15,7 @@ pub mod ids;
 pub mod polygons;
 pub mod shapes;
 pub mod tags;
+pub mod vec3;
 
 pub use components::{euler_characteristic, face_components, genus, Components};
 pub use diagnose::{diagnose, diagnose_mesh, ComponentReport, IssueExamples, MeshReport};

@@ -27,6 +27,7 @@ use crate::eval::{EvalError, EvalKind, Evaluator, SurfaceParam, SurfacePoint};
 use crate::scheme::Scheme;
 use rayon::prelude::*;
 use std::collections::HashMap;
+use subfit_mesh::vec3::{dot, sub};
 
 /// Options of the closest-point search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -684,14 +685,6 @@ fn edge_spans(ev: &Evaluator) -> EdgeMaps {
         }
     }
     (map, per_patch)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn half_norm2(a: [f64; 3]) -> f64 {

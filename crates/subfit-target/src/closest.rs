@@ -2,7 +2,7 @@
 //! boxes, median split), for mesh targets. The point–triangle test is Ericson, "Real-Time
 //! Collision Detection" §5.1.5 (Voronoi regions, barycentric result).
 
-use crate::vec3::{add, cross, dot, normalize, scale, sub};
+use subfit_mesh::vec3::{add, cross, dot, normalize, scale, sub};
 
 /// Closest point on a triangle mesh to a query point.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -39,8 +39,8 @@
 
 use rayon::prelude::*;
 
-use crate::vec3::{add, dot, norm, normalize, scale, sub};
 use crate::winding::DipoleTree;
+use subfit_mesh::vec3::{add, dot, norm, normalize, scale, sub};
 
 /// Kernel regularization `σ_i = SIGMA · h_i`.
 const SIGMA: f64 = 0.2;

@@ -2,6 +2,7 @@
 //! control points) or [`SurfacePoint`] (values) out, and why an evaluation is refused.
 
 use crate::error::SubdivError;
+use subfit_mesh::vec3::{cross, unit};
 
 /// A point of the parameter domain: `(face, sub, u, v)`, see the module docs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -156,26 +157,9 @@ impl EvalWeights {
                 .second
                 .as_ref()
                 .map(|[a, b, c]| [dot(a), dot(b), dot(c)]),
-            normal: unit(cross(du, dv)),
+            normal: unit(cross(du, dv)).unwrap_or([0.0; 3]),
             kind: self.kind,
             depth: self.depth,
         }
-    }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(n: [f64; 3]) -> [f64; 3] {
-    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    if l > 0.0 && l.is_finite() {
-        [n[0] / l, n[1] / l, n[2] / l]
-    } else {
-        [0.0; 3]
     }
 }
