@@ -5,8 +5,9 @@
 //! bundles it with positions and optional attributes. [`HalfEdgeMesh`] is a derived view for
 //! navigating manifold meshes; [`diagnose()`] reports on any polygon soup (boundary loops,
 //! manifoldness, orientation, components, Euler characteristic, genus). [`vec3`] holds the
-//! small `[f64; 3]` helpers every crate uses.
+//! small `[f64; 3]` helpers every crate uses; [`bvh`] the exact closest point on triangles.
 
+pub mod bvh;
 pub mod components;
 pub mod diagnose;
 mod edges;
