@@ -4,7 +4,7 @@
 //! Plain functions, `#[inline]`, each written out component by component in a fixed order, so a
 //! result is the same bits wherever it is computed (Rust does not contract `a * b + c` into a
 //! fused multiply-add). Two normalizations exist because existing results depend on their exact
-//! bits: [`normalize`] multiplies by the reciprocal of the length, [`unit`] divides by the
+//! bits: [`normalize`] multiplies by the reciprocal of the length, [`unit`](fn@unit) divides by the
 //! length (one rounding per component instead of two); they differ by at most an ulp or so.
 
 /// `a + b`.

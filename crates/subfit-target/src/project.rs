@@ -5,14 +5,16 @@
 //! Method: the nearest data point by kd-tree (or, in batches and for warm-started queries, by
 //! certified greedy descent over the 16-nearest-neighbour graph from a nearby point, with the
 //! kd-tree as fallback: same result, fewer tree traversals), then the closest point on that
-//! point's local quadric (Newton on the height function, [`LocalQuadric::project_local`](crate::quadric::LocalQuadric::project_local)).
+//! point's local quadric (Newton on the height function,
+//! [`LocalQuadric::project_local`](crate::quadric::LocalQuadric::project_local)).
 //! Where that one quadric is not to be trusted — next to a point whose quadric disagrees with
 //! its neighbours' (creases, scanner debris), or over a sampling gap — the foot point is
 //! instead blended over the quadrics of the 16 nearest data points (`blend` module; Ohtake et
 //! al. 2003's partition of unity of local quadrics).
 //!
-//! The foot point on one quadric, and the signs of its distance and radii: [`crate::foot`]
-//! (re-exported here).
+//! The foot point on one quadric and the signs of its distance and radii ([`FootPoint`],
+//! [`foot_point_on`], [`alpha_plus`]) live in the crate-private module `foot` and are
+//! re-exported here.
 
 use rayon::prelude::*;
 

@@ -18,11 +18,11 @@
 //!
 //! Ascii values keep the precision of their text whatever type the header declares.
 //!
-//! Every problem is an [`Error`]: ascii files report the 1-based line ([`crate::Location::Line`], the
-//! message names the element), binary files the element ([`crate::Location::Element`], the message
-//! gives the byte offset). The reader never panics, and never allocates more than the
-//! remaining bytes could hold, whatever the counts in the header say. Non-finite positions and
-//! normals and out-of-range indices are errors.
+//! Every problem is an [`Error`](crate::Error): ascii files report the 1-based line
+//! ([`crate::Location::Line`], the message names the element), binary files the element
+//! ([`crate::Location::Element`], the message gives the byte offset). The reader never panics,
+//! and never allocates more than the remaining bytes could hold, whatever the counts in the
+//! header say. Non-finite positions and normals and out-of-range indices are errors.
 //!
 //! **Writing** produces `vertex` with `double` coordinates (`float` when `single_precision`),
 //! normals and `uchar` colours when present, and `face` as `list uchar int vertex_indices`

@@ -9,7 +9,8 @@
 //! ([`crate::patch`]: quartic box spline for Loop, bicubic B-spline for Catmull-Clark) is
 //! evaluated. Both steps are exact, so the result is exact to rounding, near extraordinary
 //! vertices too (no Gregory or other approximation). Exactly at an irregular vertex the limit
-//! masks ([`Scheme::limit_masks`]) give the position and two limit tangents.
+//! masks ([`Scheme::limit_masks`](crate::Scheme::limit_masks)) give the position and two limit
+//! tangents.
 //!
 //! # Parametrisation
 //! * Loop triangle `(c0, c1, c2)` (corner order of the face): barycentric, the point is
