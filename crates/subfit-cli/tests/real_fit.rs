@@ -1,5 +1,5 @@
-//! `subfit fit` on the real models of `$SUBFIT_DATA` (issue 6): Igea as a point cloud and the
-//! rocker arm against Cheng 2007 Table IV, genus kept through fitting on fertility (genus 4)
+//! `subfit fit` on the real models of `$SUBFIT_DATA` (DESIGN.md §5): Igea as a point cloud and
+//! the rocker arm against Cheng 2007 Table IV, genus kept through fitting on fertility (genus 4)
 //! and the armadillo with E_rms ≤ 0.001,
 //! and the fitted limit surface against our own QEM simplification at the same vertex count.
 //!

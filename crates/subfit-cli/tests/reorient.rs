@@ -83,5 +83,8 @@ fn inconsistently_oriented_faces_are_repaired_with_a_warning() {
     // The repair is in the report too, beside the warning.
     assert_eq!(report["reoriented"]["faces_flipped"], 4, "{report}");
     assert_eq!(report["reoriented"]["components_changed"], 1, "{report}");
-    assert!(report["warnings"][0].as_str().unwrap().contains("re-oriented 4 faces"));
+    assert!(report["warnings"][0]
+        .as_str()
+        .unwrap()
+        .contains("re-oriented 4 faces"));
 }

@@ -1,6 +1,7 @@
-//! Active sets: fitting only some control points while the others stay fixed (issue #6:
-//! "optimize only the new and neighbouring control points when the rest already fits";
-//! the local fitting of Cheng et al. 2004 §4.6).
+//! Active sets: fitting only some control points while the others stay fixed — the local
+//! optimization of Cheng et al. 2004 §4.5: after a local subdivision, "if the fitting error in
+//! most other regions are already acceptable, only the newly added points and their
+//! neighboring vertices are treated as variables and optimized".
 //!
 //! With the control points split into active `a` and fixed `f`, the model's minimizer over
 //! `δ_a` with `δ_f = 0` solves `H_aa δ_a = −g_a` (the fixed variables eliminated:

@@ -1,5 +1,5 @@
-//! Samples grouped by shared support, for the fill of the normal matrix (issue #5, assembly
-//! speed; DESIGN.md §3.3).
+//! Samples grouped by shared support, for a fast fill of the normal matrix of the quadratic
+//! model (the error terms of Cheng 2007 §II-D summed over samples; DESIGN.md §3.3).
 //!
 //! `H = w_e Σ_k (c_k c_kᵀ) ⊗ Q_k` is a sum of small dense blocks. Most samples share their
 //! support with many others (all level-`l` samples inside one control face depend on the same

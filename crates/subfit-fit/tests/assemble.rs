@@ -8,6 +8,7 @@ use subfit_fit::smooth::Laplacian;
 use subfit_fit::solve::{CholeskySolver, SolveFailure};
 use subfit_fit::terms::{error_matrix, Mat3, Method};
 use subfit_mesh::shapes::octahedron_mesh;
+use subfit_mesh::vec3::{self, cross};
 use subfit_mesh::{PolyMesh, Tags};
 use subfit_subdiv::{sampling_operator, Options, SamplingOperator, Scheme};
 use subfit_target::FootPoint;
@@ -33,17 +34,9 @@ fn rnd(state: &mut u64) -> f64 {
     ((*state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
 }
 
+/// `v / |v|` ([`vec3::unit`]); NaN for a zero vector.
 fn normalize(v: [f64; 3]) -> [f64; 3] {
-    let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [v[0] / l, v[1] / l, v[2] / l]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    vec3::unit(v).unwrap_or([f64::NAN; 3])
 }
 
 /// The foot point of `x` on the sphere `|x − c| = r` (outward normal), exact.

@@ -5,7 +5,7 @@
 mod common;
 
 use subfit_fit::{fit, fit_stages, FitError, FitOptions, Fitter, StageEvent, StageOptions};
-use subfit_mesh::{Cancel, Tags};
+use subfit_mesh::Cancel;
 
 use common::{ellipsoid_target, fourteen_vertex_mesh, normalized};
 
@@ -31,14 +31,7 @@ fn a_cancelled_token_stops_the_fitter_and_the_stages() {
 
     // Cancelled after the first iteration: the loop stops at the top of the second.
     let opts = options();
-    let mut fitter = Fitter::new(
-        &target,
-        &mesh.faces,
-        mesh.num_vertices(),
-        &Tags::new(),
-        &opts,
-    )
-    .unwrap();
+    let mut fitter = Fitter::new(&target, &mesh.faces, mesh.num_vertices(), &opts).unwrap();
     let mut control = mesh.positions.clone();
     let mut rows = 0;
     let token = opts.cancel.clone();

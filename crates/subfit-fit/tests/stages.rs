@@ -1,5 +1,5 @@
-//! The stage driver's local option (issue 6: "optimize only the new and neighbouring control
-//! points when the rest already fits").
+//! The stage driver's local option: after a refinement, optimize only the new and neighbouring
+//! control points when the rest already fits (Cheng et al. 2004 §4.5, local subdivision).
 
 mod common;
 

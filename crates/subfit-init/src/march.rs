@@ -8,7 +8,7 @@
 use subfit_mesh::{Cancel, Cancelled};
 
 use crate::octree::{KeyMap, KUHN};
-use crate::simplify::{cross, dot, sub};
+use subfit_mesh::vec3::{cross, dot, sub};
 
 /// Accumulates the zero set of tetrahedra over nodes numbered `0..n`.
 pub(crate) struct Marcher<'a> {

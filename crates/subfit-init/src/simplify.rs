@@ -27,6 +27,7 @@
 
 use std::cmp::Ordering;
 
+use subfit_mesh::vec3::{add, cross, dot, norm, scale, sub};
 use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, TopologyError};
 
 /// Options of [`simplify`]. Lengths are in the mesh's units; the checks are scale-invariant.
@@ -795,29 +796,6 @@ fn quality(p: &[[f64; 3]; 3], area2: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 #[cfg(test)]

@@ -1,4 +1,5 @@
-//! Initial control meshes of the real models in `$SUBFIT_DATA` (DESIGN.md §3.6, issue 6): every
+//! Initial control meshes of the real models in `$SUBFIT_DATA` with the target's topology
+//! (DESIGN.md §3.6; the initial mesh of Cheng et al. 2004 §4.3 and Cheng 2007 §II-C): every
 //! closed model gives a manifold, closed cage of its genus, from the mesh and from its vertices
 //! alone (faces and file normals ignored), with at most the requested vertex count and no
 //! degenerate face; open models keep their boundary loops from the mesh.

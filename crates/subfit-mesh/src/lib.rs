@@ -6,8 +6,10 @@
 //! navigating manifold meshes; [`diagnose()`] reports on any polygon soup (boundary loops,
 //! manifoldness, orientation, components, Euler characteristic, genus); [`reorient_faces`] repairs
 //! inconsistently oriented faces. [`Cancel`] is the cancellation token that the long phases of
-//! the other crates poll.
+//! the other crates poll. [`vec3`] holds the small `[f64; 3]` helpers every crate uses; [`bvh`]
+//! the exact closest point on triangles.
 
+pub mod bvh;
 pub mod cancel;
 pub mod components;
 pub mod diagnose;
@@ -18,6 +20,7 @@ pub mod polygons;
 pub mod reorient;
 pub mod shapes;
 pub mod tags;
+pub mod vec3;
 
 pub use cancel::{Cancel, Cancelled};
 pub use components::{euler_characteristic, face_components, genus, Components};

@@ -15,6 +15,7 @@ use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 
 use crate::polygons::{PolyMesh, Polygons};
+use crate::vec3::{dot, unit};
 
 /// An analytic closed surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,17 +225,9 @@ fn lemniscate(x: f64, y: f64) -> f64 {
     r2 * r2 - x * x + y * y
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
+/// `v / |v|`, or `z` for a zero vector.
 fn normalize(v: [f64; 3]) -> [f64; 3] {
-    let l = dot(v, v).sqrt();
-    if l > 0.0 {
-        [v[0] / l, v[1] / l, v[2] / l]
-    } else {
-        [0.0, 0.0, 1.0]
-    }
+    unit(v).unwrap_or([0.0, 0.0, 1.0])
 }
 
 fn sample_ellipsoid(

@@ -1,6 +1,6 @@
 //! Closest point on the limit surface from any query point.
 //!
-//! 1. Start: a BVH ([`crate::bvh`]) over a tessellation of the limit surface (each patch's
+//! 1. Start: a BVH ([`subfit_mesh::bvh`]) over a tessellation of the limit surface (each patch's
 //!    domain cut into an `r × r` grid, corners evaluated exactly and remembered as
 //!    `(face, sub, u, v)`) gives the nearest tessellation triangle; its barycentric point is
 //!    mapped to parameters.
@@ -22,11 +22,12 @@
 //! derivative along the edge); at a boundary corner with both constraints active it is 0. So
 //! queries whose closest point is on the boundary converge too.
 
-use crate::bvh::TriangleBvh;
 use crate::eval::{EvalError, EvalKind, Evaluator, SurfaceParam, SurfacePoint};
 use crate::scheme::Scheme;
 use rayon::prelude::*;
 use std::collections::HashMap;
+use subfit_mesh::bvh::TriangleBvh;
+use subfit_mesh::vec3::{dot, sub};
 
 /// Options of the closest-point search.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -181,7 +182,7 @@ impl<'a> ClosestPointFinder<'a> {
             ev: evaluator,
             positions: positions.to_vec(),
             opts,
-            bvh: TriangleBvh::new(tris),
+            bvh: TriangleBvh::from_triangles(tris),
             tri_params,
             edges,
             patch_edges,
@@ -191,10 +192,10 @@ impl<'a> ClosestPointFinder<'a> {
 
     /// The starting guess for `q`: parameters of the nearest tessellation point.
     fn start(&self, q: [f64; 3]) -> Option<SurfaceParam> {
-        let n = self.bvh.nearest(q)?;
+        let n = self.bvh.closest(q)?;
         let ps = &self.tri_params[n.triangle as usize];
         let (mut u, mut v) = (0.0, 0.0);
-        for (p, w) in ps.iter().zip(n.bary) {
+        for (p, w) in ps.iter().zip(n.barycentric) {
             u += w * p.u;
             v += w * p.v;
         }
@@ -684,14 +685,6 @@ fn edge_spans(ev: &Evaluator) -> EdgeMaps {
         }
     }
     (map, per_patch)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 fn half_norm2(a: [f64; 3]) -> f64 {

@@ -46,6 +46,5 @@ pub use eval::{
     random_samples, EvalError, EvalKind, EvalWeights, Evaluator, SurfaceParam, SurfacePoint,
     DEFAULT_CACHE_BYTES,
 };
-pub mod bvh;
 pub mod closest;
 pub use closest::{ClosestOptions, ClosestPoint, ClosestPointFinder};

@@ -34,7 +34,7 @@ use crate::refine::{
 use crate::regular::{is_regular, Regular, Tables};
 use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
-use crate::stencil::{compose_rows, MultiRows, Stacked, StencilMatrix};
+use crate::stencil::{compose_rows, MultiRows, SparseSum, Stacked, StencilMatrix};
 use crate::topology::Topology;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use subfit_mesh::{Polygons, Tags};
@@ -283,7 +283,7 @@ fn limit_refine_compose_with(
             }
             sum.expand_faces(nv as u32, |f| parent.face(f as usize));
             if fast {
-                tables.record(&sum.entries);
+                tables.record(sum.entries());
             }
             sum.drain_into(row);
         },
@@ -309,71 +309,8 @@ impl LimitRefineScratch {
             child_row: Vec::with_capacity(32),
             vertex_masks: VertexMaskCache::default(),
             tables: Tables::default(),
-            sum: SparseSum {
-                slot: vec![u32::MAX; ncols],
-                entries: Vec::with_capacity(64),
-            },
+            sum: SparseSum::new(ncols),
         }
-    }
-}
-
-/// A short sparse row of 3-weights being summed: `slot[c]` is the position of column `c` in
-/// `entries` (`u32::MAX` if absent).
-pub(crate) struct SparseSum {
-    slot: Vec<u32>,
-    entries: Vec<(u32, [f64; 3])>,
-}
-
-impl SparseSum {
-    #[inline]
-    pub(crate) fn add(&mut self, c: u32, w: [f64; 3]) {
-        let s = &mut self.slot[c as usize];
-        if *s == u32::MAX {
-            *s = self.entries.len() as u32;
-            self.entries.push((c, w));
-        } else {
-            let e = &mut self.entries[*s as usize].1;
-            e[0] += w[0];
-            e[1] += w[1];
-            e[2] += w[2];
-        }
-    }
-
-    /// Replaces every entry of a column `c >= nv` (a face centre, face `c − nv`) by equal
-    /// shares over the vertices of that face, given by `face`.
-    #[inline]
-    fn expand_faces<'f>(&mut self, nv: u32, face: impl Fn(u32) -> &'f [u32]) {
-        let n = self.entries.len();
-        let mut kept = 0;
-        for i in 0..n {
-            let (c, w) = self.entries[i];
-            if c < nv {
-                continue;
-            }
-            self.slot[c as usize] = u32::MAX;
-            let verts = face(c - nv);
-            let len = verts.len() as f64;
-            for &u in verts {
-                self.add(u, [w[0] / len, w[1] / len, w[2] / len]);
-            }
-            kept += 1;
-        }
-        if kept > 0 {
-            // Drop the face columns; re-point the slots of the vertices that moved.
-            self.entries.retain(|e| e.0 < nv);
-            for (i, &(c, _)) in self.entries.iter().enumerate() {
-                self.slot[c as usize] = i as u32;
-            }
-        }
-    }
-
-    /// Moves the entries (first-touch order) to `out` and clears the sum.
-    #[inline]
-    fn drain_into(&mut self, out: &mut Vec<(u32, [f64; 3])>) {
-        for &(c, _) in &self.entries {
-            self.slot[c as usize] = u32::MAX;
-        }
-        out.append(&mut self.entries);
     }
 }
 

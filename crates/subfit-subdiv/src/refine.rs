@@ -379,3 +379,146 @@ pub(crate) fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    //! The child adjacency read off the parent (module `child`) against the topology of the
+    //! refined faces: here, in the module that depends on both.
+    use super::*;
+    use crate::child::{refined_topology, ChildCorners, ChildRing};
+    use subfit_mesh::Polygons;
+
+    /// The child faces as the module docs of [`crate::refine`] list them, face by face.
+    fn child_faces_by_pattern(topo: &Topology, scheme: Scheme) -> Polygons {
+        let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
+        let mut out = Polygons::new();
+        for f in 0..topo.num_faces() {
+            let v = topo.face(f);
+            let e = topo.face_edges(f);
+            let n = v.len();
+            match scheme {
+                Scheme::Loop => {
+                    let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
+                    out.push(&[v[0], ab, ca]);
+                    out.push(&[v[1], bc, ab]);
+                    out.push(&[v[2], ca, bc]);
+                    out.push(&[ab, bc, ca]);
+                }
+                Scheme::CatmullClark => {
+                    let fp = nv + ne + f as u32;
+                    for i in 0..n {
+                        out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// An open grid of `n × n` quads (or triangles) with one vertex left out of all faces.
+    fn grid(n: u32, tris: bool) -> (usize, Polygons) {
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        let mut faces = Polygons::new();
+        for i in 0..n {
+            for j in 0..n {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if tris {
+                    faces.push(&[q[0], q[1], q[2]]);
+                    faces.push(&[q[0], q[2], q[3]]);
+                } else {
+                    faces.push(&q);
+                }
+            }
+        }
+        (((n + 1) * (n + 1) + 1) as usize, faces)
+    }
+
+    /// A closed cube-like mesh with a pentagon, a triangle and valence-3 and -5 vertices (an
+    /// octahedron for Loop).
+    fn closed(tris: bool) -> (usize, Polygons) {
+        if tris {
+            let f = [
+                [0, 1, 2],
+                [0, 2, 3],
+                [0, 3, 4],
+                [0, 4, 1],
+                [5, 2, 1],
+                [5, 3, 2],
+                [5, 4, 3],
+                [5, 1, 4],
+            ];
+            return (6, Polygons::from_triangles(&f));
+        }
+        // A cube with a vertex added on one edge (two pentagons) and a side split in two
+        // triangles.
+        let mut p = Polygons::new();
+        p.push(&[0, 3, 2, 1]);
+        p.push(&[0, 1, 5]);
+        p.push(&[0, 5, 4]);
+        p.push(&[1, 2, 6, 5]);
+        p.push(&[2, 3, 7, 8, 6]);
+        p.push(&[3, 0, 4, 7]);
+        p.push(&[4, 5, 6, 8, 7]);
+        (9, p)
+    }
+
+    #[test]
+    fn child_corners_rings_and_refined_topology_equal_the_child_topology() {
+        for scheme in [Scheme::Loop, Scheme::CatmullClark] {
+            let tris = scheme == Scheme::Loop;
+            for (nv, faces) in [grid(3, tris), closed(tris)] {
+                let o = Options::new(scheme);
+                let parent = Topology::new(&faces, nv).unwrap();
+                let r = refine(&faces, nv, &Tags::new(), &o).unwrap();
+                // Two levels: the second parent has only regular faces.
+                let child_topo = Topology::new(&r.faces, r.num_vertices).unwrap();
+                let r2 = refine(&r.faces, r.num_vertices, &Tags::new(), &o).unwrap();
+                let grandchild = Topology::new(&r2.faces, r2.num_vertices).unwrap();
+                for (p, c, faces) in [
+                    (&parent, &child_topo, &r.faces),
+                    (&child_topo, &grandchild, &r2.faces),
+                ] {
+                    assert_eq!(faces, &child_faces_by_pattern(p, scheme), "{scheme:?}");
+                    assert_eq!(&refined_topology(p, scheme).unwrap(), c, "{scheme:?}");
+                    let k = ChildCorners::new(p, scheme);
+                    assert_eq!(k.num_vertices(), c.num_vertices());
+                    let nc = faces.indices().len() as u32;
+                    for x in 0..nc {
+                        assert_eq!(k.vertex(x), c.corner_vertex(x), "{scheme:?} corner {x}");
+                        assert_eq!(k.next(x), c.corner_next(x));
+                        assert_eq!(k.prev(x), c.corner_prev(x));
+                        assert_eq!(k.twin(x), c.corner_twin(x), "{scheme:?} twin of {x}");
+                    }
+                    let mut ring = ChildRing::default();
+                    for w in 0..c.num_vertices() as u32 {
+                        let b: Vec<bool> = c
+                            .vertex_edges(w)
+                            .iter()
+                            .map(|&e| c.is_boundary_edge(e))
+                            .collect();
+                        let d: Vec<u32> = match scheme {
+                            Scheme::CatmullClark => c
+                                .vertex_corners(w)
+                                .iter()
+                                .map(|&x| c.corner_vertex(c.corner_next(c.corner_next(x))))
+                                .collect(),
+                            Scheme::Loop => Vec::new(),
+                        };
+                        for walk in [false, true] {
+                            if walk {
+                                k.ring_by_walk(w, &mut ring);
+                            } else {
+                                k.ring(w, &mut ring);
+                            }
+                            let what = format!("{scheme:?} vertex {w} (walk: {walk})");
+                            assert_eq!(ring.verts, c.vertex_ring(w), "{what}");
+                            assert_eq!(ring.corners, c.vertex_corners(w), "{what}");
+                            assert_eq!(ring.boundary, b, "{what}");
+                            assert_eq!(ring.diagonals, d, "{what}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

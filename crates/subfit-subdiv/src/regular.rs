@@ -20,8 +20,8 @@
 //! are summed, as the general path sums them. So the rows are the general path's, up to the
 //! order of floating-point additions (checked to 1e-14 in the tests of [`crate::limit`]).
 
-use crate::limit::SparseSum;
 use crate::scheme::{Neighborhood, VertexRule};
+use crate::stencil::SparseSum;
 use crate::topology::Topology;
 
 const NONE: u32 = u32::MAX;

@@ -9,17 +9,17 @@
 //! multiplied by `P_{l−1}` ([`crate::limit`]), so neither `M_l` nor `P_l` — the largest
 //! intermediate, one row per level-`l` vertex — is stored.
 //!
-//! Only the control mesh's adjacency is built from its face list ([`Topology::new`]); that of
-//! each finer level is read off the level above (module `child`) — for levels `1 … l − 1` as a
-//! [`Topology`], for level `l` vertex by vertex as its limit rows need it, so no adjacency with
+//! Only the control mesh's adjacency is built from its face list
+//! ([`Topology::new`](crate::Topology::new)); that of each finer level is read off the level
+//! above (module `child`) — for levels `1 … l − 1` as a [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so no adjacency with
 //! one entry per corner of the finest mesh is built, and no intermediate face list.
 
+use crate::child::refined_topology;
 use crate::error::SubdivError;
 use crate::limit::{limit_refine_compose, limit_rows};
 use crate::refine::{child_faces, child_tags, refine_compose, refine_matrix, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
-use crate::topology::Topology;
 use subfit_mesh::{Polygons, Tags};
 
 /// Limit stencils of the level-`l` vertices over the control points.
@@ -98,7 +98,7 @@ pub fn sampling_operator(
             refine_compose(&topo, &level_tags, options, &product)
         };
         level_tags = child_tags(&topo, &level_tags);
-        topo = Topology::refined(&topo, options.scheme)?;
+        topo = refined_topology(&topo, options.scheme)?;
     }
     // The last level: C = L_l · M_l · P_{l−1}, with neither M_l nor its product stored and the
     // level-l adjacency read off level l − 1.

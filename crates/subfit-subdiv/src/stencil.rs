@@ -573,6 +573,80 @@ impl<const K: usize, S> Scratch<K, S> {
     }
 }
 
+/// A short sparse row of 3-weights being summed: `slot[c]` is the position of column `c` in
+/// `entries` (`u32::MAX` if absent).
+pub(crate) struct SparseSum {
+    slot: Vec<u32>,
+    entries: Vec<(u32, [f64; 3])>,
+}
+
+impl SparseSum {
+    /// An empty sum over `ncols` columns.
+    pub(crate) fn new(ncols: usize) -> Self {
+        Self {
+            slot: vec![u32::MAX; ncols],
+            entries: Vec::with_capacity(64),
+        }
+    }
+
+    /// The entries so far, in first-touch order.
+    pub(crate) fn entries(&self) -> &[(u32, [f64; 3])] {
+        &self.entries
+    }
+
+    /// Adds `w` to column `c`.
+    #[inline]
+    pub(crate) fn add(&mut self, c: u32, w: [f64; 3]) {
+        let s = &mut self.slot[c as usize];
+        if *s == u32::MAX {
+            *s = self.entries.len() as u32;
+            self.entries.push((c, w));
+        } else {
+            let e = &mut self.entries[*s as usize].1;
+            e[0] += w[0];
+            e[1] += w[1];
+            e[2] += w[2];
+        }
+    }
+
+    /// Replaces every entry of a column `c >= nv` (a face centre, face `c − nv`) by equal
+    /// shares over the vertices of that face, given by `face`.
+    #[inline]
+    pub(crate) fn expand_faces<'f>(&mut self, nv: u32, face: impl Fn(u32) -> &'f [u32]) {
+        let n = self.entries.len();
+        let mut kept = 0;
+        for i in 0..n {
+            let (c, w) = self.entries[i];
+            if c < nv {
+                continue;
+            }
+            self.slot[c as usize] = u32::MAX;
+            let verts = face(c - nv);
+            let len = verts.len() as f64;
+            for &u in verts {
+                self.add(u, [w[0] / len, w[1] / len, w[2] / len]);
+            }
+            kept += 1;
+        }
+        if kept > 0 {
+            // Drop the face columns; re-point the slots of the vertices that moved.
+            self.entries.retain(|e| e.0 < nv);
+            for (i, &(c, _)) in self.entries.iter().enumerate() {
+                self.slot[c as usize] = i as u32;
+            }
+        }
+    }
+
+    /// Moves the entries (first-touch order) to `out` and clears the sum.
+    #[inline]
+    pub(crate) fn drain_into(&mut self, out: &mut Vec<(u32, [f64; 3])>) {
+        for &(c, _) in &self.entries {
+            self.slot[c as usize] = u32::MAX;
+        }
+        out.append(&mut self.entries);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,9 +6,7 @@
 //! `i + 1`, and at a boundary vertex ring edge 0 is the leading boundary edge (see
 //! [`crate::Neighborhood`]).
 
-use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
-use crate::scheme::Scheme;
 use rayon::prelude::*;
 use subfit_mesh::Polygons;
 
@@ -22,6 +20,31 @@ struct RingPart {
     edges: Vec<u32>,
     verts: Vec<u32>,
     corners: Vec<u32>,
+}
+
+/// A mesh whose adjacency is known in closed form, for [`Topology::from_closed_form`]: all faces
+/// have [`Self::face_size`] corners, corner `c` of face `f` is `f · face_size + i`, and rings
+/// are in the order [`Topology::new`] gives them (counter-clockwise, from the leading boundary
+/// edge or the lowest-numbered corner).
+pub(crate) trait ClosedForm: Sync {
+    /// Reusable buffers of [`Self::ring`].
+    type Ring: Default;
+    /// Number of vertices.
+    fn num_vertices(&self) -> usize;
+    /// Number of faces.
+    fn num_faces(&self) -> usize;
+    /// Corners per face.
+    fn face_size(&self) -> u32;
+    /// The vertex of corner `c`.
+    fn vertex(&self, c: u32) -> u32;
+    /// The next corner of `c`'s face.
+    fn next(&self, c: u32) -> u32;
+    /// The twin of corner `c` (the corner of the opposite directed edge), `u32::MAX` at a
+    /// boundary.
+    fn twin(&self, c: u32) -> u32;
+    /// The ring of vertex `v`: its corners, and the far ends of its ring edges (one more than
+    /// the corners at a boundary vertex), filled into `scratch`.
+    fn ring<'r>(&self, v: u32, scratch: &'r mut Self::Ring) -> (&'r [u32], &'r [u32]);
 }
 
 /// Edge and vertex-ring adjacency of a manifold, consistently oriented polygon mesh.
@@ -129,16 +152,14 @@ impl Topology {
         Ok(t)
     }
 
-    /// The adjacency of the once-refined `parent` (child face and vertex order of
-    /// [`crate::refine`]), equal to `Topology::new` of the child's faces but read off the
-    /// parent's corners in closed form (module `child`) instead of searched for: no twin
-    /// search, no outgoing lists, no validation (the child of a valid mesh is valid). The
-    /// parent must suit `scheme` (Loop: triangles only).
+    /// The adjacency of a mesh given in closed form ([`ClosedForm`]: every corner's vertex,
+    /// successor and twin, and every vertex's ring), equal to `Topology::new` of its faces but
+    /// without the twin search, the outgoing lists or validation (the caller vouches for a
+    /// valid mesh). Used for the child of a uniform refinement (module `child`).
     ///
-    /// Errors: [`SubdivError::TooLarge`] if the child has `u32::MAX` or more vertices or
-    /// corners. Cost O(#child corners), parallel except for the edge numbering.
-    pub(crate) fn refined(parent: &Topology, scheme: Scheme) -> Result<Self, SubdivError> {
-        let child = ChildCorners::new(parent, scheme);
+    /// Errors: [`SubdivError::TooLarge`] if the mesh has `u32::MAX` or more vertices or
+    /// corners. Cost O(#corners), parallel except for the edge numbering.
+    pub(crate) fn from_closed_form<C: ClosedForm>(child: &C) -> Result<Self, SubdivError> {
         let (size, nf) = (child.face_size(), child.num_faces());
         let (nv, nc) = (child.num_vertices(), nf * size as usize);
         if nv >= NONE as usize || nc >= NONE as usize {
@@ -174,16 +195,14 @@ impl Topology {
             .into_par_iter()
             .map(|k| {
                 let mut part = RingPart::default();
-                let mut ring = ChildRing::default();
+                let mut ring = C::Ring::default();
                 for v in (k * CHUNK) as u32..((k + 1) * CHUNK).min(nv) as u32 {
-                    child.ring(v, &mut ring);
-                    part.corners.extend_from_slice(&ring.corners);
-                    part.verts.extend_from_slice(&ring.verts);
+                    let (corners, verts) = child.ring(v, &mut ring);
+                    part.corners.extend_from_slice(corners);
+                    part.verts.extend_from_slice(verts);
                     part.edges
-                        .extend(ring.corners.iter().map(|&c| this.corner_edge[c as usize]));
-                    if let (Some(&last), true) =
-                        (ring.corners.last(), ring.verts.len() > ring.corners.len())
-                    {
+                        .extend(corners.iter().map(|&c| this.corner_edge[c as usize]));
+                    if let (Some(&last), true) = (corners.last(), verts.len() > corners.len()) {
                         // The closing boundary edge, entering `v`.
                         part.edges
                             .push(this.corner_edge[this.corner_prev(last) as usize]);

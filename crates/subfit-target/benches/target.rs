@@ -9,6 +9,7 @@
 
 use std::time::Instant;
 
+use subfit_mesh::vec3::{cross, norm, sub};
 use subfit_mesh::PolyMesh;
 use subfit_target::{NormalSource, Target, TargetOptions};
 
@@ -28,13 +29,7 @@ fn sample_surface(mesh: &PolyMesh, n: usize) -> Vec<[f64; 3]> {
     let mut total = 0.0;
     for t in &tris {
         let [a, b, c] = t.map(|v| p[v as usize]);
-        let (u, v) = (sub(b, a), sub(c, a));
-        let x = [
-            u[1] * v[2] - u[2] * v[1],
-            u[2] * v[0] - u[0] * v[2],
-            u[0] * v[1] - u[1] * v[0],
-        ];
-        total += 0.5 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        total += 0.5 * norm(cross(sub(b, a), sub(c, a)));
         cum.push(total);
     }
     (0..n)
@@ -49,10 +44,6 @@ fn sample_surface(mesh: &PolyMesh, n: usize) -> Vec<[f64; 3]> {
             [0, 1, 2].map(|i| a[i] + u * (b[i] - a[i]) + v * (c[i] - a[i]))
         })
         .collect()
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// Process CPU time (user + system, all threads) in seconds, from `/proc/self/stat` (Linux; 0

@@ -25,10 +25,12 @@
 //! then is the foot point blended, so in smooth, dense regions results are exactly the
 //! nearest-quadric ones (and as fast).
 
-use crate::project::{alpha_plus, foot_point_on, FootPoint};
+use rayon::prelude::*;
+
+use crate::foot::{alpha_plus, foot_point_on, FootPoint};
+use crate::layout::QueryLayout;
 use crate::quadric::LocalQuadric;
-use crate::target::QueryLayout;
-use crate::vec3::{cross, dot, normalize, scale, sub};
+use subfit_mesh::vec3::{cross, dot, normalize, scale, sub};
 
 /// Data points blended at a query (its nearest ones).
 pub(crate) const BLEND_K: usize = 16;
@@ -53,6 +55,22 @@ fn first_order_distance(quadric: &LocalQuadric, origin: [f64; 3], x: [f64; 3]) -
     let l = quadric.local(sub(x, origin));
     let h = quadric.height(l[0], l[1]);
     (l[2] - h[0]) / (1.0 + h[1] * h[1] + h[2] * h[2]).sqrt()
+}
+
+/// [`untrusted`] for every slot of `l`, over its descent-graph rows. Parallel, O(#P · 16).
+pub(crate) fn mark_untrusted(l: &QueryLayout) -> Vec<bool> {
+    (0..l.points.len())
+        .into_par_iter()
+        .map(|s| {
+            untrusted(
+                &l.points,
+                &l.quadrics,
+                l.radius[s],
+                s,
+                l.descent.row(s as u32),
+            )
+        })
+        .collect()
 }
 
 /// Whether point `s`'s quadric disagrees with those of its graph neighbours (see

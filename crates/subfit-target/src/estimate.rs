@@ -8,7 +8,7 @@ use subfit_mesh::{Cancel, Cancelled};
 
 use crate::neighbors::{morton_order, Neighbor, PointIndex};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
-use crate::vec3::{any_orthogonal, dot, normalize, scale, sub};
+use subfit_mesh::vec3::{any_orthogonal, dot, normalize, scale, sub};
 
 /// How the neighbourhood of a data point is chosen for normal and curvature estimation.
 #[derive(Clone, Copy, Debug, PartialEq)]

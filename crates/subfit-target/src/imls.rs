@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use crate::target::Target;
-use crate::vec3::{dot, sub};
+use subfit_mesh::vec3::{dot, sub};
 
 /// Value and gradient of the IMLS function at one point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -32,7 +32,9 @@ mod blend;
 pub mod closest;
 mod error;
 pub mod estimate;
+mod foot;
 pub mod imls;
+mod layout;
 pub mod neighbors;
 mod normalize;
 mod options;
@@ -41,7 +43,6 @@ pub mod project;
 pub mod quadric;
 mod regularize;
 mod target;
-mod vec3;
 mod winding;
 
 pub use closest::{MeshClosestPoint, TriangleBvh};

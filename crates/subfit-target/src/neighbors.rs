@@ -9,6 +9,7 @@ use std::num::NonZeroUsize;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
+use subfit_mesh::vec3::dist2;
 
 /// One neighbour: index of the point in the indexed slice and its Euclidean distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -192,12 +193,6 @@ pub(crate) struct NeighborGraph {
 /// kd-tree). Descents from a nearby start take a handful.
 const MAX_DESCENT_STEPS: usize = 16;
 
-#[inline]
-fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-}
-
 impl NeighborGraph {
     /// Builds the graph from rows of nearest neighbours (`#P · stride`, each row sorted by
     /// increasing distance, padded with `u32::MAX`) over `points` (`#P by 3`). O(#P · stride).
@@ -210,7 +205,7 @@ impl NeighborGraph {
             .map(|(row, p)| {
                 row.iter()
                     .take_while(|&&j| j != u32::MAX)
-                    .map(|&j| dist2(p, &points[j as usize]))
+                    .map(|&j| dist2(*p, points[j as usize]))
                     .fold(0.0, f64::max)
             })
             .collect();
@@ -219,6 +214,17 @@ impl NeighborGraph {
             targets,
             radius2,
         }
+    }
+
+    /// The neighbours of point `s` (sorted by distance, padded with `u32::MAX`; `stride`
+    /// entries).
+    ///
+    /// # Panics
+    /// If `s` is out of range.
+    #[track_caller]
+    pub(crate) fn row(&self, s: u32) -> &[u32] {
+        let s = s as usize;
+        &self.targets[s * self.stride..(s + 1) * self.stride]
     }
 
     /// Greedy descent towards `q` from point `start` over the graph of `points` (the slice the
@@ -239,7 +245,7 @@ impl NeighborGraph {
         start: u32,
     ) -> Option<(Neighbor, bool)> {
         let mut c = start as usize;
-        let mut dc = dist2(q, points.get(c)?);
+        let mut dc = dist2(*q, *points.get(c)?);
         let mut certified = false;
         for _ in 0..MAX_DESCENT_STEPS {
             let row = &self.targets[c * self.stride..(c + 1) * self.stride];
@@ -248,7 +254,7 @@ impl NeighborGraph {
                 if j == u32::MAX {
                     break;
                 }
-                let d = dist2(q, &points[j as usize]);
+                let d = dist2(*q, points[j as usize]);
                 if d < bd {
                     (best, bd) = (j as usize, d);
                 }

@@ -38,8 +38,8 @@ use subfit_mesh::{Cancel, Cancelled};
 
 use crate::neighbors::morton_order;
 use crate::regularize::{self, FieldInput};
-use crate::vec3::{add, dot, norm, normalize, scale, sub};
 use crate::winding::{self, DipoleTree, WindingInput};
+use subfit_mesh::vec3::{add, dot, norm, normalize, scale, sub};
 
 /// Outcome of [`orient_normals`].
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

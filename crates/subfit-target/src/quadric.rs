@@ -13,7 +13,7 @@
 
 use nalgebra::{Matrix3, SMatrix, SVector};
 
-use crate::vec3::{add, cross, dot, normalize, scale, sub};
+use subfit_mesh::vec3::{add, cross, dot, normalize, scale, sub};
 
 /// A polynomial height field ("jet", degree 2 or 3) over a local orthonormal frame
 /// `(e1, e2, n)` with origin at a data point: points `origin + u e1 + v e2 + h(u, v) n`.

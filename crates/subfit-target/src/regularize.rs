@@ -40,8 +40,8 @@
 use rayon::prelude::*;
 use subfit_mesh::{Cancel, Cancelled};
 
-use crate::vec3::{add, dot, norm, normalize, scale, sub};
 use crate::winding::DipoleTree;
+use subfit_mesh::vec3::{add, dot, norm, normalize, scale, sub};
 
 /// Kernel regularization `σ_i = SIGMA · h_i`.
 const SIGMA: f64 = 0.2;

@@ -13,14 +13,15 @@ use crate::estimate::{
     estimate_all, estimate_point, graph_stride, EstimateParams, Neighborhood, PointEstimate,
     Scratch, DESCENT_K,
 };
-use crate::neighbors::{morton_order, NeighborGraph, PointIndex};
+use crate::layout::QueryLayout;
+use crate::neighbors::PointIndex;
 use crate::normalize::Normalization;
 use crate::options::{
     NormalOrigin, NormalSource, Phase, Progress, ProgressFn, TargetOptions, TargetStats,
 };
 use crate::orient::{orient_normals, KnnGraph, OrientInput, FIELD_MAX_NEIGHBORS};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
-use crate::vec3::{add, cross, dot, normalize, scale, sub};
+use subfit_mesh::vec3::{add, cross, dot, normalize, scale, sub};
 
 /// Fraction of the neighbourhood radius doubled into the foot-point shortcut diameter. 0 keeps
 /// the shortcut exact (only the nearest-neighbour spacing: results identical to always doing the
@@ -275,13 +276,14 @@ impl Target {
         }
         cancel.check()?;
         let radius: Vec<f64> = estimates.iter().map(|e| e.radius).collect();
-        let layout = QueryLayout::new(
+        let mut layout = QueryLayout::new(
             &points,
             &quadrics,
             &nn_dist,
             &radius,
             &prefix_rows(&graph, stride, DESCENT_K),
         );
+        layout.untrusted = crate::blend::mark_untrusted(&layout);
         stats.untrusted_quadrics = layout.untrusted.iter().filter(|&&u| u).count();
         drop(graph);
         stats.timings.orient = t.elapsed();
@@ -434,84 +436,6 @@ impl Target {
             k2: frames.iter().map(|f| f.1).collect(),
             t1: frames.iter().map(|f| f.2).collect(),
             t2: frames.iter().map(|f| f.3).collect(),
-        }
-    }
-}
-
-/// The data read by foot-point queries, copied into Morton (Z-curve) order of the points: "slot"
-/// `s` holds point `point[s]`, and `slot[i]` is the slot of point `i`. The target's public arrays
-/// keep the input order; queries read these copies, so that spatially coherent queries (batches
-/// are processed in Morton order) touch contiguous memory: on a million points in random input
-/// order, cache misses otherwise dominate. Memory: `#P · (4·16 + 8 + 24 + 8 + 8 + 128)` bytes.
-#[derive(Debug)]
-pub(crate) struct QueryLayout {
-    /// Slot of each point, `#P`.
-    pub slot: Vec<u32>,
-    /// Point of each slot, `#P`.
-    pub point: Vec<u32>,
-    /// Positions by slot.
-    pub points: Vec<[f64; 3]>,
-    /// Quadrics by slot.
-    pub quadrics: Vec<LocalQuadric>,
-    /// Foot-point shortcut diameters by slot (see [`Target::foot_shortcut_diameters`]).
-    pub shortcut: Vec<f64>,
-    /// Neighbourhood radius of each slot's quadric fit.
-    pub radius: Vec<f64>,
-    /// Whether each slot's quadric disagrees with its neighbours' (see `blend::untrusted`).
-    pub untrusted: Vec<bool>,
-    /// The `DESCENT_K`-nearest-neighbour graph over slots.
-    pub descent: NeighborGraph,
-}
-
-impl QueryLayout {
-    /// `rows`: the `DESCENT_K` nearest neighbours of each point (point indices, `u32::MAX`
-    /// padding), sorted by distance. O(P log P).
-    fn new(
-        points: &[[f64; 3]],
-        quadrics: &[LocalQuadric],
-        shortcut: &[f64],
-        radius: &[f64],
-        rows: &[u32],
-    ) -> Self {
-        let point = morton_order(points);
-        let mut slot = vec![0u32; points.len()];
-        for (s, &i) in point.iter().enumerate() {
-            slot[i as usize] = s as u32;
-        }
-        let k = DESCENT_K;
-        let targets: Vec<u32> = point
-            .par_iter()
-            .flat_map_iter(|&i| {
-                rows[i as usize * k..(i as usize + 1) * k].iter().map(|&j| {
-                    if j == u32::MAX {
-                        j
-                    } else {
-                        slot[j as usize]
-                    }
-                })
-            })
-            .collect();
-        let spoints: Vec<[f64; 3]> = point.par_iter().map(|&i| points[i as usize]).collect();
-        let squadrics: Vec<LocalQuadric> =
-            point.par_iter().map(|&i| quadrics[i as usize]).collect();
-        let sradius: Vec<f64> = point.par_iter().map(|&i| radius[i as usize]).collect();
-        let untrusted = (0..point.len())
-            .into_par_iter()
-            .map(|s| {
-                let row = &targets[s * k..(s + 1) * k];
-                crate::blend::untrusted(&spoints, &squadrics, sradius[s], s, row)
-            })
-            .collect();
-        let descent = NeighborGraph::new(&spoints, targets, k);
-        Self {
-            quadrics: squadrics,
-            shortcut: point.par_iter().map(|&i| shortcut[i as usize]).collect(),
-            radius: sradius,
-            untrusted,
-            points: spoints,
-            slot,
-            point,
-            descent,
         }
     }
 }

@@ -19,7 +19,7 @@
 use rayon::prelude::*;
 use subfit_mesh::{Cancel, Cancelled};
 
-use crate::vec3::{add, dot, scale, sub};
+use subfit_mesh::vec3::{add, dot, scale, sub};
 
 /// Points per leaf.
 const LEAF: usize = 8;
@@ -427,7 +427,7 @@ pub(crate) fn refine(
 mod tests {
     use super::*;
     use crate::neighbors::{morton_order, PointIndex};
-    use crate::vec3::norm;
+    use subfit_mesh::vec3::norm;
 
     /// Fibonacci sphere of radius 0.4 about (0.5, 0.5, 0.5), Morton-ordered, outward normals.
     fn sphere(n: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {

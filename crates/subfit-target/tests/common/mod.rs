@@ -10,23 +10,12 @@ pub fn rng(seed: u64) -> StdRng {
     StdRng::seed_from_u64(seed)
 }
 
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-pub fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
+#[allow(unused_imports, reason = "each test binary uses some")]
+pub use subfit_mesh::vec3::{add, dot, norm, scale, sub};
+
+/// `a / |a|` by the reciprocal ([`subfit_mesh::vec3::normalize`]); NaN for a zero vector.
 pub fn unit(a: [f64; 3]) -> [f64; 3] {
-    scale(a, 1.0 / norm(a))
+    subfit_mesh::vec3::normalize(a).unwrap_or([f64::NAN; 3])
 }
 
 /// A surface sample with its exact differential geometry (outward normal; `k1`, `k2` signed

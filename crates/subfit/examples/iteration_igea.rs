@@ -6,9 +6,9 @@
 //!
 //! ```text
 //! SUBFIT_DATA=/work/shared/data RAYON_NUM_THREADS=2 \
-//!     cargo run --release -p subfit-fit --example iteration_igea
+//!     cargo run --release -p subfit --example iteration_igea
 //! SUBFIT_DATA=/work/shared/data SUBFIT_SIZES=10000 SUBFIT_ITERS=5 SUBFIT_SOLVER=pcg \
-//!     RAYON_NUM_THREADS=2 cargo run --release -p subfit-fit --example iteration_igea
+//!     RAYON_NUM_THREADS=2 cargo run --release -p subfit --example iteration_igea
 //! ```
 //!
 //! Environment: `SUBFIT_DATA` (directory holding `igea.ply`; required), `SUBFIT_SIZES`

@@ -9,7 +9,7 @@
 //!
 //! ```text
 //! SUBFIT_DATA=/work/shared/data RAYON_NUM_THREADS=1 \
-//!     cargo run --release -p subfit-fit --example assemble_igea
+//!     cargo run --release -p subfit --example assemble_igea
 //! ```
 //!
 //! Environment: `SUBFIT_DATA` (directory holding `igea.ply`; required), `SUBFIT_SIZES`

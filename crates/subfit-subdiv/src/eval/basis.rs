@@ -1,0 +1,172 @@
+//! The regular patch basis (Loop's quartic box spline, Catmull-Clark's bicubic B-spline, from
+//! [`crate::patch`]) and a regular patch's control points as dense rows over a few control
+//! points; the affine maps from a parent face's parameters to a child's.
+
+use super::types::{EvalKind, EvalWeights};
+use crate::local::{ChildFace, Combo, LocalMesh};
+use crate::patch::{bicubic_bspline, loop_box_spline};
+use crate::scheme::Scheme;
+
+/// The regular patch basis (value and five derivatives) padded to 16 entries, and its size.
+fn basis(scheme: Scheme, u: f64, v: f64) -> (usize, [[f64; 16]; 6]) {
+    let mut out = [[0.0; 16]; 6];
+    match scheme {
+        Scheme::Loop => {
+            let b = loop_box_spline(u, v);
+            for (o, x) in out
+                .iter_mut()
+                .zip([b.point, b.du, b.dv, b.duu, b.duv, b.dvv])
+            {
+                o[..12].copy_from_slice(&x);
+            }
+            (12, out)
+        }
+        Scheme::CatmullClark => {
+            let b = bicubic_bspline(u, v);
+            (16, [b.point, b.du, b.dv, b.duu, b.duv, b.dvv])
+        }
+    }
+}
+
+/// A regular patch's control points as dense rows over a few control points.
+#[derive(Clone, Debug)]
+pub(super) struct PatchCoef {
+    pub(super) cols: Vec<u32>,
+    /// `npts × cols.len()`.
+    pub(super) coef: Vec<f64>,
+}
+
+impl PatchCoef {
+    pub(super) fn new(mesh: &LocalMesh, combos: &[Combo]) -> Self {
+        let k = mesh.k();
+        let mut dense = vec![0.0; combos.len() * k];
+        for (i, c) in combos.iter().enumerate() {
+            for &(v, w) in &c.terms[..c.n as usize] {
+                if w != 0.0 {
+                    for (o, r) in dense[i * k..(i + 1) * k].iter_mut().zip(mesh.row(v)) {
+                        *o += w * r;
+                    }
+                }
+            }
+        }
+        let keep: Vec<usize> = (0..k)
+            .filter(|&j| (0..combos.len()).any(|i| dense[i * k + j] != 0.0))
+            .collect();
+        let mut order: Vec<usize> = keep.clone();
+        order.sort_by_key(|&j| mesh.cols[j]);
+        let cols: Vec<u32> = order.iter().map(|&j| mesh.cols[j]).collect();
+        let mut coef = Vec::with_capacity(combos.len() * cols.len());
+        for i in 0..combos.len() {
+            coef.extend(order.iter().map(|&j| dense[i * k + j]));
+        }
+        Self { cols, coef }
+    }
+
+    /// Evaluates at child parameters `(u, v)` with `a` = ∂(child params)/∂(original params).
+    pub(super) fn eval(
+        &self,
+        scheme: Scheme,
+        u: f64,
+        v: f64,
+        a: [[f64; 2]; 2],
+        depth: u32,
+    ) -> EvalWeights {
+        let (np, [p, du, dv, duu, duv, dvv]) = basis(scheme, u, v);
+        let n = self.cols.len();
+        let mut out = [
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+            vec![0.0; n],
+        ];
+        // Chain rule: ∂f/∂x_j = Σ_i a[i][j] ∂f/∂c_i; H_x = aᵀ H_c a.
+        for i in 0..np {
+            let (gu, gv) = (du[i], dv[i]);
+            let hx = [[duu[i], duv[i]], [duv[i], dvv[i]]];
+            let g = [a[0][0] * gu + a[1][0] * gv, a[0][1] * gu + a[1][1] * gv];
+            let mut h = [[0.0; 2]; 2];
+            for (j, hj) in h.iter_mut().enumerate() {
+                for (l, hjl) in hj.iter_mut().enumerate() {
+                    let mut s = 0.0;
+                    for (r, hr) in hx.iter().enumerate() {
+                        for (c, hrc) in hr.iter().enumerate() {
+                            s += a[r][j] * hrc * a[c][l];
+                        }
+                    }
+                    *hjl = s;
+                }
+            }
+            let vals = [p[i], g[0], g[1], h[0][0], h[0][1], h[1][1]];
+            let row = &self.coef[i * n..(i + 1) * n];
+            for (o, &val) in out.iter_mut().zip(&vals) {
+                if val != 0.0 {
+                    for (x, &r) in o.iter_mut().zip(row) {
+                        *x += val * r;
+                    }
+                }
+            }
+        }
+        let [position, du, dv, duu, duv, dvv] = out;
+        EvalWeights {
+            indices: self.cols.clone(),
+            position,
+            du,
+            dv,
+            second: Some([duu, duv, dvv]),
+            kind: EvalKind::Patch,
+            depth,
+        }
+    }
+}
+
+pub(super) fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    [
+        [
+            a[0][0] * b[0][0] + a[0][1] * b[1][0],
+            a[0][0] * b[0][1] + a[0][1] * b[1][1],
+        ],
+        [
+            a[1][0] * b[0][0] + a[1][1] * b[1][0],
+            a[1][0] * b[0][1] + a[1][1] * b[1][1],
+        ],
+    ]
+}
+
+/// Local parameters of parent point `(u, v)` in a child with corner parameters `params`
+/// (triangle: affine on corners 0, 1, 2; quad: on corners 0, 1, 3), and ∂(child)/∂(parent).
+pub(super) fn child_local(params: &[[f64; 2]], u: f64, v: f64) -> (f64, f64, [[f64; 2]; 2]) {
+    let p0 = params[0];
+    let e1 = [params[1][0] - p0[0], params[1][1] - p0[1]];
+    let q = if params.len() == 3 {
+        params[2]
+    } else {
+        params[3]
+    };
+    let e2 = [q[0] - p0[0], q[1] - p0[1]];
+    // parent = p0 + s e1 + t e2 ⇒ (s, t) = M⁻¹ (parent − p0), M = [e1 e2].
+    let det = e1[0] * e2[1] - e2[0] * e1[1];
+    let inv = [[e2[1] / det, -e2[0] / det], [-e1[1] / det, e1[0] / det]];
+    let (du, dv) = (u - p0[0], v - p0[1]);
+    let s = inv[0][0] * du + inv[0][1] * dv;
+    let t = inv[1][0] * du + inv[1][1] * dv;
+    (s, t, inv)
+}
+
+/// The child whose domain contains `(u, v)` best (largest minimum barycentric / box margin).
+pub(super) fn best_child(ch: &[ChildFace], u: f64, v: f64) -> usize {
+    let mut best = (f64::NEG_INFINITY, 0);
+    for (i, c) in ch.iter().enumerate() {
+        let (s, t, _) = child_local(&c.params, u, v);
+        let margin = if c.params.len() == 3 {
+            s.min(t).min(1.0 - s - t)
+        } else {
+            s.min(t).min(1.0 - s).min(1.0 - t)
+        };
+        if margin > best.0 {
+            best = (margin, i);
+        }
+    }
+    best.1
+}

@@ -1,0 +1,90 @@
+//! The memoised local-refinement tree of each patch: the first [`CACHE_DEPTH`] levels of local
+//! refinement around irregular vertices are kept, within a memory budget.
+
+use super::basis::PatchCoef;
+use crate::local::{regular_patch, LocalMesh};
+use crate::scheme::Scheme;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::OnceLock;
+
+/// Default budget of the memoised local refinements of an [`Evaluator`](super::Evaluator): 256 MiB.
+pub const DEFAULT_CACHE_BYTES: usize = 256 << 20;
+
+/// Heap bytes held by memoised nodes (approximate: array payloads only), and the budget beyond
+/// which no more nodes are memoised.
+#[derive(Debug)]
+pub(super) struct MemoBudget {
+    pub(super) used: AtomicUsize,
+    pub(super) budget: usize,
+}
+
+impl Clone for MemoBudget {
+    fn clone(&self) -> Self {
+        Self {
+            used: AtomicUsize::new(self.used.load(Ordering::Relaxed)),
+            budget: self.budget,
+        }
+    }
+}
+
+impl MemoBudget {
+    pub(super) fn full(&self) -> bool {
+        self.used.load(Ordering::Relaxed) >= self.budget
+    }
+
+    pub(super) fn add(&self, node: &Node) {
+        self.used.fetch_add(node.heap_bytes(), Ordering::Relaxed);
+    }
+}
+
+/// Local refinement levels whose results are memoised per patch: evaluations reuse the refined
+/// neighbourhoods and the regular sub-patches of the first `CACHE_DEPTH` levels (memory: up to a
+/// few tens of kB per irregular patch that has been evaluated near its irregular corners).
+pub const CACHE_DEPTH: u32 = 4;
+
+/// A node of a patch's memoised local-refinement tree.
+#[derive(Clone, Debug)]
+pub(super) enum Node {
+    /// A regular (sub-)patch.
+    Regular(PatchCoef),
+    /// An irregular (sub-)patch: its refined neighbourhood and, lazily, its four children.
+    Irregular {
+        mesh: LocalMesh,
+        t: usize,
+        kids: Box<[OnceLock<Node>; 4]>,
+    },
+    /// Local refinement failed (a broken invariant, reported as [`EvalError::Incomplete`](super::EvalError::Incomplete)).
+    Failed,
+}
+
+impl Node {
+    /// Approximate heap bytes of this node (not of its children).
+    fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        match self {
+            Node::Regular(pc) => pc.cols.len() * 4 + pc.coef.len() * 8,
+            Node::Irregular { mesh, .. } => {
+                mesh.cols.len() * 4
+                    + mesh.rows.len() * 8
+                    + (mesh.fo.len() + mesh.fv.len() + mesh.nfaces.len()) * 4
+                    + mesh.fe.len()
+                    + mesh.corner.len()
+                    + size_of::<[OnceLock<Node>; 4]>()
+            }
+            Node::Failed => 0,
+        }
+    }
+}
+
+/// A tree node for face `t` of `mesh`: regular patch or irregular (to be refined further).
+pub(super) fn make_node(mesh: LocalMesh, t: usize, scheme: Scheme) -> Node {
+    let adj = mesh.adjacency();
+    match regular_patch(&mesh, &adj, scheme, t) {
+        Some(c) => Node::Regular(PatchCoef::new(&mesh, &c)),
+        None => Node::Irregular {
+            mesh,
+            t,
+            kids: Box::new(std::array::from_fn(|_| OnceLock::new())),
+        },
+    }
+}
