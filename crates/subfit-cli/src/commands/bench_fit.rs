@@ -153,7 +153,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
         let t = &r.timings_s;
         let two = &r.r#final.two_sided;
         rows.push(format!(
-            "{:<15} {:>7} {:>5} → {:<5} {:>5} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>4} {:>4} {:>6.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2}\n{:<15} paper: {}",
+            "{:<15} {:>7} {:>5} → {:<5} {:>5} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>4} {:>4} {:>6.2} {:>6.2} {:>6.2} {:>6.2} {:>6.2} {:>7.2}\n{:<15} paper: {}",
             m.name,
             r.target_points,
             r.init.control_points,
@@ -168,6 +168,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
             t.preprocess,
             t.init,
             t.fit,
+            t.measure,
             t.output,
             t.total,
             "",
@@ -196,7 +197,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
         }));
     }
     println!(
-        "{:<15} {:>7} {:>13} {:>5} {:>10} {:>10} {:>10} {:>10} {:>4} {:>4} {:>6} {:>6} {:>6} {:>6} {:>7}",
+        "{:<15} {:>7} {:>13} {:>5} {:>10} {:>10} {:>10} {:>10} {:>4} {:>4} {:>6} {:>6} {:>6} {:>6} {:>6} {:>7}",
         "model",
         "points",
         "control pts",
@@ -210,6 +211,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
         "prep s",
         "init s",
         "fit s",
+        "meas s",
         "out s",
         "total s"
     );
