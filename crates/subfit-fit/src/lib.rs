@@ -5,6 +5,8 @@
 //! (§II-D; Cheng et al. 2004 §3, §4.4) plus the umbrella smoothing term (§II-E) — with a sparse
 //! Cholesky solve, and control the step by Levenberg–Marquardt or Armijo (§III-C).
 //!
+//! * [`DataTerm`]: what is fitted — per sample, the true squared error and its quadratic model;
+//!   [`FootPointTerm`] is Cheng's PD/TD/SD on a target;
 //! * [`terms`]: the per-sample 3×3 error matrices `Q_k`;
 //! * [`smooth`]: the umbrella Laplacian;
 //! * [`assemble`]: the pattern of `H`, built once per topology, filled in place in parallel;
@@ -51,6 +53,7 @@ pub mod assemble;
 mod error;
 pub mod feet;
 mod fitter;
+mod foot_point_term;
 mod groups;
 mod options;
 pub mod ordering;
@@ -59,13 +62,16 @@ mod report;
 pub mod smooth;
 pub mod solve;
 mod stages;
+mod term;
 pub mod terms;
 
 pub use error::{FitError, FitPhase};
 pub use feet::FootPointSource;
 pub use fitter::{fit, FitResult, Fitter};
+pub use foot_point_term::FootPointTerm;
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
     fit_stages, StageEvent, StageOptions, StageReport, StageStop, StagesReport, StagesResult,
 };
+pub use term::DataTerm;

@@ -32,6 +32,7 @@ use crate::error::FitError;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
 use crate::report::{ErrorStats, FitReport, IterationRow};
+use crate::term::DataTerm;
 
 /// Options of the stage driver; the per-iteration options (method, step control, sample
 /// level, scheme) come from a [`FitOptions`].
@@ -369,8 +370,8 @@ struct Measurement {
     data_faces: Vec<FaceError>,
 }
 
-/// Measures `positions` both ways: fresh foot points of every sample of the fitter's sampling
-/// operator, and the distance of every data sample to the tessellation of the samples (the
+/// Measures `positions` both ways: the squared errors of every sample of the fitter's sampling
+/// operator from fresh projections (its data term), and the distance of every data sample to the tessellation of the samples (the
 /// level-`l` limit points; within its chordal error of the limit surface).
 fn measure(
     topo: &Topo<'_>,
@@ -415,8 +416,8 @@ struct Best {
 /// `base.tags`) to `target` in stages. `base` gives the scheme, method, step control and sample
 /// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
-/// After each stage's fit the cage is measured both ways (surface → data with fresh foot
-/// points; data → surface from the target's data samples, [`subfit_report::data_samples`],
+/// After each stage's fit the cage is measured both ways (surface → data with fresh
+/// projections; data → surface from the target's data samples, [`subfit_report::data_samples`],
 /// to the tessellation of the limit samples); the tolerances are judged on both
 /// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
 /// direction, so data the surface leaves uncovered gets control points. The cage returned is
@@ -554,7 +555,7 @@ pub fn fit_stages(
             let before = mesh.faces.clone();
             if stages.edge_flips {
                 let (tried, kept) = flip_pass(
-                    target,
+                    t.fitter.term(),
                     &mut mesh,
                     (&m.surface_faces, &m.data_faces),
                     &mut score,
@@ -647,7 +648,7 @@ fn face_score(e: &FaceError, stages: &StageOptions, unmet: (bool, bool)) -> f64 
 /// over the faces whose limit it changes goes down; the scores of those faces are updated.
 /// Returns (tried, kept).
 fn flip_pass(
-    target: &Target,
+    term: &impl DataTerm,
     mesh: &mut PolyMesh,
     (surface, data): (&[FaceError], &[FaceError]),
     score: &mut [f64],
@@ -668,11 +669,7 @@ fn flip_pass(
         base.sample_level,
     )?;
     let samples = op.position.apply(&mesh.positions);
-    let new_errors = face_errors(
-        &flipped,
-        &op,
-        &crate::feet::squared_errors(target, base.foot_points, &samples),
-    );
+    let new_errors = face_errors(&flipped, &op, &term.squared_errors(&samples));
     // Faces incident to each vertex of the old mesh (the same faces are incident to a, b, c,
     // d in both meshes).
     let mut vf: Vec<Vec<u32>> = vec![Vec::new(); mesh.num_vertices()];

@@ -206,7 +206,7 @@ fn subset_step_solves_the_eliminated_full_system() {
     let p0 = &mesh.positions;
     let op = &fitter.sampling_operator().position;
     let s = op.apply(p0);
-    let feet = fitter.foot_points(&s);
+    let feet = fitter.term().foot_points(&s);
     let q: Vec<_> = feet.iter().map(|f| error_matrix(Method::Sdm, f)).collect();
     let v: Vec<[f64; 3]> = feet.iter().map(|f| f.point).collect();
     let pattern = Pattern::new(op, &Laplacian::umbrella(&mesh.faces, n), 3);

@@ -93,7 +93,7 @@ fn main() {
         let fitter = Fitter::new(&target, &cage.faces, p.len(), &fopts).expect("fitter");
         let op = &fitter.sampling_operator().position;
         let s = op.apply(&p);
-        let feet = fitter.foot_points(&s);
+        let feet = fitter.term().foot_points(&s);
         let v: Vec<[f64; 3]> = feet.iter().map(|f| f.point).collect();
         let lap = Laplacian::umbrella(&cage.faces, p.len());
         let t0 = Instant::now();
