@@ -20,8 +20,7 @@ use crate::options::{FitOptions, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
 use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
-use crate::term::DataTerm;
-use crate::terms::Mat3;
+use crate::term::{DataTerm, Mat3};
 
 /// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
 const MU_MAX: f64 = 1e16;
@@ -267,9 +266,10 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         &self.op
     }
 
-    /// The pattern of the normal matrix.
-    pub fn pattern(&self) -> &Pattern {
-        &self.pattern
+    /// Stored values of the normal matrix `H` (its pattern's nonzeros; with [`Self::factor_len`]
+    /// a measure of fill-in).
+    pub fn normal_matrix_nnz(&self) -> usize {
+        self.pattern.nnz()
     }
 
     /// Stored values of the Cholesky factor (fill-in measure; `None` before the first solve).

@@ -3,7 +3,7 @@
 //! weight `λ` is lowered from stage to stage (default 1e-3 → 1e-5, ×0.1 per stage) and, when
 //! a stage stalls above the tolerance, the control mesh is changed where the error is large:
 //! edge flips that lower the error are kept, then the faces with large error are split 1-to-4
-//! with red-green closure ([`crate::adapt`]). Stops at the tolerance (`E_rms`, and `E_max`
+//! with red-green closure (Cheng et al. 2004 §4.5). Stops at the tolerance (`E_rms`, and `E_max`
 //! when asked), at the control-point budget, or when nothing more can be changed.
 //!
 //! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
@@ -24,13 +24,13 @@ use subfit_report::{data_samples, DistanceStats, MeshDistance, TwoSided};
 use subfit_subdiv::sampling_operator;
 use subfit_target::Target;
 
-use crate::adapt::{
-    apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
-    FaceError, RefineStats,
-};
 use crate::error::FitError;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
+use crate::remesh::{
+    apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
+    FaceError, RefineStats,
+};
 use crate::report::{ErrorStats, FitReport, IterationRow};
 use crate::term::DataTerm;
 
@@ -417,7 +417,7 @@ struct Best {
 /// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
 /// After each stage's fit the cage is measured both ways (surface → data with fresh
-/// projections; data → surface from the target's data samples, [`subfit_report::data_samples`],
+/// projections; data → surface from the target's data samples, [`subfit_report::data_samples()`],
 /// to the tessellation of the limit samples); the tolerances are judged on both
 /// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
 /// direction, so data the surface leaves uncovered gets control points. The cage returned is
@@ -821,7 +821,7 @@ fn carry_tags(tags: &Tags, old_n: usize, faces: &Polygons) -> Tags {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::adapt::refine_red_green;
+    use crate::remesh::refine_red_green;
     use subfit_mesh::shapes::octahedron_mesh;
 
     /// A crease on a split edge passes to both halves; one on an unsplit edge stays.

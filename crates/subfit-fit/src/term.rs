@@ -21,7 +21,8 @@
 //! for IMLS (Xie et al. 2023 eq. 2–3) — as its [`DataTerm::Sample`]. The fitter and the
 //! stage driver see only this trait.
 
-use crate::terms::Mat3;
+/// A symmetric 3×3 matrix, row-major. Units: dimensionless weights.
+pub type Mat3 = [[f64; 3]; 3];
 
 /// The 3×3 identity: `Q` of an isotropic term.
 pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
@@ -77,4 +78,21 @@ pub trait DataTerm: Send + Sync {
             .map(|(&x, s)| self.squared_error(s, x))
             .collect()
     }
+}
+
+/// The quadratic form `eᵀ Q e`. Cost: O(1).
+#[inline]
+pub fn quadratic(q: &Mat3, e: [f64; 3]) -> f64 {
+    let qe = mul(q, e);
+    e[0] * qe[0] + e[1] * qe[1] + e[2] * qe[2]
+}
+
+/// `Q e`. Cost: O(1).
+#[inline]
+pub fn mul(q: &Mat3, e: [f64; 3]) -> [f64; 3] {
+    [
+        q[0][0] * e[0] + q[0][1] * e[1] + q[0][2] * e[2],
+        q[1][0] * e[0] + q[1][1] * e[1] + q[1][2] * e[2],
+        q[2][0] * e[0] + q[2][1] * e[1] + q[2][2] * e[2],
+    ]
 }

@@ -187,9 +187,8 @@ fn dense_solve(mut a: Vec<f64>, mut b: Vec<f64>) -> Vec<f64> {
 /// the whole problem (smoothing included) assembled by `Pattern` and solved densely.
 #[test]
 fn subset_step_solves_the_eliminated_full_system() {
-    use subfit_fit::assemble::{weighted_residuals, Pattern};
-    use subfit_fit::smooth::Laplacian;
-    use subfit_fit::terms::{error_matrix, Method};
+    use subfit_fit::internals::{error_matrix, weighted_residuals, Laplacian, Pattern};
+    use subfit_fit::Method;
 
     let (target, mesh) = setup();
     let n = mesh.num_vertices();
