@@ -78,7 +78,7 @@ fn main() {
             "\n{} control points, {} samples (level {level}), H: {} nonzeros (upper), setup {:.2?}",
             mesh.num_vertices(),
             fitter.num_samples(),
-            fitter.pattern().nnz(),
+            fitter.normal_matrix_nnz(),
             setup
         );
         let mut p = mesh.positions.clone();
@@ -88,7 +88,7 @@ fn main() {
             report.initial.e_rms,
             report.initial.e_max,
             fitter.factor_len().unwrap_or(0),
-            fitter.factor_len().unwrap_or(0) as f64 / fitter.pattern().nnz() as f64
+            fitter.factor_len().unwrap_or(0) as f64 / fitter.normal_matrix_nnz() as f64
         );
         println!(
             "iter acc   E_rms     E_max     total    sample  project assemble  solve  evaluate"

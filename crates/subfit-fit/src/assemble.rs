@@ -2,7 +2,7 @@
 //! §III-B; DESIGN.md §3.3, §6).
 //!
 //! With samples `S_k = Σ_i c_ki P_i` (rows of the sampling operator), frozen foot points `V_k`
-//! and error matrices `Q_k` ([`crate::terms`]), the model of eq. 2 is
+//! and error matrices `Q_k` (a data term's model, [`crate::DataTerm`]), the model of eq. 2 is
 //!
 //! ```text
 //! F_L(P) = 1/m Σ_k (S_k − V_k)ᵀ Q_k (S_k − V_k) + λ/n ‖L P‖²
@@ -16,7 +16,7 @@
 //! The [`Pattern`] (union of the `c_k c_kᵀ` and `LᵀL` patterns) is built once per control-mesh
 //! topology; each iteration [`Pattern::fill`] writes values in place, so there is no triplet
 //! re-assembly and nothing dense of size `n²`. With 3×3 blocks the samples are grouped by
-//! shared support (`groups`: all samples of a control face share one), each group's dense
+//! shared support (`grouped_fill`: all samples of a control face share one), each group's dense
 //! block is one small matrix product added once into per-chunk partial sums, and every block
 //! entry then sums its parts in a fixed order — parallel, lock-free and bitwise identical for
 //! any thread count. PD (and any operator whose supports are too wide to group) uses the
@@ -26,9 +26,9 @@
 use rayon::prelude::*;
 use subfit_subdiv::StencilMatrix;
 
-use crate::groups::Groups;
+use crate::grouped_fill::Groups;
 use crate::smooth::Laplacian;
-use crate::terms::{mul, Mat3};
+use crate::term::{mul, Mat3};
 
 /// Sparsity pattern of the normal matrix `H` (upper triangle, CSC) with the index structures
 /// that let values be filled in place.

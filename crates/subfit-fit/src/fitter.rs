@@ -1,41 +1,50 @@
 //! The fitting loop (Cheng et al. 2007, §II-B steps 4–7 and §III-C; DESIGN.md §1, §3.3–3.4):
-//! sample `S = C·P`, project onto the target, assemble the PD/TD/SD model, solve with the
-//! reused sparse Cholesky, then accept the step as it is, by the LM gain ratio, or by Armijo
-//! backtracking — both judged on the true objective with fresh foot points.
+//! sample `S = C·P`, project the samples through the data term ([`DataTerm`]), assemble its
+//! quadratic model, solve with the reused sparse Cholesky, then accept the step as it is, by
+//! the LM gain ratio, or by Armijo backtracking — both judged on the true objective with fresh
+//! projections.
 
+use std::marker::PhantomData;
 use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 use subfit_mesh::{PolyMesh, Polygons};
 use subfit_subdiv::{sampling_operator, SamplingOperator};
-use subfit_target::{FootPoint, Target};
+use subfit_target::Target;
 
 use crate::active::{sample_rows, ActiveSet, FixedErrors};
 use crate::assemble::{FillScratch, Pattern};
 use crate::error::{FitError, FitPhase};
-use crate::options::{FitOptions, Method, StepControl};
+use crate::foot_point_term::FootPointTerm;
+use crate::options::{FitOptions, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
 use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
-use crate::terms::{error_matrix, mul, Mat3};
+use crate::term::{DataTerm, Mat3};
 
 /// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
 const MU_MAX: f64 = 1e16;
 
-/// Samples and foot points of one set of control points (all samples, or with an active set
-/// only the samples touching an active point; `stats` are always over all samples).
-#[derive(Clone, Debug, Default)]
-struct State {
+/// Samples and their projections of one set of control points (all samples, or with an
+/// active set only the samples touching an active point; `stats` are always over all samples).
+struct State<S> {
     samples: Vec<[f64; 3]>,
-    feet: Vec<FootPoint>,
+    projected: Vec<S>,
     stats: ErrorStats,
 }
 
-/// A reusable fitter for one target and one control-mesh topology. Keeps the sampling operator,
-/// the pattern of the normal matrix, the symbolic Cholesky factorization and all buffers
-/// between iterations and between calls to [`Fitter::run`] (STYLE.md rule 3).
-pub struct Fitter<'t> {
-    target: &'t Target,
+/// What a step trial ends with: (accepted, the trial's state, step length, gain ratio).
+type Trial<S> = (bool, State<S>, f64, f64);
+
+/// A reusable fitter for one data term and one control-mesh topology. Keeps the sampling
+/// operator, the pattern of the normal matrix, the symbolic Cholesky factorization and all
+/// buffers between iterations and between calls to [`Fitter::run`] (STYLE.md rule 3).
+///
+/// The data term `T` ([`DataTerm`]) is by default Cheng's foot-point term on a [`Target`]
+/// ([`FootPointTerm`], built by [`Fitter::new`]); any other comes in through
+/// [`Fitter::with_term`].
+pub struct Fitter<'t, T: DataTerm = FootPointTerm<'t>> {
+    term: T,
     options: FitOptions,
     op: SamplingOperator,
     pattern: Pattern,
@@ -45,14 +54,14 @@ pub struct Fitter<'t> {
     q: Vec<Mat3>,
     bbox_diagonal: f64,
     setup: Duration,
-    /// Nearest data point of every sample at the last projection (warm start).
-    hints: std::sync::Mutex<Vec<u32>>,
     /// The umbrella Laplacian over all control points.
     lap: Laplacian,
     /// The active set and its sub-problem ([`Self::set_active`]); `None`: all points active.
     active: Option<ActiveSet>,
     /// Partial sums of the fill, reused.
     scratch: FillScratch,
+    /// The target (or whatever the term borrows) outlives the fitter.
+    _data: PhantomData<&'t ()>,
 }
 
 /// The solver the options call for with `n` unknown points of block size `block`.
@@ -72,15 +81,41 @@ fn make_solver(options: &FitOptions, n: usize, block: usize) -> NormalSolver {
 
 impl<'t> Fitter<'t> {
     /// Prepares fitting `faces` (over `num_vertices` control points, with the crease/corner
-    /// tags and subdivision rules of `options`) to `target`. Builds the sampling operator at `options.sample_level`, the umbrella
-    /// Laplacian, the pattern of `H` and its symbolic Cholesky analysis. The control points themselves are given to
-    /// [`Self::run`], in the target's normalized coordinates.
+    /// tags and subdivision rules of `options`) to `target` with the foot-point term of
+    /// `options` ([`FootPointTerm::from_options`]: [`FitOptions::method`],
+    /// [`FitOptions::foot_points`]). See [`Self::with_term`].
+    ///
+    /// Errors: invalid options, invalid control topology (see [`subfit_subdiv::SubdivError`]).
+    pub fn new(
+        target: &'t Target,
+        faces: &Polygons,
+        num_vertices: usize,
+        options: &FitOptions,
+    ) -> Result<Self, FitError> {
+        Self::with_term(
+            FootPointTerm::from_options(target, options),
+            faces,
+            num_vertices,
+            options,
+        )
+    }
+}
+
+impl<'t, T: DataTerm> Fitter<'t, T> {
+    /// Prepares fitting `faces` (over `num_vertices` control points, with the crease/corner
+    /// tags and subdivision rules of `options`) to the data term `term` (which is then the
+    /// fitter's: a term with warm-start state keyed by sample row serves one fitter).
+    /// Builds the sampling operator at `options.sample_level`, the umbrella Laplacian, the
+    /// pattern of `H` (block size 1 when the term is isotropic, else 3) and its symbolic
+    /// Cholesky analysis. The control points themselves are given to [`Self::run`], in the
+    /// target's normalized coordinates. Options that configure a particular term
+    /// ([`FitOptions::method`], [`FitOptions::foot_points`]) are not read here.
     ///
     /// Errors: invalid options, invalid control topology (see [`subfit_subdiv::SubdivError`]).
     /// Cost: dominated by the sampling operator and the pattern, O(m·s²) with `m` samples and
     /// `s` ≈ 12–15 control points per sample.
-    pub fn new(
-        target: &'t Target,
+    pub fn with_term(
+        term: T,
         faces: &Polygons,
         num_vertices: usize,
         options: &FitOptions,
@@ -100,16 +135,16 @@ impl<'t> Fitter<'t> {
             options.sample_level,
         )?;
         let lap = Laplacian::umbrella(faces, num_vertices);
-        let block = if options.method == Method::Pdm { 1 } else { 3 };
+        let block = if term.isotropic() { 1 } else { 3 };
         let pattern = Pattern::new(&op.position, &lap, block);
         let values = vec![0.0; pattern.nnz()];
-        let bbox_diagonal = bbox_diagonal(target.points());
+        let bbox_diagonal = term.bbox_diagonal();
         let mut solver: CholeskySolver = make_solver(options, num_vertices, block);
         solver
             .analyse(&pattern)
             .map_err(|e| FitError::Solver(format!("symbolic analysis: {e:?}")))?;
         Ok(Self {
-            target,
+            term,
             options: options.clone(),
             op,
             pattern,
@@ -119,10 +154,10 @@ impl<'t> Fitter<'t> {
             q: Vec::new(),
             bbox_diagonal,
             setup: t0.elapsed(),
-            hints: std::sync::Mutex::new(Vec::new()),
             lap,
             active: None,
             scratch: FillScratch::default(),
+            _data: PhantomData,
         })
     }
 
@@ -133,11 +168,11 @@ impl<'t> Fitter<'t> {
     ///
     /// Only the samples whose stencil touches an active point are sampled, projected and
     /// assembled during [`Self::run`], so an iteration costs in proportion to the active
-    /// region. The other samples cannot move; their squared distances are measured once per
+    /// region. The other samples cannot move; their squared errors are measured once per
     /// run start at which the fixed points changed (the first run after this call, or after the
     /// caller moved a fixed point), and cached. So every [`ErrorStats`] reported by
     /// [`Self::run`] (initial, per iteration) is still over the whole surface, exact: fresh
-    /// foot points for the active samples plus the cached distances of the fixed ones, and
+    /// projections of the active samples plus the cached errors of the fixed ones, and
     /// the smoothing energy of all points. [`Self::evaluate`] always samples everything.
     ///
     /// Building an active set costs a pass over the sampling operator, the pattern of `H_aa`
@@ -215,10 +250,15 @@ impl<'t> Fitter<'t> {
         self.options.min_relative_decrease = stall;
     }
 
-    /// Squared distances of `samples` (e.g. `C·P`) to fresh foot points from the options'
-    /// source; the warm-start hints are left alone.
+    /// Squared errors of `samples` (e.g. `C·P`, or any points) from fresh projections
+    /// ([`DataTerm::squared_errors`]); the term's warm start is left alone.
     pub fn squared_errors(&self, samples: &[[f64; 3]]) -> Vec<f64> {
-        crate::feet::squared_errors(self.target, self.options.foot_points, samples)
+        self.term.squared_errors(samples)
+    }
+
+    /// The data term.
+    pub fn term(&self) -> &T {
+        &self.term
     }
 
     /// The sampling operator (`m × n` limit stencils at the sample level).
@@ -226,14 +266,10 @@ impl<'t> Fitter<'t> {
         &self.op
     }
 
-    /// Foot points of `xs` from the source the options name (normalized coordinates).
-    pub fn foot_points(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
-        crate::feet::foot_points(self.target, self.options.foot_points, xs)
-    }
-
-    /// The pattern of the normal matrix.
-    pub fn pattern(&self) -> &Pattern {
-        &self.pattern
+    /// Stored values of the normal matrix `H` (its pattern's nonzeros; with [`Self::factor_len`]
+    /// a measure of fill-in).
+    pub fn normal_matrix_nnz(&self) -> usize {
+        self.pattern.nnz()
     }
 
     /// Stored values of the Cholesky factor (fill-in measure; `None` before the first solve).
@@ -255,8 +291,8 @@ impl<'t> Fitter<'t> {
         self.op.position.nrows()
     }
 
-    /// Errors of `control` (`n by 3`, normalized units) with fresh samples and foot points.
-    /// Cost: one `C·P` and `m` foot-point queries.
+    /// Errors of `control` (`n by 3`, normalized units) with fresh samples and projections.
+    /// Cost: one `C·P` and one projection of the `m` samples.
     pub fn evaluate(&self, control: &[[f64; 3]]) -> ErrorStats {
         let mut t = PhaseTimings::default();
         self.full_state(control, &mut t).stats
@@ -264,16 +300,16 @@ impl<'t> Fitter<'t> {
 
     /// The state at `control`: all samples, or with an active set the active samples (the
     /// stats adding the cached fixed ones, which must be valid for `control`).
-    fn state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State {
+    fn state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State<T::Sample> {
         let Some(a) = &self.active else {
             return self.full_state(control, t);
         };
         let t0 = Instant::now();
         let samples = sample_rows(&self.op.position, &a.samples, control);
         let t1 = Instant::now();
-        let feet = self.project_rows(&a.samples, &samples);
+        let projected = self.term.project(Some(&a.samples), &samples);
         let t2 = Instant::now();
-        let (sum, max) = sum_max_d2(&samples, &feet);
+        let (sum, max) = sum_max_d2(&self.term, &samples, &projected);
         let (fs, fm) = a.fixed.as_ref().map_or((0.0, 0.0), |f| (f.sum, f.max));
         let stats = self.stats(control, sum + fs, max.max(fm));
         t.sample += t1 - t0;
@@ -281,26 +317,9 @@ impl<'t> Fitter<'t> {
         t.evaluate += t2.elapsed();
         State {
             samples,
-            feet,
+            projected,
             stats,
         }
-    }
-
-    /// Foot points of the samples `rows` at positions `xs`, warm-started from (and updating)
-    /// their hints.
-    fn project_rows(&self, rows: &[u32], xs: &[[f64; 3]]) -> Vec<FootPoint> {
-        let mut hints = self
-            .hints
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        hints.resize(self.num_samples(), u32::MAX);
-        let mut sub: Vec<u32> = rows.iter().map(|&k| hints[k as usize]).collect();
-        let feet =
-            crate::feet::foot_points_hinted(self.target, self.options.foot_points, xs, &mut sub);
-        for (&k, &h) in rows.iter().zip(&sub) {
-            hints[k as usize] = h;
-        }
-        feet
     }
 
     /// Measures the fixed samples of the active set at `control` unless the cache holds.
@@ -310,8 +329,8 @@ impl<'t> Fitter<'t> {
             return;
         }
         let xs = sample_rows(&self.op.position, &a.fixed_samples, control);
-        let feet = self.project_rows(&a.fixed_samples, &xs);
-        let (sum, max) = sum_max_d2(&xs, &feet);
+        let projected = self.term.project(Some(&a.fixed_samples), &xs);
+        let (sum, max) = sum_max_d2(&self.term, &xs, &projected);
         if let Some(a) = &mut self.active {
             a.fixed = Some(FixedErrors {
                 control: control.to_vec(),
@@ -322,33 +341,21 @@ impl<'t> Fitter<'t> {
     }
 
     /// The state at `control` over all samples.
-    fn full_state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State {
+    fn full_state(&self, control: &[[f64; 3]], t: &mut PhaseTimings) -> State<T::Sample> {
         let t0 = Instant::now();
         let samples = self.op.position.apply(control);
         let t1 = Instant::now();
-        let feet = {
-            // Samples move little between calls: warm-start the nearest-point search from the
-            // last call's answers (a poisoned lock only loses the hints).
-            let mut hints = self
-                .hints
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
-            crate::feet::foot_points_hinted(
-                self.target,
-                self.options.foot_points,
-                &samples,
-                &mut hints,
-            )
-        };
+        // Samples move little between calls: the term may warm-start from its last answers.
+        let projected = self.term.project(None, &samples);
         let t2 = Instant::now();
-        let (sum, max) = sum_max_d2(&samples, &feet);
+        let (sum, max) = sum_max_d2(&self.term, &samples, &projected);
         let stats = self.stats(control, sum, max);
         t.sample += t1 - t0;
         t.project += t2 - t1;
         t.evaluate += t2.elapsed();
         State {
             samples,
-            feet,
+            projected,
             stats,
         }
     }
@@ -379,8 +386,8 @@ impl<'t> Fitter<'t> {
     /// given, is called after each iteration.
     ///
     /// Errors: non-finite input or results, an indefinite system without LM damping.
-    /// Cost per iteration: one fill of `H` (O(m·s²)), one numeric Cholesky, `m` foot-point
-    /// queries per trial.
+    /// Cost per iteration: one fill of `H` (O(m·s²)), one numeric Cholesky, one projection of
+    /// the `m` samples per trial.
     pub fn run(
         &mut self,
         control: &mut [[f64; 3]],
@@ -529,7 +536,7 @@ impl<'t> Fitter<'t> {
         Ok(report)
     }
 
-    /// Evaluates trial control points along `dir` with fresh foot points and decides, per the
+    /// Evaluates trial control points along `dir` with fresh projections and decides, per the
     /// step control, whether to accept (Cheng 2007 §III-C). Returns (accepted, trial state,
     /// step length, gain ratio); the trial control points are left in `trial_p`.
     #[allow(clippy::too_many_arguments)]
@@ -542,7 +549,7 @@ impl<'t> Fitter<'t> {
         trial_p: &mut [[f64; 3]],
         t: &mut PhaseTimings,
         it: usize,
-    ) -> Result<(bool, State, f64, f64), FitError> {
+    ) -> Result<Trial<T::Sample>, FitError> {
         let opts = &self.options;
         let mut step_length = 1.0;
         let mut backtracks = 0;
@@ -602,29 +609,31 @@ impl<'t> Fitter<'t> {
 
     /// Fills `H` (values and its diagonal copy) at the current state; returns `g` — over the
     /// active points (`H_aa`, `g_a`) when an active set is in use.
-    fn assemble(&mut self, control: &[[f64; 3]], cur: &State) -> Vec<[f64; 3]> {
+    fn assemble(&mut self, control: &[[f64; 3]], cur: &State<T::Sample>) -> Vec<[f64; 3]> {
         let m = self.num_samples().max(1) as f64;
         let n = control.len().max(1) as f64;
         let (w_e, w_s) = (1.0 / m, self.options.lambda / n);
-        let method = self.options.method;
+        let term = &self.term;
         let coupled = self.pattern.block() == 3;
-        // Q_k and the weighted residuals r_k = Q_k (S_k − V_k) (PD: S_k − V_k) in one pass.
+        // Q_k and the weighted residuals r_k = Q_k (S_k − V_k) (isotropic: S_k − V_k) in one
+        // pass.
         let r: Vec<[f64; 3]> = if coupled {
-            self.q.resize(cur.feet.len(), [[0.0; 3]; 3]);
+            self.q.resize(cur.projected.len(), [[0.0; 3]; 3]);
             self.q
                 .par_iter_mut()
-                .zip(cur.feet.par_iter())
+                .zip(cur.projected.par_iter())
                 .zip(cur.samples.par_iter())
-                .map(|((q, f), s)| {
-                    *q = error_matrix(method, f);
-                    mul(q, std::array::from_fn(|a| s[a] - f.point[a]))
+                .map(|((q, f), &s)| {
+                    let (qk, rk) = term.model(f, s);
+                    *q = qk;
+                    rk
                 })
                 .collect()
         } else {
             cur.samples
                 .par_iter()
-                .zip(cur.feet.par_iter())
-                .map(|(s, f)| std::array::from_fn(|a| s[a] - f.point[a]))
+                .zip(cur.projected.par_iter())
+                .map(|(&s, f)| term.model(f, s).1)
                 .collect()
         };
         let (g, pattern, values) = match &mut self.active {
@@ -729,13 +738,13 @@ impl Damping {
     }
 }
 
-/// `(Σ_k d_k², max_k d_k²)` with `d_k = ‖S_k − V_k‖`: squared distances in parallel, summed
-/// serially in sample order (deterministic for any thread count).
-fn sum_max_d2(s: &[[f64; 3]], feet: &[FootPoint]) -> (f64, f64) {
+/// `(Σ_k e_k², max_k e_k²)` of the samples `s` with their projections `projected`: squared
+/// errors in parallel, summed serially in sample order (deterministic for any thread count).
+fn sum_max_d2<T: DataTerm>(term: &T, s: &[[f64; 3]], projected: &[T::Sample]) -> (f64, f64) {
     let d2: Vec<f64> = s
         .par_iter()
-        .zip(feet.par_iter())
-        .map(|(s, f)| (0..3).map(|a| (s[a] - f.point[a]).powi(2)).sum::<f64>())
+        .zip(projected.par_iter())
+        .map(|(&s, f)| term.squared_error(f, s))
         .collect();
     let sum: f64 = d2.iter().sum();
     let max = d2.iter().fold(0.0f64, |a, &b| a.max(b));
@@ -756,23 +765,6 @@ fn check_finite(
             phase,
             what,
         })
-    }
-}
-
-fn bbox_diagonal(p: &[[f64; 3]]) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for x in p {
-        for a in 0..3 {
-            lo[a] = lo[a].min(x[a]);
-            hi[a] = hi[a].max(x[a]);
-        }
-    }
-    let d = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
-    if d.is_finite() && d > 0.0 {
-        d
-    } else {
-        1.0
     }
 }
 

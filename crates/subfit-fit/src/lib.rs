@@ -5,14 +5,13 @@
 //! (§II-D; Cheng et al. 2004 §3, §4.4) plus the umbrella smoothing term (§II-E) — with a sparse
 //! Cholesky solve, and control the step by Levenberg–Marquardt or Armijo (§III-C).
 //!
-//! * [`terms`]: the per-sample 3×3 error matrices `Q_k`;
-//! * [`smooth`]: the umbrella Laplacian;
-//! * [`assemble`]: the pattern of `H`, built once per topology, filled in place in parallel;
-//! * [`solve`]: `faer` supernodal Cholesky with the symbolic analysis reused, or PCG for large
-//!   systems ([`pcg`]); [`ordering`]: fill-reducing orderings on the block graph;
-//! * [`Fitter`] / [`fit`]: the loop with step control; [`FitReport`] logs every iteration;
+//! * [`DataTerm`]: what is fitted — per sample, the true squared error and its quadratic model
+//!   (`Q_k`, `Q_k (S_k − V_k)`); [`FootPointTerm`] is Cheng's PD/TD/SD on a target;
+//! * [`Fitter`] / [`fit`]: the loop with step control (sampling operator, the pattern of the
+//!   normal matrix and its symbolic Cholesky analysis kept between iterations and calls; PCG
+//!   for large systems, [`LinearSolver`]); [`FitReport`] logs every iteration;
 //! * [`fit_stages`]: multi-stage fitting — `λ` schedule, edge flips and red-green local
-//!   refinement ([`adapt`]) until a tolerance or a control-point budget.
+//!   refinement until a tolerance or a control-point budget.
 //!
 //! Everything is in the target's normalized units (unit cube). The library prints nothing;
 //! progress goes to an optional callback.
@@ -46,26 +45,45 @@
 //! ```
 
 mod active;
-pub mod adapt;
-pub mod assemble;
+mod assemble;
 mod error;
-pub mod feet;
 mod fitter;
-mod groups;
+mod foot_point_term;
+mod grouped_fill;
 mod options;
-pub mod ordering;
-pub mod pcg;
+mod ordering;
+mod pcg;
+mod remesh;
 mod report;
-pub mod smooth;
-pub mod solve;
+mod smooth;
+mod solve;
 mod stages;
-pub mod terms;
+mod term;
 
 pub use error::{FitError, FitPhase};
-pub use feet::FootPointSource;
 pub use fitter::{fit, FitResult, Fitter};
+pub use foot_point_term::{FootPointSource, FootPointTerm};
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
+pub use pcg::PcgStats;
+pub use remesh::RefineStats;
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
     fit_stages, StageEvent, StageOptions, StageReport, StageStop, StagesReport, StagesResult,
 };
+pub use term::{DataTerm, Mat3};
+
+/// The fitter's building blocks, reachable only for this crate's integration tests (`tests/`)
+/// and the assembly benchmark (`crates/subfit/examples/assemble_igea.rs`), which check them
+/// against dense references and time them one by one. Not part of the API: undocumented, no
+/// stability promise; use [`Fitter`].
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::assemble::{weighted_residuals, FillScratch, Pattern};
+    pub use crate::foot_point_term::error_matrix;
+    pub use crate::ordering::{block_amd, nested_dissection, BlockGraph};
+    pub use crate::pcg::PcgSolver;
+    pub use crate::remesh::refine_red_green;
+    pub use crate::smooth::Laplacian;
+    pub use crate::solve::{CholeskySolver, SolveFailure};
+    pub use crate::term::{mul, quadratic};
+}

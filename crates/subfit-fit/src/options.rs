@@ -3,10 +3,10 @@
 use subfit_mesh::{Cancel, Tags};
 use subfit_subdiv::{BoundaryRule, Options, Scheme};
 
-use crate::feet::FootPointSource;
+use crate::foot_point_term::FootPointSource;
 
+pub use crate::foot_point_term::Method;
 pub use crate::ordering::FillOrdering;
-pub use crate::terms::Method;
 
 /// How the damped normal equations are solved each iteration.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -157,7 +157,7 @@ pub struct FitOptions {
     /// PCG stops when `‖r‖ ≤ pcg_tolerance · ‖g‖` (relative residual, dimensionless).
     /// Default `1e-2`: on Igea at 10k control points the per-iteration errors match those
     /// with `1e-3` to three digits at half the PCG iterations (the LM gain ratio stays exact
-    /// for any tolerance, see [`crate::pcg`]).
+    /// for any tolerance: the predicted decrease is computed from the step solved).
     pub pcg_tolerance: f64,
     /// PCG iteration cap per solve. Default 500.
     pub pcg_max_iterations: usize,

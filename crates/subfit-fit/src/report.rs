@@ -9,13 +9,13 @@ use crate::options::{Method, StepControl};
 pub struct PhaseTimings {
     /// `S = C·P` at trial control points.
     pub sample: Duration,
-    /// Foot-point queries at the trial samples.
+    /// Projections of the trial samples by the data term (foot-point queries).
     pub project: Duration,
     /// `Q_k`, the in-place fill of `H` and the gradient.
     pub assemble: Duration,
     /// Numeric Cholesky and triangular solves.
     pub solve: Duration,
-    /// Objective and error statistics from the fresh foot points.
+    /// Objective and error statistics from the fresh projections.
     pub evaluate: Duration,
 }
 
@@ -35,7 +35,7 @@ impl PhaseTimings {
     }
 }
 
-/// Fitting errors of one set of control points, measured with fresh samples and foot points.
+/// Fitting errors of one set of control points, measured with fresh samples and projections.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ErrorStats {
     /// `E_max = max_k ‖S_k − V_k‖` (normalized units).
@@ -88,7 +88,8 @@ pub enum StopReason {
 /// The log of one [`crate::Fitter::run`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct FitReport {
-    /// Error term used.
+    /// The options' error term ([`crate::FitOptions::method`]: what a [`crate::FootPointTerm`]
+    /// built by [`crate::Fitter::new`] uses; another data term may ignore it).
     pub method: Method,
     /// Step control used.
     pub step: StepControl,

@@ -33,8 +33,8 @@ pub enum SolveFailure {
     Other(String),
 }
 
-/// The name the fitter uses for [`NormalSolver`] (a sparse Cholesky unless built with
-/// [`NormalSolver::with_pcg`]).
+/// The name the fitter uses for `NormalSolver` (a sparse Cholesky unless built with
+/// `NormalSolver::with_pcg`).
 pub type CholeskySolver = NormalSolver;
 
 /// A solver of the normal equations for one [`Pattern`]: a sparse `LLᵀ` factorization that keeps

@@ -3,7 +3,7 @@
 //! weight `λ` is lowered from stage to stage (default 1e-3 → 1e-5, ×0.1 per stage) and, when
 //! a stage stalls above the tolerance, the control mesh is changed where the error is large:
 //! edge flips that lower the error are kept, then the faces with large error are split 1-to-4
-//! with red-green closure ([`crate::adapt`]). Stops at the tolerance (`E_rms`, and `E_max`
+//! with red-green closure (Cheng et al. 2004 §4.5). Stops at the tolerance (`E_rms`, and `E_max`
 //! when asked), at the control-point budget, or when nothing more can be changed.
 //!
 //! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
@@ -24,14 +24,15 @@ use subfit_report::{data_samples, DistanceStats, MeshDistance, TwoSided};
 use subfit_subdiv::sampling_operator;
 use subfit_target::Target;
 
-use crate::adapt::{
-    apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
-    FaceError, RefineStats,
-};
 use crate::error::FitError;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
+use crate::remesh::{
+    apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
+    FaceError, RefineStats,
+};
 use crate::report::{ErrorStats, FitReport, IterationRow};
+use crate::term::DataTerm;
 
 /// Options of the stage driver; the per-iteration options (method, step control, sample
 /// level, scheme) come from a [`FitOptions`].
@@ -369,8 +370,8 @@ struct Measurement {
     data_faces: Vec<FaceError>,
 }
 
-/// Measures `positions` both ways: fresh foot points of every sample of the fitter's sampling
-/// operator, and the distance of every data sample to the tessellation of the samples (the
+/// Measures `positions` both ways: the squared errors of every sample of the fitter's sampling
+/// operator from fresh projections (its data term), and the distance of every data sample to the tessellation of the samples (the
 /// level-`l` limit points; within its chordal error of the limit surface).
 fn measure(
     topo: &Topo<'_>,
@@ -415,8 +416,8 @@ struct Best {
 /// `base.tags`) to `target` in stages. `base` gives the scheme, method, step control and sample
 /// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
-/// After each stage's fit the cage is measured both ways (surface → data with fresh foot
-/// points; data → surface from the target's data samples, [`subfit_report::data_samples`],
+/// After each stage's fit the cage is measured both ways (surface → data with fresh
+/// projections; data → surface from the target's data samples, [`subfit_report::data_samples()`],
 /// to the tessellation of the limit samples); the tolerances are judged on both
 /// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
 /// direction, so data the surface leaves uncovered gets control points. The cage returned is
@@ -554,7 +555,7 @@ pub fn fit_stages(
             let before = mesh.faces.clone();
             if stages.edge_flips {
                 let (tried, kept) = flip_pass(
-                    target,
+                    t.fitter.term(),
                     &mut mesh,
                     (&m.surface_faces, &m.data_faces),
                     &mut score,
@@ -647,7 +648,7 @@ fn face_score(e: &FaceError, stages: &StageOptions, unmet: (bool, bool)) -> f64 
 /// over the faces whose limit it changes goes down; the scores of those faces are updated.
 /// Returns (tried, kept).
 fn flip_pass(
-    target: &Target,
+    term: &impl DataTerm,
     mesh: &mut PolyMesh,
     (surface, data): (&[FaceError], &[FaceError]),
     score: &mut [f64],
@@ -668,11 +669,7 @@ fn flip_pass(
         base.sample_level,
     )?;
     let samples = op.position.apply(&mesh.positions);
-    let new_errors = face_errors(
-        &flipped,
-        &op,
-        &crate::feet::squared_errors(target, base.foot_points, &samples),
-    );
+    let new_errors = face_errors(&flipped, &op, &term.squared_errors(&samples));
     // Faces incident to each vertex of the old mesh (the same faces are incident to a, b, c,
     // d in both meshes).
     let mut vf: Vec<Vec<u32>> = vec![Vec::new(); mesh.num_vertices()];
@@ -824,7 +821,7 @@ fn carry_tags(tags: &Tags, old_n: usize, faces: &Polygons) -> Tags {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::adapt::refine_red_green;
+    use crate::remesh::refine_red_green;
     use subfit_mesh::shapes::octahedron_mesh;
 
     /// A crease on a split edge passes to both halves; one on an unsplit edge stays.

@@ -187,9 +187,8 @@ fn dense_solve(mut a: Vec<f64>, mut b: Vec<f64>) -> Vec<f64> {
 /// the whole problem (smoothing included) assembled by `Pattern` and solved densely.
 #[test]
 fn subset_step_solves_the_eliminated_full_system() {
-    use subfit_fit::assemble::{weighted_residuals, Pattern};
-    use subfit_fit::smooth::Laplacian;
-    use subfit_fit::terms::{error_matrix, Method};
+    use subfit_fit::internals::{error_matrix, weighted_residuals, Laplacian, Pattern};
+    use subfit_fit::Method;
 
     let (target, mesh) = setup();
     let n = mesh.num_vertices();
@@ -206,7 +205,7 @@ fn subset_step_solves_the_eliminated_full_system() {
     let p0 = &mesh.positions;
     let op = &fitter.sampling_operator().position;
     let s = op.apply(p0);
-    let feet = fitter.foot_points(&s);
+    let feet = fitter.term().foot_points(&s);
     let q: Vec<_> = feet.iter().map(|f| error_matrix(Method::Sdm, f)).collect();
     let v: Vec<[f64; 3]> = feet.iter().map(|f| f.point).collect();
     let pattern = Pattern::new(op, &Laplacian::umbrella(&mesh.faces, n), 3);

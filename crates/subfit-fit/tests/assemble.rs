@@ -3,10 +3,10 @@
 
 // The dense reference is written with explicit indices on purpose (it mirrors the formula).
 #![allow(clippy::needless_range_loop)]
-use subfit_fit::assemble::{weighted_residuals, Pattern};
-use subfit_fit::smooth::Laplacian;
-use subfit_fit::solve::{CholeskySolver, SolveFailure};
-use subfit_fit::terms::{error_matrix, Mat3, Method};
+use subfit_fit::internals::{
+    error_matrix, weighted_residuals, CholeskySolver, Laplacian, Pattern, SolveFailure,
+};
+use subfit_fit::{Mat3, Method};
 use subfit_mesh::shapes::octahedron_mesh;
 use subfit_mesh::vec3::{self, cross};
 use subfit_mesh::{PolyMesh, Tags};

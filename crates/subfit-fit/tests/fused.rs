@@ -3,9 +3,8 @@
 
 mod common;
 
-use subfit_fit::assemble::{weighted_residuals, FillScratch, Pattern};
-use subfit_fit::smooth::Laplacian;
-use subfit_fit::terms::{error_matrix, Mat3, Method};
+use subfit_fit::internals::{error_matrix, weighted_residuals, FillScratch, Laplacian, Pattern};
+use subfit_fit::{Mat3, Method};
 use subfit_mesh::Tags;
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 

@@ -5,13 +5,12 @@
 
 mod common;
 
-use subfit_fit::assemble::Pattern;
-use subfit_fit::ordering::{block_amd, nested_dissection, BlockGraph, FillOrdering};
-use subfit_fit::pcg::PcgSolver;
-use subfit_fit::smooth::Laplacian;
-use subfit_fit::solve::CholeskySolver;
-use subfit_fit::terms::{error_matrix, Mat3, Method};
+use subfit_fit::internals::{
+    block_amd, error_matrix, nested_dissection, BlockGraph, CholeskySolver, Laplacian, Pattern,
+    PcgSolver,
+};
 use subfit_fit::{fit, FitOptions, LinearSolver, Variant};
+use subfit_fit::{FillOrdering, Mat3, Method};
 use subfit_mesh::{PolyMesh, Tags};
 use subfit_subdiv::{refine, sampling_operator, Options, Scheme};
 

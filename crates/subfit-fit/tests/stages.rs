@@ -3,7 +3,7 @@
 
 mod common;
 
-use subfit_fit::adapt::refine_red_green;
+use subfit_fit::internals::refine_red_green;
 use subfit_fit::{fit_stages, FitOptions, Fitter, StageOptions};
 
 use common::{ellipsoid_target, fourteen_vertex_mesh, normalized};

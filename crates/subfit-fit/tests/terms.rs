@@ -1,7 +1,8 @@
 //! The SD term is the second-order Taylor model of the true squared distance (Cheng 2007
 //! eq. 5–6, sign convention of §II-D3), checked on a sphere where everything is analytic.
 
-use subfit_fit::terms::{error_matrix, mul, quadratic, Method};
+use subfit_fit::internals::{error_matrix, mul, quadratic};
+use subfit_fit::Method;
 use subfit_target::FootPoint;
 
 const C: [f64; 3] = [0.4, 0.5, 0.6];

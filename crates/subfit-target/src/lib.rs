@@ -6,7 +6,8 @@
 //! oriented by minimum-spanning-tree propagation ([`orient`]; Hoppe et al. 1992), foot-point
 //! queries with the signed distance, frame and curvature radii of the SD term ([`project`];
 //! Cheng 2007 §II-D3), the IMLS distance ([`imls`]; Xie et al. 2023 eq. 2–3) and, for meshes,
-//! exact closest points on the triangles ([`closest`]).
+//! exact closest points on the triangles ([`closest`]) and foot points on them
+//! ([`Target::mesh_foot_point`]).
 //!
 //! Everything inside is in normalized units; [`Normalization`] maps back. The library prints
 //! nothing: progress goes through [`ProgressFn`], figures through [`TargetStats`].

@@ -18,11 +18,10 @@
 
 use std::time::{Duration, Instant};
 
-use subfit_fit::assemble::{weighted_residuals, FillScratch, Pattern};
-use subfit_fit::pcg::PcgSolver;
-use subfit_fit::smooth::Laplacian;
-use subfit_fit::terms::{error_matrix, Method};
-use subfit_fit::{FitOptions, Fitter, Variant};
+use subfit_fit::internals::{
+    error_matrix, weighted_residuals, FillScratch, Laplacian, Pattern, PcgSolver,
+};
+use subfit_fit::{FitOptions, Fitter, Method, Variant};
 use subfit_init::{simplify, SimplifyOptions};
 use subfit_target::{Target, TargetOptions};
 
@@ -93,7 +92,7 @@ fn main() {
         let fitter = Fitter::new(&target, &cage.faces, p.len(), &fopts).expect("fitter");
         let op = &fitter.sampling_operator().position;
         let s = op.apply(&p);
-        let feet = fitter.foot_points(&s);
+        let feet = fitter.term().foot_points(&s);
         let v: Vec<[f64; 3]> = feet.iter().map(|f| f.point).collect();
         let lap = Laplacian::umbrella(&cage.faces, p.len());
         let t0 = Instant::now();

@@ -37,7 +37,7 @@
 //! blended foot points of `subfit-target` (where a quadric is untrusted or extrapolated, about
 //! 1.5 % of the queries here) cost 25–90 ms of it (alternate runs with blending disabled:
 //! 0.23–0.26 s). 1k control points: 42–45 ms.
-//! The assembly is the grouped fill of `subfit_fit::assemble` (see `examples/assemble_igea.rs`
+//! The assembly is the grouped fill of the normal matrix (see `examples/assemble_igea.rs`
 //! for its CPU time alone); projection is `subfit-target`'s and dominates what is left.
 #![allow(clippy::print_stdout)]
 
@@ -166,7 +166,7 @@ fn main() {
              setup {:.0} ms (CPU {:.0} ms)",
             positions.len(),
             fitter.num_samples(),
-            fitter.pattern().nnz(),
+            fitter.normal_matrix_nnz(),
             ms(setup),
             ms(setup_cpu)
         );
@@ -193,7 +193,7 @@ fn main() {
             match fitter.factor_len() {
                 Some(f) => format!(
                     "{f} values ({:.1}× nnz(H))",
-                    f as f64 / fitter.pattern().nnz() as f64
+                    f as f64 / fitter.normal_matrix_nnz() as f64
                 ),
                 None => "none (PCG)".into(),
             },

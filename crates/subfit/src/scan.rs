@@ -12,7 +12,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use subfit_fit::{
-    fit_stages, FitOptions, IterationRow, StageEvent, StageOptions, StageReport, StagesResult,
+    fit_stages, DataTerm, FitOptions, FootPointTerm, IterationRow, StageEvent, StageOptions,
+    StageReport, StagesResult,
 };
 use subfit_init::{default_control_points, initial_control_mesh, InitOptions, InitReport};
 use subfit_mesh::{reorient_faces, Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
@@ -423,11 +424,11 @@ pub fn fit_scan(
         last.e_max,
     )
     .map_err(|e| Error::Output(e.to_string()))?;
-    let local: Vec<f64> =
-        subfit_fit::feet::squared_errors(&target, fit.foot_points, &tessellation.mesh.positions)
-            .into_iter()
-            .map(f64::sqrt)
-            .collect();
+    let local: Vec<f64> = FootPointTerm::from_options(&target, &fit)
+        .squared_errors(&tessellation.mesh.positions)
+        .into_iter()
+        .map(f64::sqrt)
+        .collect();
     let data = data_samples(&target, options.stages.data_samples);
     let to_surface: Vec<f64> =
         MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces)

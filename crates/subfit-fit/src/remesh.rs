@@ -363,16 +363,6 @@ pub fn apply_flips(faces: &Polygons, flips: &[Flip]) -> Polygons {
     Polygons::from_triangles(&tris)
 }
 
-/// Faces incident to any of `vertices` (sorted, unique).
-pub fn incident_faces(faces: &Polygons, vertices: &[u32]) -> Vec<u32> {
-    faces
-        .iter()
-        .enumerate()
-        .filter(|(_, f)| f.iter().any(|v| vertices.contains(v)))
-        .map(|(i, _)| i as u32)
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -382,6 +372,16 @@ mod tests {
 
     fn edges_unique(m: &PolyMesh) -> bool {
         HalfEdgeMesh::from_mesh(m).is_ok()
+    }
+
+    /// Faces incident to any of `vertices` (sorted, unique).
+    fn incident_faces(faces: &Polygons, vertices: &[u32]) -> Vec<u32> {
+        faces
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.iter().any(|v| vertices.contains(v)))
+            .map(|(i, _)| i as u32)
+            .collect()
     }
 
     #[test]

@@ -20,7 +20,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 use subfit_subdiv::StencilMatrix;
 
-use crate::terms::Mat3;
+use crate::term::Mat3;
 
 /// Hosts larger than this fall back to the column-wise fill (dense blocks would grow as s²).
 pub(crate) const MAX_HOST: usize = 48;

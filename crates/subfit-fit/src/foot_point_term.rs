@@ -1,0 +1,258 @@
+//! The foot-point error terms PD, TD and SD (Cheng et al. 2007, §II-D, eq. 3, 4 and 6; Cheng
+//! et al. 2004, §4.4; DESIGN.md §3.2–3.3) as a [`DataTerm`].
+//!
+//! Each sample `S_k` is projected onto the fixed target (Cheng: foot points come from the
+//! target, not the surface), which gives the foot point `V_k`, the signed distance `d_k`, the
+//! normal `N`, the principal directions `T1`, `T2` and radii `ρ1`, `ρ2`
+//! ([`subfit_target::FootPoint`]). The true squared error is `‖S_k − V_k‖²`; every term is a
+//! quadratic form `f_k² = (S_k − V_k)ᵀ Q_k (S_k − V_k)` in the variable sample point, with the
+//! foot point and the frame frozen at the current iterate:
+//!
+//! * PD (eq. 3): `Q = I`;
+//! * TD (eq. 4): `Q = N Nᵀ`;
+//! * SD (eq. 6): `Q = N Nᵀ + [α1]₊ T1 T1ᵀ + [α2]₊ T2 T2ᵀ`, `α_i = d / (d − ρ_i)`.
+//!
+//! Since `S_k − V_k` is along `N` at a foot point, every model has the true error's value and
+//! gradient there (PD exactly, TD and SD through `Q (S − V) = S − V`).
+//!
+//! Sign convention (§II-D3): `d > 0` when the sample lies on the side `N` points to; `ρ_i > 0`
+//! when the centre of curvature of the normal section along `T_i` lies on that side. For a sphere
+//! of radius `r` with outward normals `ρ = −r`, and a sample at distance `d > 0` outside gets
+//! `α = d / (d + r)`. The `[α]₊` values come precomputed from
+//! [`subfit_target::FootPoint`] (which also zeroes them beyond the focal point).
+//!
+//! Where the foot points come from ([`FootPointSource`]): a point cloud has only its local
+//! quadrics ([`Target::foot_points`]); a mesh target also has its triangles, and then the exact
+//! closest point on them is the better foot point ([`Target::mesh_foot_point`]).
+
+use std::sync::{Mutex, PoisonError};
+
+use rayon::prelude::*;
+use subfit_target::{FootPoint, Target};
+
+use crate::options::FitOptions;
+use crate::term::{mul, DataTerm, Mat3, IDENTITY};
+
+/// The error term (distance measure) used to build the quadratic model (Cheng 2007 §II-D).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Point distance (eq. 3), `Q = I`: the classic alternating method, linear convergence.
+    Pdm,
+    /// Tangent distance (eq. 4), `Q = N Nᵀ`: a Gauss-Newton step; unstable without damping.
+    Tdm,
+    /// Squared distance (eq. 6), `Q = N Nᵀ + [α1]₊ T1 T1ᵀ + [α2]₊ T2 T2ᵀ`: a (modified) Newton
+    /// step. The default.
+    #[default]
+    Sdm,
+}
+
+/// The source of foot points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FootPointSource {
+    /// The exact closest point on the target's triangles when it has them, else the quadrics.
+    #[default]
+    Auto,
+    /// Always the local quadrics of the data points.
+    Quadric,
+}
+
+/// `Q_k` of `method` for one foot point (see the module docs). Cost: O(1).
+pub fn error_matrix(method: Method, foot: &FootPoint) -> Mat3 {
+    match method {
+        Method::Pdm => IDENTITY,
+        Method::Tdm => outer(foot.normal, foot.normal, 1.0),
+        Method::Sdm => {
+            let mut q = outer(foot.normal, foot.normal, 1.0);
+            add_outer(&mut q, foot.t1, sanitize(foot.alpha1));
+            add_outer(&mut q, foot.t2, sanitize(foot.alpha2));
+            q
+        }
+    }
+}
+
+/// Cheng's foot-point terms on a [`Target`]: the samples are projected onto the target from
+/// `source`, and `method` makes the quadratic model. The nearest data point of every sample is
+/// kept as the warm start of the next projection of the same sample row
+/// ([`Target::foot_points_hinted`]; the triangle path needs none), so a term serves one
+/// sampling operator (one [`crate::Fitter`]).
+#[derive(Debug)]
+pub struct FootPointTerm<'t> {
+    target: &'t Target,
+    method: Method,
+    source: FootPointSource,
+    /// Nearest data point of every sample row at its last projection (`u32::MAX`: none).
+    hints: Mutex<Vec<u32>>,
+}
+
+impl<'t> FootPointTerm<'t> {
+    /// The term `method` with foot points on `target` from `source`.
+    pub fn new(target: &'t Target, method: Method, source: FootPointSource) -> Self {
+        Self {
+            target,
+            method,
+            source,
+            hints: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The term `options` name ([`FitOptions::method`], [`FitOptions::foot_points`]).
+    pub fn from_options(target: &'t Target, options: &FitOptions) -> Self {
+        Self::new(target, options.method, options.foot_points)
+    }
+
+    /// The target.
+    pub fn target(&self) -> &'t Target {
+        self.target
+    }
+
+    /// The error term.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// Fresh foot points of `xs` (normalized coordinates) from the term's source, in parallel;
+    /// the warm start is left alone. Same as [`DataTerm::project_fresh`].
+    pub fn foot_points(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
+        match self.source {
+            FootPointSource::Auto if self.target.mesh().is_some() => xs
+                .par_iter()
+                .map(|&x| self.target.mesh_foot_point(x))
+                .collect(),
+            _ => self.target.foot_points(xs),
+        }
+    }
+
+    /// [`Self::foot_points`] warm-started: `hints` holds, per point, the nearest data point
+    /// found last time (resized to `xs.len()` with "no hint"; updated). Same results as
+    /// [`Self::foot_points`] (the quadric path certifies every warm-started nearest point or
+    /// falls back to the kd-tree; see [`Target::foot_points_hinted`]).
+    fn foot_points_hinted(&self, xs: &[[f64; 3]], hints: &mut Vec<u32>) -> Vec<FootPoint> {
+        match self.source {
+            FootPointSource::Auto if self.target.mesh().is_some() => self.foot_points(xs),
+            _ => {
+                hints.resize(xs.len(), u32::MAX);
+                self.target.foot_points_hinted(xs, hints)
+            }
+        }
+    }
+}
+
+impl DataTerm for FootPointTerm<'_> {
+    type Sample = FootPoint;
+
+    /// PD: `Q = I`.
+    fn isotropic(&self) -> bool {
+        self.method == Method::Pdm
+    }
+
+    fn project(&self, rows: Option<&[u32]>, xs: &[[f64; 3]]) -> Vec<FootPoint> {
+        // A poisoned lock only loses the hints.
+        let mut hints = self.hints.lock().unwrap_or_else(PoisonError::into_inner);
+        let Some(rows) = rows else {
+            return self.foot_points_hinted(xs, &mut hints);
+        };
+        let need = rows.iter().max().map_or(0, |&k| k as usize + 1);
+        if hints.len() < need {
+            hints.resize(need, u32::MAX);
+        }
+        let mut sub: Vec<u32> = rows.iter().map(|&k| hints[k as usize]).collect();
+        let feet = self.foot_points_hinted(xs, &mut sub);
+        for (&k, &h) in rows.iter().zip(&sub) {
+            hints[k as usize] = h;
+        }
+        feet
+    }
+
+    fn project_fresh(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
+        self.foot_points(xs)
+    }
+
+    /// `‖x − V‖²`.
+    #[inline]
+    fn squared_error(&self, f: &FootPoint, x: [f64; 3]) -> f64 {
+        (0..3).map(|a| (x[a] - f.point[a]).powi(2)).sum::<f64>()
+    }
+
+    /// [`error_matrix`] and `Q (x − V)` (PD: `x − V`).
+    #[inline]
+    fn model(&self, f: &FootPoint, x: [f64; 3]) -> (Mat3, [f64; 3]) {
+        let e = std::array::from_fn(|a| x[a] - f.point[a]);
+        if self.method == Method::Pdm {
+            return (IDENTITY, e);
+        }
+        let q = error_matrix(self.method, f);
+        let r = mul(&q, e);
+        (q, r)
+    }
+
+    fn bbox_diagonal(&self) -> f64 {
+        bbox_diagonal(self.target.points())
+    }
+}
+
+/// The diagonal of the bounding box of `p` (1 when empty or degenerate).
+fn bbox_diagonal(p: &[[f64; 3]]) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for x in p {
+        for a in 0..3 {
+            lo[a] = lo[a].min(x[a]);
+            hi[a] = hi[a].max(x[a]);
+        }
+    }
+    let d = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
+    if d.is_finite() && d > 0.0 {
+        d
+    } else {
+        1.0
+    }
+}
+
+/// `[α]₊` guarded against NaN (treated as 0, i.e. the TD term).
+fn sanitize(a: f64) -> f64 {
+    if a.is_finite() && a > 0.0 {
+        a
+    } else {
+        0.0
+    }
+}
+
+/// `s · a bᵀ`.
+fn outer(a: [f64; 3], b: [f64; 3], s: f64) -> Mat3 {
+    let mut m = [[0.0; 3]; 3];
+    for (r, row) in m.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            *v = s * a[r] * b[c];
+        }
+    }
+    m
+}
+
+/// `q += s · t tᵀ` (skipped when `s == 0`).
+fn add_outer(q: &mut Mat3, t: [f64; 3], s: f64) {
+    if s == 0.0 {
+        return;
+    }
+    for (r, row) in q.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            *v += s * t[r] * t[c];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subfit_target::TargetOptions;
+
+    /// A point cloud has no triangles: `Auto` takes the quadric foot points.
+    #[test]
+    fn a_point_cloud_takes_the_quadric_foot_points() {
+        let mesh = subfit_mesh::shapes::torus_mesh(0.35, 0.15, 64, 32, true);
+        let cloud = subfit_mesh::PolyMesh::point_cloud(mesh.positions.clone(), None);
+        let t2 = Target::from_mesh(&cloud, &TargetOptions::default()).unwrap();
+        let xs = [t2.to_normalized([0.5, 0.0, 0.0])];
+        let term = FootPointTerm::new(&t2, Method::Sdm, FootPointSource::Auto);
+        assert_eq!(term.foot_points(&xs)[0].point, t2.foot_points(&xs)[0].point);
+    }
+}
