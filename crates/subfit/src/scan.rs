@@ -410,7 +410,9 @@ pub fn fit_scan(
 
     let unit = target.normalization().length_to_original(1.0);
     let last = result.report.last;
-    let diagonal = bbox_diagonal(target.points());
+    // Foot points as the fitter takes them; its diagonal is the one ErrorStats divide by.
+    let term = FootPointTerm::from_options(&target, &fit);
+    let diagonal = term.bbox_diagonal();
     options.cancel.check().map_err(|_| Error::Interrupted)?;
     // The cage written, measured both ways on the tessellation written with it (chordal error
     // a tenth of the fitting error, reported): what a user measures on limit.ply.
@@ -424,7 +426,7 @@ pub fn fit_scan(
         last.e_max,
     )
     .map_err(|e| Error::Output(e.to_string()))?;
-    let local: Vec<f64> = FootPointTerm::from_options(&target, &fit)
+    let local: Vec<f64> = term
         .squared_errors(&tessellation.mesh.positions)
         .into_iter()
         .map(f64::sqrt)
@@ -651,18 +653,6 @@ fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
             total: r.timings.total.as_secs_f64(),
         },
     }
-}
-
-fn bbox_diagonal(p: &[[f64; 3]]) -> f64 {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for x in p {
-        for a in 0..3 {
-            lo[a] = lo[a].min(x[a]);
-            hi[a] = hi[a].max(x[a]);
-        }
-    }
-    (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt()
 }
 
 /// Reads `path` as a cage for [`InitialCage::Given`].
