@@ -9,6 +9,7 @@
 
 use rayon::prelude::*;
 
+use crate::neighbors::PointIndex;
 use crate::target::Target;
 use subfit_mesh::vec3::{dot, sub};
 
@@ -34,52 +35,67 @@ impl Target {
 
     /// IMLS value and gradient with an explicit support radius `h > 0` (normalized units).
     pub fn imls_with_radius(&self, x: [f64; 3], h: f64) -> ImlsValue {
-        let pts = self.points();
-        let nrm = self.normals();
-        let nb = self.index().within_unsorted(&x, h);
-        let inv_h2 = 1.0 / (h * h);
-        // s0 = Σφ, s1 = Σ n·(x−p) φ; g0 = Σ∇φ, g1 = Σ (n φ + n·(x−p) ∇φ).
-        let (mut s0, mut s1) = (0.0, 0.0);
-        let (mut g0, mut g1) = ([0.0; 3], [0.0; 3]);
-        for b in &nb {
-            let i = b.index as usize;
-            let d = sub(x, pts[i]);
-            let t = 1.0 - dot(d, d) * inv_h2;
-            if t <= 0.0 {
-                continue;
-            }
-            let t3 = t * t * t;
-            let phi = t3 * t;
-            let dphi = -8.0 * inv_h2 * t3; // ∇φ = dphi · d
-            let s = dot(nrm[i], d);
-            s0 += phi;
-            s1 += s * phi;
-            for k in 0..3 {
-                g0[k] += dphi * d[k];
-                g1[k] += nrm[i][k] * phi + s * dphi * d[k];
-            }
-        }
-        if s0 > 0.0 && s0.is_finite() {
-            let value = s1 / s0;
-            let gradient = [0, 1, 2].map(|k| (g1[k] - value * g0[k]) / s0);
-            return ImlsValue {
-                value,
-                gradient,
-                neighbors: nb.len(),
-                fallback: false,
-            };
-        }
-        let j = self.index().nearest(&x).index as usize;
-        ImlsValue {
-            value: dot(nrm[j], sub(x, pts[j])),
-            gradient: nrm[j],
-            neighbors: 0,
-            fallback: true,
-        }
+        imls_value(self.index(), self.points(), self.normals(), x, h)
     }
 
     /// [`Self::imls`] for many points, in parallel; `#Q` results in order.
     pub fn imls_batch(&self, xs: &[[f64; 3]]) -> Vec<ImlsValue> {
         xs.par_iter().map(|&x| self.imls(x)).collect()
+    }
+}
+
+/// The IMLS value and gradient at `x` over `points` (`#P by 3`) with unit `normals` (`#P by 3`)
+/// indexed by `index` (built over `points`), support radius `h > 0` (units of the points): the
+/// kernel of [`Target::imls_with_radius`], for callers with their own points and normals (the
+/// Python package's autograd layer). Cost: a radius query plus O(#neighbours).
+///
+/// Not checked: that `index` was built over `points` and that the slices have equal lengths
+/// (an index past their end panics).
+pub fn imls_value(
+    index: &PointIndex,
+    points: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    x: [f64; 3],
+    h: f64,
+) -> ImlsValue {
+    let nb = index.within_unsorted(&x, h);
+    let inv_h2 = 1.0 / (h * h);
+    // s0 = Σφ, s1 = Σ n·(x−p) φ; g0 = Σ∇φ, g1 = Σ (n φ + n·(x−p) ∇φ).
+    let (mut s0, mut s1) = (0.0, 0.0);
+    let (mut g0, mut g1) = ([0.0; 3], [0.0; 3]);
+    for b in &nb {
+        let i = b.index as usize;
+        let d = sub(x, points[i]);
+        let t = 1.0 - dot(d, d) * inv_h2;
+        if t <= 0.0 {
+            continue;
+        }
+        let t3 = t * t * t;
+        let phi = t3 * t;
+        let dphi = -8.0 * inv_h2 * t3; // ∇φ = dphi · d
+        let s = dot(normals[i], d);
+        s0 += phi;
+        s1 += s * phi;
+        for k in 0..3 {
+            g0[k] += dphi * d[k];
+            g1[k] += normals[i][k] * phi + s * dphi * d[k];
+        }
+    }
+    if s0 > 0.0 && s0.is_finite() {
+        let value = s1 / s0;
+        let gradient = [0, 1, 2].map(|k| (g1[k] - value * g0[k]) / s0);
+        return ImlsValue {
+            value,
+            gradient,
+            neighbors: nb.len(),
+            fallback: false,
+        };
+    }
+    let j = index.nearest(&x).index as usize;
+    ImlsValue {
+        value: dot(normals[j], sub(x, points[j])),
+        gradient: normals[j],
+        neighbors: 0,
+        fallback: true,
     }
 }

@@ -49,7 +49,7 @@ mod winding;
 pub use closest::{MeshClosestPoint, TriangleBvh};
 pub use error::TargetError;
 pub use estimate::Neighborhood;
-pub use imls::ImlsValue;
+pub use imls::{imls_value, ImlsValue};
 pub use neighbors::{Neighbor, PointIndex};
 pub use normalize::Normalization;
 pub use options::{

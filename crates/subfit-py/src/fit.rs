@@ -1,0 +1,363 @@
+//! `subfit.fit`: numpy arrays and keywords → [`subfit::FitScanOptions`] → [`subfit::fit_scan`]
+//! (the pipeline of `subfit fit`, nothing re-implemented) → a [`NativeFit`] holding the result.
+//!
+//! Keywords mirror the CLI's flags (`--max-control-points` → `max_control_points`, `--lambda`
+//! → `lambda_start`, `--no-refine` → `refine=False`, …) with the same defaults and ranges. The
+//! fit runs with the interpreter detached; once per iteration the progress hook re-attaches to
+//! check for Ctrl-C (`KeyboardInterrupt`), pass warnings to Python's `warnings`, and call the
+//! user's `progress` callable, any of which cancels the run through [`subfit::mesh::Cancel`].
+
+use std::sync::Mutex;
+
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyRuntimeWarning;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use subfit::fit::{FitOptions, Method, StageOptions, StepControl};
+use subfit::mesh::{Cancel, PolyMesh, Tags};
+use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
+
+use crate::arrays::{
+    polygons, polygons_to_py, scheme, scheme_name, tags_to_py, vec3s, vec3s_to_py,
+};
+use crate::errors::{fit_error, value_error};
+
+/// Faces as `(counts, indices)` int64 arrays.
+type FaceArrays<'py> = (PyReadonlyArray1<'py, i64>, PyReadonlyArray1<'py, i64>);
+
+/// A finished fit: the library's [`Fitted`] (cage, tags, scheme, report, and what writing the
+/// outputs needs: the analysed target and the limit tessellation).
+#[pyclass(frozen, module = "subfit._subfit")]
+pub struct NativeFit {
+    fitted: Mutex<Fitted>,
+}
+
+fn range(name: &str, v: i64, lo: i64, hi: i64) -> PyResult<usize> {
+    if v < lo || v > hi {
+        return Err(value_error(format!(
+            "{name} must be in [{lo}, {hi}], got {v}"
+        )));
+    }
+    Ok(v as usize)
+}
+
+/// The library's options for the keywords of `subfit.fit` (the CLI's `fit::options`).
+#[allow(clippy::too_many_arguments)]
+fn options(
+    scheme_name: &str,
+    method: &str,
+    step: &str,
+    tolerance: f64,
+    max_error: Option<f64>,
+    max_control_points: i64,
+    control_points: Option<i64>,
+    as_points: bool,
+    lambda_start: f64,
+    lambda_end: Option<f64>,
+    sample_level: i64,
+    max_iterations: i64,
+    stage_iterations: i64,
+    one_sided: bool,
+    refine: bool,
+    edge_flips: bool,
+    max_depth: i64,
+    local: bool,
+    local_rings: Option<i64>,
+    error_scale: Option<f64>,
+) -> PyResult<FitScanOptions> {
+    let method = match method.to_ascii_lowercase().as_str() {
+        "pdm" => Method::Pdm,
+        "tdm" => Method::Tdm,
+        "sdm" => Method::Sdm,
+        _ => {
+            return Err(value_error(format!(
+                "method must be \"pdm\", \"tdm\" or \"sdm\", got {method:?}"
+            )))
+        }
+    };
+    let step = match step.to_ascii_lowercase().as_str() {
+        "none" => StepControl::None,
+        "lm" => StepControl::LevenbergMarquardt,
+        "armijo" => StepControl::Armijo,
+        _ => {
+            return Err(value_error(format!(
+                "step must be \"none\", \"lm\" or \"armijo\", got {step:?}"
+            )))
+        }
+    };
+    if local_rings.is_some() && !local {
+        return Err(value_error("local_rings needs local=True"));
+    }
+    Ok(FitScanOptions {
+        control_points: control_points
+            .map(|n| range("control_points", n, 4, 1_000_000))
+            .transpose()?,
+        as_points,
+        scheme: scheme(scheme_name, true)?,
+        fit: FitOptions {
+            sample_level: range("sample_level", sample_level, 0, 6)?,
+            method,
+            step,
+            ..FitOptions::default()
+        },
+        stages: StageOptions {
+            lambda_start,
+            lambda_end: lambda_end.unwrap_or(lambda_start.min(1e-5)),
+            iterations_per_stage: range("stage_iterations", stage_iterations, 1, 10_000)?,
+            max_iterations: range("max_iterations", max_iterations, 1, 10_000)?,
+            tolerance_rms: tolerance,
+            tolerance_max: max_error.unwrap_or(0.0),
+            max_control_points: range("max_control_points", max_control_points, 4, 10_000_000)?,
+            refine,
+            edge_flips: refine && edge_flips,
+            max_depth: range("max_depth", max_depth, 1, 12)? as u8,
+            local,
+            local_rings: range("local_rings", local_rings.unwrap_or(2), 0, 1_000)?,
+            two_sided: !one_sided,
+            ..StageOptions::default()
+        },
+        error_scale,
+        ..FitScanOptions::default()
+    })
+}
+
+/// A progress event as a Python dict.
+fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    match p {
+        Progress::Step(s) => {
+            d.set_item("event", "step")?;
+            d.set_item(
+                "step",
+                match s {
+                    Step::Read => "read",
+                    Step::Analyse => "analyse",
+                    Step::Init => "init",
+                    Step::Fit => "fit",
+                },
+            )?;
+        }
+        Progress::Iteration { stage, row } => {
+            d.set_item("event", "iteration")?;
+            d.set_item("stage", *stage)?;
+            d.set_item("iteration", row.iteration)?;
+            d.set_item("accepted", row.accepted)?;
+            d.set_item("e_rms", row.errors.e_rms)?;
+            d.set_item("e_max", row.errors.e_max)?;
+            d.set_item("objective", row.errors.objective)?;
+        }
+        Progress::Stage(r) => {
+            d.set_item("event", "stage")?;
+            d.set_item("stage", r.stage)?;
+            d.set_item("lambda", r.lambda)?;
+            d.set_item("control_points", r.num_control_points)?;
+            d.set_item("iterations", r.fit.iterations.len())?;
+        }
+        Progress::Warning(w) => {
+            d.set_item("event", "warning")?;
+            d.set_item("message", *w)?;
+        }
+    }
+    Ok(d)
+}
+
+/// Runs the pipeline on arrays (see the Python `subfit.fit` for the documented API).
+#[pyfunction]
+#[pyo3(signature = (
+    points, faces=None, normals=None, *, scheme="loop", method="sdm", step="lm",
+    tolerance=5e-4, max_error=None, max_control_points=5000, control_points=None,
+    as_points=false, init=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
+    max_iterations=100, stage_iterations=6, one_sided=false, refine=true, edge_flips=true,
+    max_depth=4, local=false, local_rings=None, error_scale=None, name=None, progress=None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn fit(
+    py: Python<'_>,
+    points: PyReadonlyArray2<'_, f64>,
+    faces: Option<FaceArrays<'_>>,
+    normals: Option<PyReadonlyArray2<'_, f64>>,
+    scheme: &str,
+    method: &str,
+    step: &str,
+    tolerance: f64,
+    max_error: Option<f64>,
+    max_control_points: i64,
+    control_points: Option<i64>,
+    as_points: bool,
+    init: Option<(PyReadonlyArray2<'_, f64>, FaceArrays<'_>)>,
+    lambda_start: f64,
+    lambda_end: Option<f64>,
+    sample_level: i64,
+    max_iterations: i64,
+    stage_iterations: i64,
+    one_sided: bool,
+    refine: bool,
+    edge_flips: bool,
+    max_depth: i64,
+    local: bool,
+    local_rings: Option<i64>,
+    error_scale: Option<f64>,
+    name: Option<String>,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<NativeFit> {
+    let mut opts = options(
+        scheme,
+        method,
+        step,
+        tolerance,
+        max_error,
+        max_control_points,
+        control_points,
+        as_points,
+        lambda_start,
+        lambda_end,
+        sample_level,
+        max_iterations,
+        stage_iterations,
+        one_sided,
+        refine,
+        edge_flips,
+        max_depth,
+        local,
+        local_rings,
+        error_scale,
+    )?;
+    let positions = vec3s("points", &points, subfit::target::MIN_POINTS)?;
+    let n = positions.len();
+    let mut mesh = match &faces {
+        Some((c, i)) => PolyMesh::new(positions, polygons(c, i, n)?),
+        None => PolyMesh::point_cloud(positions, None),
+    };
+    if let Some(nr) = &normals {
+        let nr = vec3s("normals", nr, 0)?;
+        if nr.len() != n {
+            return Err(value_error(format!(
+                "normals must have one row per point: {} rows for {n} points",
+                nr.len()
+            )));
+        }
+        if let Some(i) = nr.iter().position(|v| v.iter().all(|&x| x == 0.0)) {
+            return Err(value_error(format!("normals[{i}] is zero")));
+        }
+        mesh.normals = Some(nr);
+    }
+    if let Some((v, (c, i))) = &init {
+        if control_points.is_some() {
+            return Err(value_error(
+                "control_points sets the size of the automatic initial cage; it cannot be used with init",
+            ));
+        }
+        let cage = vec3s("init vertices", v, 4)?;
+        let faces = polygons(c, i, cage.len())?;
+        opts.init = InitialCage::Given {
+            mesh: PolyMesh::new(cage, faces),
+            tags: Tags::new(),
+            name: "init".into(),
+        };
+    }
+    let cancel = Cancel::new();
+    opts.cancel = cancel.clone();
+    let name = name.unwrap_or_else(|| "<array>".into());
+    let failure: Mutex<Option<PyErr>> = Mutex::new(None);
+    let result = py.detach(|| {
+        let mut hook = |p: Progress<'_>| {
+            Python::attach(|py| {
+                let r = (|| -> PyResult<()> {
+                    py.check_signals()?;
+                    if let Progress::Warning(w) = p {
+                        let cat = py.get_type::<PyRuntimeWarning>();
+                        PyErr::warn(py, &cat, &std::ffi::CString::new(w).unwrap_or_default(), 1)?;
+                    }
+                    if let Some(cb) = &progress {
+                        cb.call1(py, (event(py, &p)?,))?;
+                    }
+                    Ok(())
+                })();
+                if let Err(e) = r {
+                    let mut f = failure.lock().unwrap_or_else(|e| e.into_inner());
+                    if f.is_none() {
+                        *f = Some(e);
+                    }
+                    cancel.cancel();
+                }
+            });
+        };
+        fit_scan(Input::Mesh { mesh, name }, &opts, Some(&mut hook))
+    });
+    if let Some(e) = failure.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        return Err(e);
+    }
+    Ok(NativeFit {
+        fitted: Mutex::new(result.map_err(fit_error)?),
+    })
+}
+
+impl NativeFit {
+    fn with<R>(&self, f: impl FnOnce(&Fitted) -> R) -> R {
+        f(&self.fitted.lock().unwrap_or_else(|e| e.into_inner()))
+    }
+}
+
+#[pymethods]
+impl NativeFit {
+    /// Cage control points, `(n, 3)` float64, in the input's coordinates.
+    fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.with(|f| vec3s_to_py(py, &f.cage.positions))
+    }
+
+    /// Cage faces as `(offsets (m + 1,), indices)` int64.
+    #[allow(clippy::type_complexity)]
+    fn faces<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (Bound<'py, PyArray1<i64>>, Bound<'py, PyArray1<i64>>) {
+        self.with(|f| polygons_to_py(py, &f.cage.faces))
+    }
+
+    /// Crease and corner tags (see `arrays::tags_to_py`).
+    #[allow(clippy::type_complexity)]
+    fn tags<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> (
+        Bound<'py, PyArray2<i64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<f64>>,
+    ) {
+        self.with(|f| tags_to_py(py, &f.tags))
+    }
+
+    /// `"loop"` or `"catmull-clark"`.
+    fn scheme(&self) -> &'static str {
+        self.with(|f| scheme_name(f.scheme))
+    }
+
+    /// The report as JSON text (report.json).
+    fn report_json(&self) -> PyResult<String> {
+        self.with(|f| serde_json::to_string(&f.report))
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))
+    }
+
+    /// Whether the tolerances were met.
+    fn reached(&self) -> bool {
+        self.with(|f| f.reached())
+    }
+
+    /// One line: control points, stages, iterations, errors both ways.
+    fn summary(&self) -> String {
+        self.with(|f| f.summary())
+    }
+
+    /// Writes every output into the existing directory `dir` (control.obj, control.usda,
+    /// limit.ply, error.ply, log.csv, report.json), interpreter detached.
+    fn write_into(&self, py: Python<'_>, dir: std::path::PathBuf) -> PyResult<()> {
+        py.detach(|| {
+            self.fitted
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .write_into(&dir)
+        })
+        .map_err(fit_error)
+    }
+}
