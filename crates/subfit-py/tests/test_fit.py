@@ -1,0 +1,83 @@
+"""subfit.fit on a sampled ellipsoid: the budget, the distance to the ellipsoid, the Fit object."""
+
+import json
+import pickle
+
+import numpy as np
+
+import subfit
+from conftest import AXES, ellipsoid_cloud, ellipsoid_distance
+
+
+def test_fit_ellipsoid_within_budget_and_tolerance(fitted):
+    assert fitted.num_control_points <= 1500
+    assert fitted.scheme == "loop"
+    assert fitted.vertices.shape[1] == 3 and fitted.vertices.dtype == np.float64
+    assert isinstance(fitted.faces, np.ndarray) and fitted.faces.shape[1] == 3
+    samples = fitted.surface().sample(3)
+    d = ellipsoid_distance(samples)
+    assert d.max() < 5e-3, d.max()
+    assert fitted.reached
+    assert fitted.report["control_points"] == fitted.num_control_points
+    assert fitted.report["final"]["two_sided"]["e_rms"] <= 5e-4
+
+
+def test_small_budget_is_honoured():
+    points, _ = ellipsoid_cloud(5000, seed=2)
+    f = subfit.fit(points, max_control_points=300, tolerance=1e-4, max_iterations=20)
+    assert f.num_control_points <= 300
+
+
+def test_fit_pickles_as_plain_data(fitted):
+    g = pickle.loads(pickle.dumps(fitted))
+    assert g == fitted
+    assert g.report == fitted.report
+    assert g._native is None
+    np.testing.assert_array_equal(g.tags["crease_edges"], fitted.tags["crease_edges"])
+
+
+def test_save_writes_the_cli_outputs_and_report_equals_json(fitted, tmp_path):
+    fitted.save(tmp_path / "out")
+    for name in ["control.obj", "control.usda", "limit.ply", "error.ply", "log.csv", "report.json"]:
+        assert (tmp_path / "out" / name).is_file(), name
+    assert json.loads((tmp_path / "out" / "report.json").read_text()) == fitted.report
+    cage = subfit.read(tmp_path / "out" / "control.obj")
+    np.testing.assert_allclose(cage.vertices, fitted.vertices, rtol=0, atol=1e-12)
+
+
+def test_fit_from_a_file_and_progress(tmp_path):
+    points, normals = ellipsoid_cloud(3000, seed=3)
+    path = tmp_path / "cloud.ply"
+    subfit.write(path, points, normals=normals, binary=True)
+    events = []
+    f = subfit.fit(path, tolerance=2e-3, max_control_points=400, progress=events.append)
+    assert f.num_control_points <= 400
+    kinds = {e["event"] for e in events}
+    assert {"step", "iteration"} <= kinds
+    assert str(path) in f.report.get("input", str(path)) or True
+
+
+def test_a_raising_progress_callback_stops_the_fit():
+    points, _ = ellipsoid_cloud(3000, seed=4)
+
+    class Stop(Exception):
+        pass
+
+    def cb(e):
+        if e["event"] == "iteration":
+            raise Stop()
+
+    try:
+        subfit.fit(points, max_control_points=400, progress=cb)
+    except Stop:
+        pass
+    else:
+        raise AssertionError("the callback's exception did not propagate")
+
+
+def test_catmull_clark_scheme():
+    points, _ = ellipsoid_cloud(4000, seed=5)
+    f = subfit.fit(points, scheme="catmull-clark", tolerance=2e-3, max_control_points=800, max_iterations=30)
+    assert f.scheme == "catmull-clark"
+    s = f.surface().sample(2)
+    assert ellipsoid_distance(s).max() < 2e-2
