@@ -49,7 +49,7 @@ def run(steps: int = 300, alpha: float = 0.01, lr: float = 2e-3, level: int = 2,
         loss = distance(samples).square().sum() + alpha * regularizer(x)
         loss.backward()
         opt.step()
-        losses.append(float(loss))
+        losses.append(loss.item())
         if verbose and (k % 25 == 0 or k == steps - 1):
             print(f"step {k:4d}  loss {losses[-1]:.6e}")
     if verbose:

@@ -266,7 +266,7 @@ pub fn fit(
                     py.check_signals()?;
                     if let Progress::Warning(w) = p {
                         let cat = py.get_type::<PyRuntimeWarning>();
-                        PyErr::warn(py, &cat, &std::ffi::CString::new(w).unwrap_or_default(), 1)?;
+                        PyErr::warn(py, &cat, &std::ffi::CString::new(w).unwrap_or_default(), 2)?;
                     }
                     if let Some(cb) = &progress {
                         cb.call1(py, (event(py, &p)?,))?;

@@ -19,6 +19,7 @@ Importing this module needs PyTorch (``pip install torch``); ``import subfit`` d
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Optional, Tuple, Union
 
 try:
@@ -128,10 +129,18 @@ class LimitSurface(torch.nn.Module):
         ops = self._cache.get(key)
         if ops is None:
             n, s = self.num_vertices, self.num_samples
-            a = torch.sparse_csr_tensor(self._crow.to(device), self._col.to(device),
-                                        self._val.to(device=device, dtype=torch.float64).to(dtype), (s, n))
-            at = torch.sparse_csr_tensor(self._t_crow.to(device), self._t_col.to(device),
-                                         self._t_val.to(device=device, dtype=torch.float64).to(dtype), (n, s))
+            with warnings.catch_warnings():  # "sparse CSR support is in beta"
+                warnings.simplefilter("ignore", UserWarning)
+                a = torch.sparse_csr_tensor(
+                    self._crow.to(device), self._col.to(device),
+                    self._val.to(device=device, dtype=torch.float64).to(dtype), (s, n),
+                    check_invariants=False,
+                )
+                at = torch.sparse_csr_tensor(
+                    self._t_crow.to(device), self._t_col.to(device),
+                    self._t_val.to(device=device, dtype=torch.float64).to(dtype), (n, s),
+                    check_invariants=False,
+                )
             ops = self._cache[key] = (a, at)
         return ops
 
@@ -242,11 +251,14 @@ def _triangles(faces: FacesLike) -> np.ndarray:
     return np.concatenate(out).astype(np.int64)
 
 
-def cotangent_weights(rest: ArrayOrTensor, faces: FacesLike) -> Tuple[Tensor, Tensor, Tensor]:
+def cotangent_weights(rest: ArrayOrTensor, faces: FacesLike, *, clamp: bool = True
+                      ) -> Tuple[Tensor, Tensor, Tensor]:
     """Cotangent weights of the rest shape: ``(i (e,), j (e,), w (e,))`` over directed edges
     (both directions of every edge), ``wᵢⱼ = ½ (cot αᵢⱼ + cot βᵢⱼ)`` (Pinkall & Polthier;
     polygons are fan-triangulated, so quads gain a diagonal). Degenerate triangles contribute
-    nothing. float64 on the rest shape's device.
+    nothing. With ``clamp`` (default) negative weights (edges opposite obtuse angles) are set
+    to 0, so the ARAP energy is ≥ 0 — unclamped, an optimizer can drive it below zero.
+    float64 on the rest shape's device.
     """
     r = rest.detach().to(torch.float64) if isinstance(rest, torch.Tensor) else torch.as_tensor(np.asarray(rest, dtype=np.float64))
     if r.dim() != 2 or r.shape[1] != 3:
@@ -270,6 +282,8 @@ def cotangent_weights(rest: ArrayOrTensor, faces: FacesLike) -> Tuple[Tensor, Te
     key = i * n + j
     uniq, inv = torch.unique(key, return_inverse=True)
     wsum = torch.zeros(len(uniq), dtype=torch.float64, device=r.device).index_add_(0, inv, w)
+    if clamp:
+        wsum = wsum.clamp_min(0.0)
     return uniq // n, uniq % n, wsum
 
 
@@ -277,7 +291,8 @@ class ARAP(torch.nn.Module):
     """The ARAP energy against a fixed rest shape (weights computed once).
 
     ``E(x) = Σᵢ Σ_{j ∈ N(i)} wᵢⱼ ‖(xᵢ − xⱼ) − Rᵢ (rᵢ − rⱼ)‖²`` (Sorkine & Alexa 2007, eq. 3;
-    Xie et al. 2023 eq. 5) with cotangent weights ``wᵢⱼ`` of the rest shape ``r`` and, per
+    Xie et al. 2023 eq. 5) with cotangent weights ``wᵢⱼ`` of the rest shape ``r`` (negative
+    ones clamped to 0 unless ``clamp=False``, see :func:`cotangent_weights`) and, per
     vertex, the rotation ``Rᵢ`` minimizing its term (SVD of ``Σⱼ wᵢⱼ (rᵢ − rⱼ)(xᵢ − xⱼ)ᵀ``,
     reflections removed). Since each ``Rᵢ`` is optimal, ``∂E/∂x`` is the partial derivative at
     fixed rotations (envelope theorem), which is what autograd computes here. ``E = 0`` for
@@ -286,9 +301,9 @@ class ARAP(torch.nn.Module):
     ``forward(control)``: ``(n, 3)`` → scalar, ``(b, n, 3)`` → ``(b,)``; float32 or float64.
     """
 
-    def __init__(self, rest: ArrayOrTensor, faces: FacesLike) -> None:
+    def __init__(self, rest: ArrayOrTensor, faces: FacesLike, *, clamp: bool = True) -> None:
         super().__init__()
-        i, j, w = cotangent_weights(rest, faces)
+        i, j, w = cotangent_weights(rest, faces, clamp=clamp)
         r = rest.detach().to(torch.float64) if isinstance(rest, torch.Tensor) else torch.as_tensor(np.asarray(rest, dtype=np.float64))
         self.register_buffer("i", i, persistent=False)
         self.register_buffer("j", j, persistent=False)
@@ -324,7 +339,7 @@ class ARAP(torch.nn.Module):
         return (self.w.to(control.dtype) * (d * d).sum(-1)).sum(-1)
 
 
-def arap(control: Tensor, rest: ArrayOrTensor, faces: FacesLike) -> Tensor:
+def arap(control: Tensor, rest: ArrayOrTensor, faces: FacesLike, *, clamp: bool = True) -> Tensor:
     """The ARAP energy of ``control`` (``(n, 3)`` or ``(b, n, 3)``) against ``rest (n, 3)``
     with ``faces`` (see :class:`ARAP`, which keeps the weights between calls)."""
-    return ARAP(rest, faces).to(control.device)(control)
+    return ARAP(rest, faces, clamp=clamp).to(control.device)(control)
