@@ -25,7 +25,7 @@ pub fn vec3s(
     }
     if n < min_rows {
         return Err(value_error(format!(
-            "{name} needs at least {min_rows} rows, got {n}"
+            "{name} needs at least {min_rows} rows (points), got {n}"
         )));
     }
     let mut out = Vec::with_capacity(n);

@@ -91,4 +91,44 @@ impl ImlsField {
         let grads: Vec<[f64; 3]> = out.iter().map(|v| v.gradient).collect();
         Ok((values, vec3s_to_py(py, &grads)))
     }
+
+    /// The support of each query, for a differentiable evaluation elsewhere (torch, when the
+    /// scan itself needs gradients): `(offsets (k + 1,), indices (nnz,), nearest (k,))` — the
+    /// points within `h` of query `q` are `indices[offsets[q]..offsets[q + 1]]`, and `nearest[q]`
+    /// the nearest point (the fallback's). In parallel, interpreter detached.
+    #[allow(clippy::type_complexity)]
+    fn neighbors<'py>(
+        &self,
+        py: Python<'py>,
+        x: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray1<i64>>,
+    )> {
+        let x = vec3s("samples", &x, 0)?;
+        let lists: Vec<(Vec<i64>, i64)> = py.detach(|| {
+            x.par_iter()
+                .map(|q| {
+                    let nb = self.index.within_unsorted(q, self.h);
+                    let mut idx: Vec<i64> = nb.iter().map(|b| i64::from(b.index)).collect();
+                    idx.sort_unstable();
+                    (idx, i64::from(self.index.nearest(q).index))
+                })
+                .collect()
+        });
+        let mut offsets = Vec::with_capacity(lists.len() + 1);
+        offsets.push(0i64);
+        let mut indices = Vec::new();
+        for (l, _) in &lists {
+            indices.extend_from_slice(l);
+            offsets.push(indices.len() as i64);
+        }
+        let nearest = Array1::from_iter(lists.iter().map(|(_, n)| *n)).into_pyarray(py);
+        Ok((
+            Array1::from(offsets).into_pyarray(py),
+            Array1::from(indices).into_pyarray(py),
+            nearest,
+        ))
+    }
 }

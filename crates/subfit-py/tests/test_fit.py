@@ -54,7 +54,8 @@ def test_fit_from_a_file_and_progress(tmp_path):
     assert f.num_control_points <= 400
     kinds = {e["event"] for e in events}
     assert {"step", "iteration"} <= kinds
-    assert str(path) in f.report.get("input", str(path)) or True
+    assert f.report["target"] == str(path)
+    assert f.report["target_points"] == 3000
 
 
 def test_a_raising_progress_callback_stops_the_fit():

@@ -75,6 +75,14 @@ def test_imls_values_and_gradcheck(torch, st):
     field = st.IMLS(torch.tensor(p), torch.tensor(n), h)
     assert torch.autograd.gradcheck(field, (xt,))
     assert torch.autograd.gradcheck(lambda s: st.imls(s, p, n, h), (xt[:5],))
+    # Gradients reach the scan when its tensors require them (torch arithmetic over the
+    # native neighbour lists); the values are the same.
+    pt = torch.tensor(p[:400], requires_grad=True)
+    nt = torch.tensor(n[:400] * 1.7, requires_grad=True)  # unnormalized: normalized inside
+    xs = torch.tensor(p[:6] * 1.01, requires_grad=True)
+    np.testing.assert_allclose(st.imls(xs, pt, nt, h).detach().numpy(),
+                               st.imls(xs.detach(), p[:400], n[:400], h).numpy(), atol=1e-12)
+    assert torch.autograd.gradcheck(lambda s, a, b: st.imls(s, a, b, h), (xs, pt, nt))
 
 
 def test_arap_rigid_zero_and_gradcheck(torch, st):

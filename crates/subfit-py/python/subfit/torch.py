@@ -203,6 +203,30 @@ class _ImlsFunction(torch.autograd.Function):
         return grad_out.unsqueeze(-1) * g, None
 
 
+def _imls_autograd(samples: Tensor, points: Tensor, normals: Tensor, field: Any) -> Tensor:
+    """The IMLS values in torch arithmetic over the native kd-tree's neighbour lists: exact,
+    differentiable in the samples, the points and the normals (and twice)."""
+    flat = samples.reshape(-1, 3)
+    off, idx, nearest = field.neighbors(flat.detach().to(device="cpu", dtype=torch.float64).contiguous().numpy())
+    dev, dt = samples.device, samples.dtype
+    q = torch.repeat_interleave(torch.arange(len(flat), device=dev), torch.from_numpy(np.diff(off)).to(dev))
+    j = torch.from_numpy(idx).to(dev)
+    jn = torch.from_numpy(nearest).to(dev)
+    p = points.to(device=dev, dtype=dt)
+    n = normals.to(device=dev, dtype=dt)
+    n = n / n.norm(dim=1, keepdim=True)
+    d = flat[q] - p[j]
+    t = (1 - (d * d).sum(1) / (field.h * field.h)).clamp_min(0)
+    phi = t.square().square()
+    s = (n[j] * d).sum(1)
+    den = torch.zeros(len(flat), dtype=dt, device=dev).index_add(0, q, phi)
+    num = torch.zeros(len(flat), dtype=dt, device=dev).index_add(0, q, s * phi)
+    fallback = (n[jn] * (flat - p[jn])).sum(1)
+    ok = den > 0
+    f = torch.where(ok, num / torch.where(ok, den, torch.ones_like(den)), fallback)
+    return f.reshape(samples.shape[:-1])
+
+
 class IMLS(torch.nn.Module):
     """The IMLS distance to a scan, with the kd-tree built once (reuse it across steps).
 
@@ -210,13 +234,20 @@ class IMLS(torch.nn.Module):
     ``f(x) = Σ nᵢᵀ(x − pᵢ) φᵢ(x) / Σ φᵢ(x)``, ``φ(r) = (1 − r²/h²)⁴`` for ``r < h`` (Xie et al.
     2023 eq. 2–3, after Öztireli et al. 2009). Where no point lies within ``h`` the signed
     distance to the nearest point's tangent plane is used. ``forward(samples (..., 3))`` →
-    ``(...)`` values in the samples' dtype; the gradient with respect to the samples is the
-    exact analytic one; the scan gets none.
+    ``(...)`` values in the samples' dtype.
+
+    Gradients: with respect to the samples, the exact analytic gradient computed natively
+    (value and gradient in one parallel pass). When ``points`` or ``normals`` are tensors that
+    require grad, the values are instead computed in torch over the native neighbour lists, so
+    gradients reach them too (exact; slower). The kd-tree is built here, over the points as
+    they are now: if they move, build a new ``IMLS`` (or call :func:`imls`) each step.
     """
 
     def __init__(self, points: ArrayOrTensor, normals: ArrayOrTensor, h: float) -> None:
         super().__init__()
         self.field = _subfit.ImlsField(_as_np("points", points), _as_np("normals", normals), float(h))
+        differentiable = any(isinstance(a, torch.Tensor) and a.requires_grad for a in (points, normals))
+        self._scan = (points, normals) if differentiable else None
 
     @property
     def h(self) -> float:
@@ -225,15 +256,21 @@ class IMLS(torch.nn.Module):
 
     def forward(self, samples: Tensor) -> Tensor:
         """IMLS values at ``samples (..., 3)``."""
-        if samples.shape[-1] != 3:
-            raise ValueError(f"samples must have shape (..., 3), got {tuple(samples.shape)}")
+        if not isinstance(samples, torch.Tensor) or samples.shape[-1:] != (3,):
+            raise ValueError(f"samples must be a tensor of shape (..., 3), got {getattr(samples, 'shape', type(samples))}")
+        if samples.dtype not in (torch.float32, torch.float64):
+            raise ValueError(f"samples must be float32 or float64, got {samples.dtype}")
+        if self._scan is not None and torch.is_grad_enabled():
+            p, n = (torch.as_tensor(a) for a in self._scan)
+            return _imls_autograd(samples, p, n, self.field)
         return _ImlsFunction.apply(samples, self.field)
 
 
 def imls(samples: Tensor, points: ArrayOrTensor, normals: ArrayOrTensor, h: float) -> Tensor:
     """IMLS distance of ``samples (..., 3)`` to the scan ``points (p, 3)``, ``normals (p, 3)``
     with support radius ``h`` (see :class:`IMLS`, which keeps the kd-tree between calls; this
-    builds it each call, O(p log p)). Returns ``(...)``; differentiable in ``samples``."""
+    builds it each call, O(p log p)). Returns ``(...)``; differentiable in ``samples``, and in
+    ``points`` and ``normals`` when they are tensors that require grad."""
     return IMLS(points, normals, h)(samples)
 
 
