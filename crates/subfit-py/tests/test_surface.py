@@ -91,3 +91,11 @@ def test_surface_pickles_and_polygon_faces():
     np.testing.assert_allclose(m.operator(2) @ pv, m.sample(2), atol=1e-12)
     e = m.evaluate(0, 0.5, 0.5, sub=2)
     assert np.isfinite(e.position).all()
+
+
+def test_callers_arrays_stay_writable_and_faces_from_any_array():
+    v, f = octahedron()
+    s = subfit.Surface(v, f.astype(np.int32))
+    v[0, 0] = 2.0  # the caller's array is not frozen, and the surface kept its own copy
+    assert s.vertices[0, 0] == 1.0 and not s.vertices.flags.writeable
+    assert subfit.Surface(v, tuple(map(tuple, f))).num_faces == 8

@@ -45,12 +45,12 @@ def as_index_array(name: str, a: Any) -> npt.NDArray[np.int64]:
 
 def faces_to_flat(faces: FacesLike) -> Tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """Faces as ``(counts (m,), indices (Σ counts,))`` int64 arrays for the native module."""
-    if isinstance(faces, np.ndarray) or (
-        isinstance(faces, (list, tuple))
-        and len(faces) > 0
+    if not isinstance(faces, (list, tuple)) or (
+        len(faces) > 0
         and all(hasattr(f, "__len__") for f in faces)
         and len({len(f) for f in faces}) == 1
     ):
+        # An array (numpy, torch, …) or equal-length polygons: one (m, k) array.
         arr = as_index_array("faces", faces)
         if arr.ndim != 2:
             raise ValueError(f"faces must have shape (m, k) or be a list of polygons, got shape {arr.shape}")

@@ -127,6 +127,7 @@ class Surface:
         counts, indices = faces_to_flat(faces)
         t = tags_to_arrays(tags, len(v))
         self._native = _subfit.NativeSurface(v, counts, indices, scheme, t)
+        v = v.copy()  # frozen below; never the caller's array
         v.setflags(write=False)
         self._vertices = v
         self._counts = counts
