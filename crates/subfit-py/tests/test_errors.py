@@ -68,3 +68,16 @@ def test_surface_bad_input():
         s.closest_point(np.zeros((4, 2)))
     with pytest.raises(ValueError, match="not finite"):
         s.closest_point(np.full((1, 3), np.nan))
+
+
+def test_import_subfit_does_not_need_torch_and_subfit_torch_says_how_to_get_it():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; sys.modules['torch'] = None\n"
+        "import subfit; print(subfit.__version__)\n"
+        "try:\n    import subfit.torch\nexcept ImportError as e:\n    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert subfit.__version__ in out and "pip install torch" in out

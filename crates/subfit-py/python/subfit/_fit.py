@@ -104,6 +104,11 @@ class Fit:
         (d / "report.json").write_text(json.dumps(self.report, indent=2) + "\n")
         return d
 
+    def release_scan(self) -> None:
+        """Drops the analysed scan this Fit keeps for :meth:`save` (its kd-tree, normals and
+        limit tessellation: memory of the order of the scan's size), as pickling does."""
+        self._native = None
+
     def __getstate__(self) -> dict:
         state = self.__dict__.copy()
         state["_native"] = None
@@ -211,7 +216,8 @@ def fit(
     Notes
     -----
     The GIL is released while fitting, so fits in several threads run in parallel (each
-    also uses the library's own thread pool). Warnings (e.g. re-oriented faces) are issued
+    also uses the library's own rayon thread pool, sized by ``RAYON_NUM_THREADS``, default
+    one thread per core). Warnings (e.g. re-oriented faces) are issued
     as ``RuntimeWarning`` and kept in ``report["warnings"]``.
     """
     name = options.pop("name", None)
