@@ -85,3 +85,18 @@ def test_catmull_clark_scheme():
     assert f.scheme == "catmull-clark"
     s = f.surface().sample(2)
     assert ellipsoid_distance(s).max() < 2e-2
+
+
+def test_mesh_target_and_given_initial_cage(fitted):
+    # A dense triangle mesh (the fitted limit tessellation) as the target.
+    pos, tris = fitted.surface().tessellation(3)
+    m = subfit.fit(pos, faces=tris, tolerance=1e-3, max_control_points=1500, max_iterations=30)
+    assert m.num_control_points <= 1500
+    assert ellipsoid_distance(m.surface().sample(2)).max() < 5e-3
+    # Refit the points starting from a given cage (no refinement: the cage is kept).
+    points, _ = ellipsoid_cloud(4000, seed=6)
+    g = subfit.fit(points, init=m.surface(), refine=False, max_iterations=10, tolerance=1e-3)
+    assert g.num_control_points == m.num_control_points
+    np.testing.assert_array_equal(g.faces, m.faces)
+    with pytest.raises(ValueError, match="control_points"):
+        subfit.fit(points, init=m, control_points=100)
