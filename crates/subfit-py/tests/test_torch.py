@@ -42,6 +42,9 @@ def test_limit_surface_matches_surface_and_gradchecks(torch, st):
     y32 = layer(x.detach().float())
     assert y32.dtype == torch.float32
     np.testing.assert_allclose(y32.numpy(), y.detach().numpy(), atol=1e-5)
+    # Casting the module does not round its operator.
+    layer.float()
+    np.testing.assert_allclose(layer(x).detach().numpy(), y.detach().numpy(), rtol=0, atol=1e-15)
 
 
 def test_limit_surface_catmull_clark_gradcheck(torch, st):

@@ -124,6 +124,16 @@ class LimitSurface(torch.nn.Module):
         self.register_buffer("sample_faces", torch.from_numpy(np.ascontiguousarray(sf)), persistent=False)
         self._cache: dict = {}
 
+    def _apply(self, fn: Any, *args: Any, **kwargs: Any) -> "LimitSurface":
+        # `.float()`/`.half()` must not round the stored operator: keep its weights in float64
+        # (forward casts them to the input's dtype) and let device moves through.
+        vals = (self._val, self._t_val)
+        super()._apply(fn, *args, **kwargs)
+        for name, old in zip(("_val", "_t_val"), vals):
+            if getattr(self, name).dtype != torch.float64:
+                setattr(self, name, old.to(device=getattr(self, name).device))
+        return self
+
     def _operators(self, dtype: torch.dtype, device: torch.device) -> Tuple[Tensor, Tensor]:
         key = (dtype, device, self._val.data_ptr())
         ops = self._cache.get(key)
