@@ -14,12 +14,14 @@
 //! * [`tessellate`]: the limit tessellation written with a fit, at the coarsest level whose
 //!   chordal error is a tenth of the fitting error.
 //! * [`plot`]: deterministic SVG line charts.
+//! * [`html`]: self-contained report pages (report.html) around a three.js viewer.
 //!
 //! Nothing here prints or touches files.
 
 pub mod color;
 pub mod data_samples;
 pub mod distance;
+pub mod html;
 pub mod limit_distance;
 pub mod mesh_distance;
 pub mod plot;
