@@ -9,73 +9,15 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use common::subfit;
+use common::{artifacts, available, run_check, subfit};
 
 use subfit::io::usda::{UsdBoundary, UsdScheme};
 use subfit::io::{Encoding, WriteOptions};
 use subfit::mesh::shapes::{cube_mesh, Shape};
 use subfit::mesh::{Tags, SHARPNESS_INFINITE};
-
-fn checks() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checks")
-}
-
-/// Where screenshots are kept for CI to collect: `SUBFIT_ARTIFACTS`, else `target/artifacts`.
-fn artifacts() -> PathBuf {
-    std::env::var_os("SUBFIT_ARTIFACTS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_TARGET_TMPDIR")).join("../artifacts"))
-}
-
-/// Whether `python3` can import `module` (and, for the browser, Chromium is installed); a
-/// failure under `CI=true`, where `.ci/run` installs them.
-fn available(module: &str, program: Option<&str>) -> bool {
-    let imports = Command::new("python3")
-        .args(["-c", &format!("import {module}")])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    let program_ok = program.is_none_or(|p| Path::new(p).exists());
-    if imports && program_ok {
-        return true;
-    }
-    let what = format!(
-        "python3 module {module}{}",
-        program.map(|p| format!(" and {p}")).unwrap_or_default()
-    );
-    assert!(
-        std::env::var("CI").as_deref() != Ok("true"),
-        "CI=true but {what} is missing (.ci/run installs it)"
-    );
-    println!("notice: {what} not installed; skipping this check");
-    false
-}
-
-/// Runs a check script; panics with its output when it fails.
-fn run_check(script: &str, args: &[&str]) -> serde_json::Value {
-    let out = Command::new("python3")
-        .arg(checks().join(script))
-        .args(args)
-        .output()
-        .expect("run python3");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{script} failed ({}):\n{stdout}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let line = stdout
-        .lines()
-        .rev()
-        .find(|l| l.starts_with('{'))
-        .unwrap_or("{}");
-    println!("{script}: {line}");
-    serde_json::from_str(line).expect("the check prints JSON")
-}
 
 /// One Catmull-Clark fit of the paper's ellipsoid, shared by the tests of this file.
 struct CcFit {
