@@ -33,7 +33,7 @@ pub(crate) fn layout(bar: &ColorBar, options: &PreviewOptions) -> BarLayout {
     let bar_w = (h / 30).max(8);
     let gap = 3 * scale + 2;
     let width = (margin + bar_w + gap + chars * ADVANCE * scale + margin).min(w / 2);
-    let bar_h = (h * 7 / 10).max(2);
+    let bar_h = (h * 7 / 10).clamp(1, h);
     BarLayout {
         width,
         scale,
@@ -49,7 +49,7 @@ pub(crate) fn layout(bar: &ColorBar, options: &PreviewOptions) -> BarLayout {
 pub(crate) fn draw(image: &mut Image, l: &BarLayout) {
     const INK: [u8; 3] = [40, 40, 40];
     for y in 0..l.bar_h {
-        let t = 1.0 - f64::from(y) / f64::from(l.bar_h - 1);
+        let t = 1.0 - f64::from(y) / f64::from((l.bar_h - 1).max(1));
         let c = error_color(t);
         for x in 0..l.bar_w {
             put(image, l.bar_x + x, l.top + y, c);

@@ -278,3 +278,39 @@ fn quads_are_fan_triangulated() {
     let drawn = img.rgb.chunks(3).filter(|p| p != &[240, 240, 240]).count();
     assert!(drawn > 50_000, "{drawn}");
 }
+
+#[test]
+fn tiny_images_and_perspective_wires_do_not_panic() {
+    let (p, t) = uv_sphere(1.0, 16, 8);
+    let c = vec![[90u8; 3]; p.len()];
+    let edges: Vec<[u32; 2]> = t.iter().map(|t| [t[0], t[1]]).collect();
+    let wire = Wireframe {
+        positions: &p,
+        edges: &edges,
+    };
+    for (width, height) in [(1, 1), (2, 3), (17, 5), (5, 40)] {
+        for projection in [
+            Projection::Orthographic,
+            Projection::Perspective { fov_y_deg: 170.0 },
+        ] {
+            let o = PreviewOptions {
+                width,
+                height,
+                supersample: 3,
+                view: View {
+                    projection,
+                    zoom: 3.0,
+                    ..Default::default()
+                },
+                color_bar: Some(ColorBar {
+                    max: 1.0,
+                    suffix: "%".into(),
+                }),
+                ..Default::default()
+            };
+            let img = render(&p, &t, &c, Some(wire), &o).unwrap();
+            assert_eq!(img.rgb.len(), (width * height * 3) as usize);
+            img.to_png().unwrap();
+        }
+    }
+}
