@@ -108,7 +108,7 @@ fn report_html_is_self_contained_and_draws_in_chromium() {
             "--expect",
             "data → surface",
             "--figures",
-            "1",
+            "4",
         ],
     );
     println!(
@@ -117,6 +117,22 @@ fn report_html_is_self_contained_and_draws_in_chromium() {
         result["open_s"],
         shot.display()
     );
+}
+
+/// preview.png: a PNG of the size asked, not one flat colour.
+#[test]
+fn preview_png_shows_the_surface() {
+    let fit = cc_fit();
+    let bytes = std::fs::read(fit.out.join("preview.png")).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), (960, 720));
+    let pixels = &buf[..info.buffer_size()];
+    let distinct: std::collections::HashSet<&[u8]> = pixels.chunks(3).collect();
+    assert!(distinct.len() > 100, "{} colours", distinct.len());
 }
 
 #[test]

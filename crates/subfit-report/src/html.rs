@@ -77,13 +77,13 @@ pub struct Scene {
     pub layers: Vec<Layer>,
     /// The camera's up direction (`None`: +y).
     pub up: Option<[f64; 3]>,
-    /// The colour bar beside the viewer.
-    pub color_bar: Option<ColorBar>,
+    /// The colour scale drawn beside the viewer.
+    pub color_scale: Option<ColorScale>,
 }
 
 /// The error colour scale: blue at 0 to red at `scale`, labelled in every unit given.
 #[derive(Clone, Debug)]
-pub struct ColorBar {
+pub struct ColorScale {
     /// The value shown red (and above), in the first unit.
     pub scale: f64,
     /// Units the labels are written in: a name and the factor from the first unit (the first
@@ -213,7 +213,7 @@ pub fn escape(text: &str) -> String {
 }
 
 /// The colour bar as a vertical SVG gradient with its labels in every unit.
-pub fn color_bar_svg(bar: &ColorBar) -> String {
+pub fn color_scale_svg(bar: &ColorScale) -> String {
     let (bar_x, top, height, width) = (10.0, 34.0, 300.0, 22.0);
     let columns = bar.units.len().max(1) as f64;
     let total_width = bar_x + width + 12.0 + 92.0 * columns;
@@ -318,9 +318,9 @@ pub fn render(page: &Page) -> String {
     );
     if let Some(scene) = &page.scene {
         s.push_str("<div id=\"subfit-viewer-controls\"></div>\n<div class=\"viewer-row\">\n<div id=\"subfit-viewer\"></div>\n");
-        if let Some(bar) = &scene.color_bar {
+        if let Some(bar) = &scene.color_scale {
             s.push_str("<div class=\"color-bar\">");
-            s.push_str(&color_bar_svg(bar));
+            s.push_str(&color_scale_svg(bar));
             s.push_str("</div>\n");
         }
         s.push_str("</div>\n<div id=\"subfit-viewer-readout\">Drag to turn, scroll to zoom, right-drag to pan; click the surface to read its value.</div>\n");
@@ -396,7 +396,7 @@ mod tests {
         Scene {
             layers: vec![mesh],
             up: None,
-            color_bar: Some(ColorBar {
+            color_scale: Some(ColorScale {
                 scale: 1e-3,
                 units: vec![("unit cube".into(), 1.0), ("% of diagonal".into(), 100.0)],
                 label: "distance </script> & more".into(),

@@ -9,9 +9,12 @@
 
 use subfit_fit::{DataTerm, FootPointTerm};
 use subfit_mesh::PolyMesh;
-use subfit_report::html::{Block, ColorBar, Layer, LayerKind, Page, Scene, Section};
-use subfit_report::plot::{log_chart, Series};
-use subfit_report::{error_color, DistanceStats};
+use subfit_report::html::{Block, ColorScale, Layer, LayerKind, Page, Scene, Section};
+use subfit_report::plot::{
+    bar_chart, histogram_chart, log_chart_with, Bar, HistogramOptions, LogChartOptions, Series,
+};
+use subfit_report::preview::ColorBar as PreviewColorBar;
+use subfit_report::{error_color, preview_png, DistanceStats, PreviewOptions, Wireframe};
 use subfit_subdiv::{sampling_operator, Scheme};
 
 use crate::error::Error;
@@ -108,6 +111,32 @@ impl Fitted {
         })
     }
 
+    /// `preview.png`: the shown limit surface in error colours with the cage as a wireframe and
+    /// the colour scale in percent of the bounding-box diagonal, rendered on the CPU.
+    pub fn preview_png(&self, view: &ViewMesh) -> Result<Vec<u8>, Error> {
+        let edges = edges(&self.cage);
+        let options = PreviewOptions {
+            width: 960,
+            height: 720,
+            color_bar: Some(PreviewColorBar {
+                max: 100.0 * self.error_scale() / self.report.bbox_diagonal_unit_cube,
+                suffix: "%".into(),
+            }),
+            ..PreviewOptions::default()
+        };
+        preview_png(
+            &view.positions,
+            &view.triangles,
+            &view.colors,
+            Some(Wireframe {
+                positions: &self.cage.positions,
+                edges: &edges,
+            }),
+            &options,
+        )
+        .map_err(|e| Error::Output(format!("preview.png: {e}")))
+    }
+
     /// The self-contained `report.html` page (see the module docs).
     pub fn report_html(&self, view: &ViewMesh) -> String {
         subfit_report::html::render(&self.report_page(view))
@@ -180,7 +209,7 @@ impl Fitted {
         Scene {
             layers: vec![surface, cage, points],
             up: None,
-            color_bar: Some(ColorBar {
+            color_scale: Some(ColorScale {
                 scale: self.error_scale(),
                 units: vec![
                     ("unit cube".into(), 1.0),
@@ -313,40 +342,104 @@ impl Fitted {
 
     fn plot_section(&self) -> Section {
         let r = &self.report;
-        let rms: Vec<(f64, f64)> = r
-            .iterations
-            .iter()
-            .enumerate()
-            .map(|(i, it)| (i as f64 + 1.0, it.errors.e_rms))
-            .collect();
-        let max: Vec<(f64, f64)> = r
-            .iterations
-            .iter()
-            .enumerate()
-            .map(|(i, it)| (i as f64 + 1.0, it.errors.e_max))
-            .collect();
-        let svg = log_chart(
-            "Error per iteration (surface → data)",
+        let o = &r.options;
+        let along = |f: fn(&crate::pipeline_report::Errors) -> f64| -> Vec<(f64, f64)> {
+            r.iterations
+                .iter()
+                .enumerate()
+                .map(|(i, it)| (i as f64 + 1.0, f(&it.errors)))
+                .collect()
+        };
+        // Stage k starts after the iterations of the stages before it.
+        let mut vlines = Vec::new();
+        let mut done = 0usize;
+        for s in &r.stages {
+            vlines.push((
+                done as f64 + 0.5,
+                format!("stage {}, λ = {}", s.stage, sig(s.lambda)),
+            ));
+            done += s.iterations;
+        }
+        let mut hlines = vec![(o.tolerance_rms, "RMS tolerance".to_string())];
+        if let Some(m) = o.tolerance_max {
+            hlines.push((m, "max tolerance".into()));
+        }
+        let errors = log_chart_with(
+            "Error per iteration (surface → data, the fitter's samples)",
             "iteration",
             "error (unit cube)",
             &[
                 Series {
                     name: "E_rms".into(),
-                    points: rms,
+                    points: along(|e| e.e_rms),
                 },
                 Series {
                     name: "E_max".into(),
-                    points: max,
+                    points: along(|e| e.e_max),
                 },
             ],
-            Some(r.options.tolerance_rms),
+            &LogChartOptions {
+                vlines,
+                hlines,
+                ..LogChartOptions::default()
+            },
         );
+        let points = bar_chart(
+            "Control points per stage",
+            "control points",
+            &r.stages
+                .iter()
+                .map(|s| {
+                    Bar::new(
+                        format!("stage {} (λ {})", s.stage, sig(s.lambda)),
+                        s.control_points as f64,
+                    )
+                })
+                .collect::<Vec<_>>(),
+        );
+        let two = &r.r#final.two_sided;
+        let histogram = histogram_chart(
+            "Distances of the written cage, both ways",
+            &[
+                ("surface → data", &self.local_error),
+                ("data → surface", &self.data_error),
+            ],
+            &HistogramOptions {
+                unit: "unit cube".into(),
+                vlines: vec![
+                    (two.surface_to_data.rms, "RMS surface → data".into()),
+                    (two.data_to_surface.rms, "RMS data → surface".into()),
+                    (o.tolerance_rms, "RMS tolerance".into()),
+                ],
+                ..HistogramOptions::default()
+            },
+        );
+        let t = &r.timings_s;
+        let phases = bar_chart(
+            "Time per phase",
+            "seconds",
+            &[
+                ("read", t.read),
+                ("analyse the target", t.preprocess),
+                ("initial cage", t.init),
+                ("fit", t.fit),
+                ("measure both ways", t.measure),
+                ("write", t.output),
+            ]
+            .map(|(name, v)| Bar::new(name, v)),
+        );
+        let figure = |svg, caption: &str| Block::Figure {
+            svg,
+            caption: caption.into(),
+        };
         Section {
             heading: "Plots".into(),
-            blocks: vec![Block::Figure {
-                svg,
-                caption: "E_rms and E_max at the fitter's samples after each iteration; the dashed line is the RMS tolerance.".into(),
-            }],
+            blocks: vec![
+                figure(errors, "E_rms and E_max at the fitter's samples after each iteration (unit cube); dashed verticals start each stage with its smoothing weight λ, dashed horizontals are the tolerances."),
+                figure(histogram, "Distance from the limit tessellation's vertices to the data (surface → data) and from the data samples to the surface (data → surface), fraction of each per logarithmic bin."),
+                figure(points, "Control points of each stage's cage (refinement adds them between stages)."),
+                figure(phases, "Wall time of each phase of the run (the write time is that of the files before this page)."),
+            ],
         }
     }
 

@@ -20,12 +20,13 @@ use crate::error::Error;
 use crate::scan::Fitted;
 
 /// The files [`Fitted::write_into`] writes, in the order to move them into place.
-pub const OUTPUTS: [&str; 7] = [
+pub const OUTPUTS: [&str; 8] = [
     "control.obj",
     "control.usda",
     "limit.ply",
     "error.ply",
     "log.csv",
+    "preview.png",
     "report.html",
     "report.json",
 ];
@@ -116,6 +117,9 @@ impl Fitted {
         self.report.error_color_scale_unit_cube = scale;
         check()?;
         let view = self.view_mesh()?;
+        let png = self.preview_png(&view)?;
+        check()?;
+        subfit_io::write_atomic(&dir.join("preview.png"), &png)?;
         self.report.timings_s.output = t.elapsed().as_secs_f64();
         let html = self.report_html(&view);
         subfit_io::write_atomic(&dir.join("report.html"), html.as_bytes())?;
