@@ -222,3 +222,38 @@ fn tagged_cage_imports_into_blender_with_its_creases_and_loop_cages_without_subs
         ],
     );
 }
+
+/// `subfit compare A B --html`: the cage's limit surface against the cloud it was fitted to,
+/// both shown in distance colours, checked in the browser like a fit's report.
+#[test]
+fn compare_html_shows_both_surfaces() {
+    let fit = cc_fit();
+    let page = fit.out.join("compare.html");
+    let r = subfit(&[
+        "compare",
+        fit.out.join("control.obj").to_str().unwrap(),
+        fit.out.join("limit.ply").to_str().unwrap(),
+        "--scheme",
+        "catmull-clark",
+        "--samples",
+        "5000",
+        "--html",
+        page.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("Hausdorff distance"));
+    if !available("playwright", Some("/usr/bin/chromium")) {
+        return;
+    }
+    run_check(
+        "browser_report.py",
+        &[
+            page.to_str().unwrap(),
+            "--expect",
+            "B → A",
+            "--figures",
+            "1",
+        ],
+    );
+}

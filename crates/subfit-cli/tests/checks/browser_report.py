@@ -12,6 +12,7 @@ Prints one JSON line (open time, colours, plots, ...) and exits 1 with the reaso
 check fails, 2 when Playwright or Chromium is missing. A screenshot goes to --screenshot.
 
 Usage: python3 browser_report.py REPORT.html [--screenshot PNG] [--expect TEXT]... [--figures N]
+       [--viewport WIDTHxHEIGHT]
 """
 
 import argparse
@@ -62,6 +63,7 @@ def main():
     parser.add_argument("--expect", action="append", default=[])
     parser.add_argument("--figures", type=int, default=1)
     parser.add_argument("--chromium", default="/usr/bin/chromium")
+    parser.add_argument("--viewport", default="1400x1000", help="WIDTHxHEIGHT of the page")
     args = parser.parse_args()
     try:
         from playwright.sync_api import sync_playwright
@@ -81,7 +83,8 @@ def main():
         browser = p.chromium.launch(
             executable_path=args.chromium, headless=True, args=CHROMIUM_ARGS
         )
-        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        width, height = (int(v) for v in args.viewport.split("x"))
+        page = browser.new_page(viewport={"width": width, "height": height})
         page.on(
             "console",
             lambda m: console_errors.append(m.text) if m.type == "error" else None,
