@@ -105,7 +105,6 @@ def main():
         except Exception as e:  # noqa: BLE001 - reported as a failed check
             failures.append(f"the viewer did not become ready: {e}")
         result["open_s"] = round(time.perf_counter() - start, 3)
-        page.wait_for_timeout(300)
         stats = page.evaluate(CANVAS_STATS)
         result["canvas"] = stats
         if not stats:
@@ -123,13 +122,26 @@ def main():
         boxes = page.locator("#subfit-viewer-controls input[type=checkbox]")
         result["toggles"] = boxes.count()
         if boxes.count() >= 1 and stats:
+            # The viewer redraws on the next animation frame: wait for the picture to change
+            # (and to come back), however slow the software renderer is under load.
+            changed = (
+                "(before) => { const s = (%s)(); return s && (s.colors !== before.colors"
+                " || Math.abs(s.foreground - before.foreground) > 1e-3); }" % CANVAS_STATS.strip()
+            )
+            same = (
+                "(before) => { const s = (%s)(); return s && s.colors === before.colors"
+                " && Math.abs(s.foreground - before.foreground) <= 1e-3; }" % CANVAS_STATS.strip()
+            )
             boxes.nth(0).click()
-            page.wait_for_timeout(200)
-            hidden = page.evaluate(CANVAS_STATS)
-            boxes.nth(0).click()
-            page.wait_for_timeout(200)
-            if hidden and abs(hidden["foreground"] - stats["foreground"]) < 1e-3 and hidden["colors"] == stats["colors"]:
+            try:
+                page.wait_for_function(changed, arg=stats, timeout=60_000, polling=100)
+            except Exception:  # noqa: BLE001 - reported as a failed check
                 failures.append("hiding the first layer did not change the picture")
+            boxes.nth(0).click()
+            try:
+                page.wait_for_function(same, arg=stats, timeout=60_000, polling=100)
+            except Exception:  # noqa: BLE001 - reported as a failed check
+                failures.append("showing the first layer again did not restore the picture")
         else:
             failures.append("no layer check boxes")
         if args.screenshot:
