@@ -61,6 +61,25 @@ impl Frame {
     }
 
     /// The `<svg>` header, white background, title and axis labels.
+    /// A light vertical grid line and a label under the plot at each tick (`sx`: value → x).
+    fn x_ticks(&self, s: &mut String, ticks: &[f64], sx: impl Fn(f64) -> f64) {
+        for &t in ticks {
+            let x = sx(t);
+            let _ = writeln!(
+                s,
+                r##"<line x1="{x:.1}" y1="{}" x2="{x:.1}" y2="{:.1}" stroke="#eee"/>"##,
+                self.top(),
+                self.bottom()
+            );
+            let _ = writeln!(
+                s,
+                r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
+                self.bottom() + 16.0,
+                fmt_tick(t)
+            );
+        }
+    }
+
     fn begin(&self, s: &mut String, title: &str, xlabel: &str, ylabel: &str) {
         let (w, h) = (self.w, self.h);
         let _ = writeln!(

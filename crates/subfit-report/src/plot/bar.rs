@@ -2,7 +2,7 @@
 //! e.g. control points per stage or seconds per phase. Horizontal so that long category names
 //! (`"stage 3 (λ = 0.001)"`, `"closest points"`) read without rotation.
 
-use super::{esc, fmt_tick, fmt_value, nice_ticks, Frame, COLORS};
+use super::{esc, fmt_value, nice_ticks, Frame, COLORS};
 use std::fmt::Write as _;
 
 /// One category and its value.
@@ -64,21 +64,7 @@ pub fn bar_chart(title: &str, value_label: &str, bars: &[Bar]) -> String {
 
     let mut s = String::new();
     f.begin(&mut s, title, value_label, "");
-    for t in nice_ticks(x0, x1, 6) {
-        let x = sx(t);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{x:.1}" y1="{}" x2="{x:.1}" y2="{:.1}" stroke="#eee"/>"##,
-            f.top(),
-            f.bottom()
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
-            f.bottom() + 16.0,
-            fmt_tick(t)
-        );
-    }
+    f.x_ticks(&mut s, &nice_ticks(x0, x1, 6), sx);
     f.plot_box(&mut s);
     let zero = sx(0.0);
     for (i, b) in bars.iter().enumerate() {

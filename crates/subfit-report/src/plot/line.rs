@@ -1,7 +1,7 @@
 //! Line charts with a linear x axis and a log10 y axis: error per iteration, one polyline per
 //! series, with dashed vertical stage boundaries and horizontal reference lines.
 
-use super::{esc, fmt_tick, nice_ticks, Frame, Series, COLORS};
+use super::{esc, nice_ticks, Frame, Series, COLORS};
 use std::fmt::Write as _;
 
 /// Reference lines and size of a [`log_chart_with`] chart. Default: none, 760 × 480.
@@ -118,21 +118,7 @@ pub fn log_chart_with(
             y + 4.0
         );
     }
-    for &t in &nice_ticks(x0, x1, 10) {
-        let x = sx(t);
-        let _ = writeln!(
-            s,
-            r##"<line x1="{x:.1}" y1="{}" x2="{x:.1}" y2="{:.1}" stroke="#eee"/>"##,
-            f.top(),
-            f.bottom()
-        );
-        let _ = writeln!(
-            s,
-            r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
-            f.bottom() + 16.0,
-            fmt_tick(t)
-        );
-    }
+    f.x_ticks(&mut s, &nice_ticks(x0, x1, 10), sx);
     f.plot_box(&mut s);
     for (t, label) in hlines {
         let y = sy(t.log10());
