@@ -86,6 +86,10 @@ pub struct CompareArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Also write a self-contained HTML page showing both surfaces coloured by their distance
+    /// to the other.
+    #[arg(long, value_name = "OUT.html")]
+    pub html: Option<PathBuf>,
 }
 
 /// `subfit bench …`.

@@ -500,6 +500,8 @@ fn fit_writes_cage_limit_log_and_report() {
         "limit.ply",
         "error.ply",
         "log.csv",
+        "preview.png",
+        "report.html",
     ] {
         assert!(out.join(f).exists(), "{f}");
     }

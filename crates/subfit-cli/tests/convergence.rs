@@ -25,6 +25,13 @@ fn run_study() -> serde_json::Value {
         let csv = std::fs::read_to_string(out.join(format!("example{n}.csv"))).unwrap();
         assert!(csv.starts_with("iteration,"));
     }
+    // One page with every example's curves, self-contained.
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.matches("<figure>").count() >= 1,
+        "no plots in report.html"
+    );
+    assert!(!html.contains("src=\"http"));
     serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap()
 }
 

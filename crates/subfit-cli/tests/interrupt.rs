@@ -17,12 +17,14 @@ use subfit::io::{Encoding, WriteOptions};
 use subfit::mesh::shapes::Shape;
 use subfit::mesh::PolyMesh;
 
-const OUTPUTS: [&str; 6] = [
+const OUTPUTS: [&str; 8] = [
     "control.obj",
     "control.usda",
     "limit.ply",
     "error.ply",
     "log.csv",
+    "preview.png",
+    "report.html",
     "report.json",
 ];
 

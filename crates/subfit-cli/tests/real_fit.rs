@@ -11,7 +11,7 @@ mod common;
 use std::path::Path;
 use std::process::Output;
 
-use common::{data_dir, subfit};
+use common::{artifacts, available, data_dir, run_check, subfit};
 
 fn json_of(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout)
@@ -105,6 +105,28 @@ fn igea_as_a_point_cloud_reaches_table_iv_within_its_control_point_budget() {
     );
     assert!(r22 <= 0.0005, "two-sided E_rms {r22}");
     assert!(n2 <= 2385, "{n2}");
+    // Its report.html stays small enough to mail and opens quickly (the time is printed, not
+    // asserted: it depends on the machine).
+    let html = both.join("report.html");
+    let bytes = std::fs::metadata(&html).unwrap().len();
+    println!("igea report.html: {:.1} MB", bytes as f64 / 1e6);
+    assert!(bytes < 30_000_000, "report.html is {bytes} bytes");
+    if available("playwright", Some("/usr/bin/chromium")) {
+        let shot = artifacts().join("report-igea.png");
+        let result = run_check(
+            "browser_report.py",
+            &[
+                html.to_str().unwrap(),
+                "--screenshot",
+                shot.to_str().unwrap(),
+            ],
+        );
+        println!(
+            "igea report.html opened in {} s in headless Chromium (screenshot {})",
+            result["open_s"],
+            shot.display()
+        );
+    }
     let topo = cage_topology(&out);
     assert_eq!(topo["genus"], 0, "{topo}");
     assert_eq!(topo["manifold"], true, "{topo}");

@@ -41,7 +41,9 @@ impl FaceError {
 pub fn face_owners(control_faces: &Polygons, op: &SamplingOperator) -> Vec<u32> {
     let mut owners: Vec<u32> = (0..control_faces.len() as u32).collect();
     let mut sizes: Vec<usize> = control_faces.iter().map(<[u32]>::len).collect();
-    let tri = control_faces.is_triangles();
+    // The scheme shows in the refined faces: Loop keeps triangles (4 children each), while
+    // Catmull-Clark splits every n-gon, triangles included, into n quads, then quads into 4.
+    let tri = op.faces.is_triangles();
     for _ in 0..op.level {
         let mut next = Vec::with_capacity(owners.len() * 4);
         let mut next_sizes = Vec::with_capacity(owners.len() * 4);
@@ -369,6 +371,30 @@ mod tests {
     use subfit_mesh::shapes::octahedron_mesh;
     use subfit_mesh::{HalfEdgeMesh, Tags};
     use subfit_subdiv::{sampling_operator, Options, Scheme};
+
+    /// A triangle cage under Catmull-Clark: each triangle has 3 quad children at level 1, then
+    /// 4 per level — not Loop's 4 triangles (this once broke every CC fit of a point cloud,
+    /// whose initial cage is all triangles).
+    #[test]
+    fn face_owners_follow_the_scheme_not_the_cage() {
+        let cage = octahedron_mesh(1.0, 1.0, 1.0);
+        for (scheme, per_face) in [(Scheme::Loop, 16), (Scheme::CatmullClark, 12)] {
+            let op = sampling_operator(
+                &cage.faces,
+                cage.positions.len(),
+                &Tags::new(),
+                &Options::new(scheme),
+                2,
+            )
+            .unwrap();
+            let owners = face_owners(&cage.faces, &op);
+            assert_eq!(owners.len(), op.faces.len(), "{scheme:?}");
+            for f in 0..cage.faces.len() as u32 {
+                assert_eq!(owners.iter().filter(|&&o| o == f).count(), per_face);
+            }
+            assert!(owners.windows(2).all(|w| w[0] <= w[1]));
+        }
+    }
 
     fn edges_unique(m: &PolyMesh) -> bool {
         HalfEdgeMesh::from_mesh(m).is_ok()

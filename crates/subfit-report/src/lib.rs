@@ -14,15 +14,19 @@
 //! * [`tessellate`]: the limit tessellation written with a fit, at the coarsest level whose
 //!   chordal error is a tenth of the fitting error.
 //! * [`plot`]: deterministic SVG line charts.
+//! * [`html`]: self-contained report pages (report.html) around a three.js viewer.
+//! * [`preview`]: a CPU rasterizer for `preview.png` (error colours, cage wireframe, colour bar).
 //!
 //! Nothing here prints or touches files.
 
 pub mod color;
 pub mod data_samples;
 pub mod distance;
+pub mod html;
 pub mod limit_distance;
 pub mod mesh_distance;
 pub mod plot;
+pub mod preview;
 pub mod tessellate;
 
 pub use color::error_color;
@@ -30,4 +34,8 @@ pub use data_samples::{data_samples, DataSamples};
 pub use distance::{DistanceStats, TwoSided};
 pub use limit_distance::{LimitDistance, LimitDistanceError, PointToLimit};
 pub use mesh_distance::MeshDistance;
+pub use preview::{
+    preview_png, render as render_preview, render_polymesh as render_preview_polymesh, ColorBar,
+    Image, PreviewError, PreviewOptions, Projection, UpAxis, View, Wireframe,
+};
 pub use tessellate::{limit_tessellation, Chordal, LimitTessellation};

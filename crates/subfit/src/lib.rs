@@ -27,11 +27,13 @@
 //! - [`report`]: two-sided distances, error colours, the limit tessellation, plots.
 
 mod error;
+mod html_report;
 mod outputs;
 pub mod pipeline_report;
 mod scan;
 
 pub use error::Error;
+pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use outputs::{log_csv, OUTPUTS};
 pub use pipeline_report::Report;
 pub use scan::{fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};

@@ -1,7 +1,8 @@
 //! The files a fit writes, in the input's coordinates ([`OUTPUTS`], in the order a front end
 //! moves them into place, the report last): the cage as OBJ and as a UsdGeom Mesh with its
 //! scheme and tags, the limit tessellation with normals, the same coloured by the distance to
-//! the target (Cheng 2007 §IV-D colours), the per-iteration log and the report.
+//! the target (Cheng 2007 §IV-D colours), the per-iteration log, the page a person looks at
+//! (`report.html`, [`crate::html_report`]) and the report.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -19,12 +20,14 @@ use crate::error::Error;
 use crate::scan::Fitted;
 
 /// The files [`Fitted::write_into`] writes, in the order to move them into place.
-pub const OUTPUTS: [&str; 6] = [
+pub const OUTPUTS: [&str; 8] = [
     "control.obj",
     "control.usda",
     "limit.ply",
     "error.ply",
     "log.csv",
+    "preview.png",
+    "report.html",
     "report.json",
 ];
 
@@ -112,6 +115,14 @@ impl Fitted {
             log_csv(&self.stages.report).as_bytes(),
         )?;
         self.report.error_color_scale_unit_cube = scale;
+        check()?;
+        let view = self.view_mesh()?;
+        let png = self.preview_png(&view)?;
+        check()?;
+        subfit_io::write_atomic(&dir.join("preview.png"), &png)?;
+        self.report.timings_s.output = t.elapsed().as_secs_f64();
+        let html = self.report_html(&view);
+        subfit_io::write_atomic(&dir.join("report.html"), html.as_bytes())?;
         self.report.timings_s.output = t.elapsed().as_secs_f64();
         self.report.timings_s.total += self.report.timings_s.output;
         check()?;

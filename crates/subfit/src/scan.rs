@@ -163,6 +163,8 @@ pub struct Fitted {
     /// the target.
     pub(crate) limit: PolyMesh,
     pub(crate) local_error: Vec<f64>,
+    /// The distance of each data sample to that tessellation (data → surface).
+    pub(crate) data_error: Vec<f64>,
     pub(crate) cancel: Cancel,
 }
 
@@ -570,6 +572,7 @@ pub fn fit_scan(
         fit,
         limit: tessellation.mesh,
         local_error: local,
+        data_error: to_surface,
         cancel: options.cancel.clone(),
     })
 }

@@ -16,6 +16,7 @@ use subfit::mesh::PolyMesh;
 use subfit::target::{Target, TargetOptions};
 
 use crate::cli::{BenchCommand, ConvergenceArgs};
+use subfit::report::html::{Block, Page, Section};
 use subfit::report::plot::{log_chart, Series};
 
 /// The paper's convergence threshold on `E_rms` (unit cube).
@@ -129,6 +130,7 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
     let total_runs: usize = chosen.iter().map(|x| x.runs.len()).sum();
     let bar = crate::progress::bar(total_runs as u64, "fitting");
     let mut summary = Vec::new();
+    let mut figures = Vec::new();
     println!(
         "{:<8} {:<14} {:>10} {:>12} {:>12} {:>10}",
         "example", "run", "iters<.002", "E_rms first", "E_rms last", "monotone"
@@ -205,15 +207,84 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
         );
         crate::interrupt::watch_dir(&base.with_extension("svg"));
         subfit::io::write_atomic(&base.with_extension("svg"), svg.as_bytes())?;
+        figures.push(Block::Figure {
+            svg,
+            caption: format!(
+                "Example {}: E_rms per iteration, one line per method (exampleN.csv has the numbers).",
+                ex.number
+            ),
+        });
     }
     bar.finish_and_clear();
+    let rows = summary
+        .iter()
+        .map(|r| {
+            let cell = |k: &str| match &r[k] {
+                serde_json::Value::Null => "-".to_string(),
+                serde_json::Value::String(s) => s.clone(),
+                serde_json::Value::Number(n) => n
+                    .as_f64()
+                    .map_or_else(|| n.to_string(), subfit::report::html::number),
+                v => v.to_string(),
+            };
+            [
+                "example",
+                "run",
+                "iterations_to_tolerance",
+                "initial_e_rms",
+                "final_e_rms",
+                "objective_monotone",
+            ]
+            .map(cell)
+            .to_vec()
+        })
+        .collect();
+    let page = Page {
+        title: "subfit bench convergence: Cheng et al. 2007 on the ellipsoid".into(),
+        headline: format!(
+            "Iterations to E_rms < {TOLERANCE} from the paper's initial cages, {} sampled points.",
+            a.points
+        ),
+        scene: None,
+        sections: vec![
+            Section {
+                heading: "Runs".into(),
+                blocks: vec![Block::Table {
+                    header: [
+                        "example",
+                        "run",
+                        "iterations to tolerance",
+                        "initial E_rms",
+                        "final E_rms",
+                        "objective monotone",
+                    ]
+                    .map(String::from)
+                    .to_vec(),
+                    rows,
+                }],
+            },
+            Section {
+                heading: "Error curves".into(),
+                blocks: figures,
+            },
+        ],
+    };
+    crate::interrupt::watch_dir(&a.output.join("report.html"));
+    subfit::io::write_atomic(
+        &a.output.join("report.html"),
+        subfit::report::html::render(&page).as_bytes(),
+    )?;
     let doc = json!({ "tolerance": TOLERANCE, "points": a.points, "runs": summary });
     crate::interrupt::watch_dir(&a.output.join("summary.json"));
     subfit::io::write_atomic(
         &a.output.join("summary.json"),
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
-    println!("wrote {}", a.output.display());
+    println!(
+        "wrote {} (look at {})",
+        a.output.display(),
+        a.output.join("report.html").display()
+    );
     Ok(ExitCode::SUCCESS)
 }
 

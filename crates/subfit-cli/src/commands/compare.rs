@@ -64,6 +64,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
     let sb = surface(&mb, a.samples as usize, a.seed ^ 0x9e37_79b9)
         .with_context(|| a.b.display().to_string())?;
     let sp = crate::progress::spinner("measuring distances");
+    let mut shown_a_options = None;
     let (dab, dba): (Vec<f64>, Vec<f64>) = if let Some(scheme) = a.scheme {
         if ma.faces.is_empty() {
             bail!(
@@ -73,6 +74,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         }
         let ctx = || format!("{}: cannot evaluate its limit surface", a.a.display());
         let options = Options::new(pick_scheme(scheme, &ma));
+        shown_a_options = Some(options);
         let ev = Evaluator::new(&ma.faces, ma.num_vertices(), &Tags::new(), &options)
             .with_context(ctx)?;
         let (_, points) =
@@ -127,6 +129,22 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         a_to_b: ab,
         b_to_a: ba,
     };
+    if let Some(out) = &a.html {
+        let sp = crate::progress::spinner("writing the HTML page");
+        let page = crate::commands::compare_html::page(
+            &a,
+            &ma,
+            &mb,
+            shown_a_options.as_ref(),
+            |x| sb.query.distance(x),
+            &dab,
+            &dba,
+            diag,
+        )?;
+        subfit::io::write_atomic(out, page.as_bytes())
+            .with_context(|| format!("{}: cannot write", out.display()))?;
+        sp.finish_and_clear();
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&c)?);
     } else {

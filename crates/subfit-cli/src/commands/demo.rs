@@ -31,6 +31,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         single_precision: false,
     };
     let mut rows = Vec::new();
+    let mut reports = Vec::new();
     let mut all_reached = true;
     for (name, shape) in Shape::builtin() {
         let cloud = shape.sample(a.points as usize, a.noise, a.seed);
@@ -62,6 +63,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("fitting the {name}"))?;
         crate::commands::fit::write_outputs(&mut fitted, &dir)?;
         all_reached &= fitted.reached();
+        reports.push(dir.join("report.html"));
         let r = &fitted.report;
         rows.push(format!(
             "{:<10} {:>5} {:>5} {:>9} {:>6} → {:<6} {:>6} {:>10.2e} {:>10.2e} {:>10.2e} {:>10.2e} {:>7.1}  {}",
@@ -105,6 +107,10 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         println!("{r}");
     }
     if !a.no_fit {
+        println!("reports to look at (open in a browser; preview.png beside each):");
+        for r in &reports {
+            println!("  {}", r.display());
+        }
         println!("(errors in unit-cube units: the shape scaled so that its longest side is 1; E_rms/E_max surface → data, 2s: the worse of both directions)");
     }
     Ok(if all_reached {

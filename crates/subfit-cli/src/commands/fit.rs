@@ -14,7 +14,13 @@ use crate::cli::{FitArgs, MethodArg, SchemeArg, StepArg};
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let fitted = execute(&a)?;
-    println!("{}; wrote {}", fitted.summary(), a.output.display());
+    println!(
+        "{}; wrote {} (look at {})",
+        fitted.summary(),
+        a.output.display(),
+        a.output.join("report.html").display()
+    );
+    blender_hint(&fitted);
     Ok(if fitted.reached() {
         ExitCode::SUCCESS
     } else {
@@ -149,6 +155,15 @@ pub fn run_with_progress(
         b.finish_and_clear();
     }
     Ok(out?)
+}
+
+/// Blender subdivides Catmull-Clark meshes only: says so when a Loop cage is written.
+pub fn blender_hint(fitted: &Fitted) {
+    if fitted.scheme == Scheme::Loop {
+        eprintln!(
+            "subfit: hint: Blender subdivides only Catmull-Clark cages; this Loop cage's control.usda imports into Blender as a plain mesh (usdview, Houdini and OpenSubdiv show its Loop limit surface). Use --scheme catmull-clark for Blender."
+        );
+    }
 }
 
 /// Writes the outputs into a staging directory inside `dir` and moves them into place

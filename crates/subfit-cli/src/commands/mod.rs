@@ -4,6 +4,7 @@ mod analyze;
 mod bench;
 mod bench_fit;
 mod compare;
+mod compare_html;
 mod convert;
 mod demo;
 mod eval;
