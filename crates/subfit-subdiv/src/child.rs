@@ -28,6 +28,13 @@ use crate::topology::{ClosedForm, Topology};
 
 const NONE: u32 = u32::MAX;
 
+/// How every face of a uniform parent splits: Loop's 1→4 triangles or Catmull-Clark's quads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Split {
+    Triangles,
+    Quads,
+}
+
 /// Corner algebra of the child of `topo` under one step of `scheme`.
 ///
 /// The parent must suit the scheme (Loop: triangles only). Child corners are numbered as
@@ -35,7 +42,7 @@ const NONE: u32 = u32::MAX;
 #[derive(Clone, Copy)]
 pub(crate) struct ChildCorners<'a> {
     topo: &'a Topology,
-    scheme: Scheme,
+    scheme: Split,
     nv: u32,
     ne: u32,
 }
@@ -58,10 +65,19 @@ pub(crate) struct ChildRing {
 
 impl<'a> ChildCorners<'a> {
     /// The child of `topo` (which must suit `scheme`).
+    ///
+    /// # Panics
+    /// For [`Scheme::QuadTriangle`], whose children are not of one size (its child adjacency is
+    /// built by [`refined_topology`]).
+    #[track_caller]
     pub(crate) fn new(topo: &'a Topology, scheme: Scheme) -> Self {
+        let scheme = match scheme {
+            Scheme::Loop => Split::Triangles,
+            Scheme::CatmullClark => Split::Quads,
+            Scheme::QuadTriangle => panic!("the quad/triangle child has no closed form"),
+        };
         debug_assert!(
-            scheme == Scheme::CatmullClark
-                || (0..topo.num_faces()).all(|f| topo.face(f).len() == 3)
+            scheme == Split::Quads || (0..topo.num_faces()).all(|f| topo.face(f).len() == 3)
         );
         Self {
             topo,
@@ -71,22 +87,27 @@ impl<'a> ChildCorners<'a> {
         }
     }
 
+    /// Whether the children are triangles (Loop) rather than quads (Catmull-Clark).
+    pub(crate) fn triangles(&self) -> bool {
+        self.scheme == Split::Triangles
+    }
+
     /// Number of child vertices.
     pub(crate) fn num_vertices(&self) -> usize {
         let t = self.topo;
         t.num_vertices()
             + t.num_edges()
             + match self.scheme {
-                Scheme::CatmullClark => t.num_faces(),
-                Scheme::Loop => 0,
+                Split::Quads => t.num_faces(),
+                Split::Triangles => 0,
             }
     }
 
     /// The number of vertices of every child face (4 for Catmull-Clark, 3 for Loop).
     pub(crate) fn face_size(&self) -> u32 {
         match self.scheme {
-            Scheme::CatmullClark => 4,
-            Scheme::Loop => 3,
+            Split::Quads => 4,
+            Split::Triangles => 3,
         }
     }
 
@@ -94,8 +115,8 @@ impl<'a> ChildCorners<'a> {
     /// triangle for Loop).
     pub(crate) fn num_faces(&self) -> usize {
         match self.scheme {
-            Scheme::CatmullClark => self.topo.face_first_corner(self.topo.num_faces()),
-            Scheme::Loop => 4 * self.topo.num_faces(),
+            Split::Quads => self.topo.face_first_corner(self.topo.num_faces()),
+            Split::Triangles => 4 * self.topo.num_faces(),
         }
     }
 
@@ -104,7 +125,7 @@ impl<'a> ChildCorners<'a> {
     pub(crate) fn vertex(&self, x: u32) -> u32 {
         let t = self.topo;
         match self.scheme {
-            Scheme::CatmullClark => {
+            Split::Quads => {
                 let c = x / 4;
                 match x % 4 {
                     0 => t.corner_vertex(c),
@@ -113,7 +134,7 @@ impl<'a> ChildCorners<'a> {
                     _ => self.nv + t.corner_edge(t.corner_prev(c)),
                 }
             }
-            Scheme::Loop => {
+            Split::Triangles => {
                 let (f, j, i) = (x / 12, (x % 12) / 3, x % 3);
                 match (j, i) {
                     (3, i) => self.nv + t.corner_edge(3 * f + i),
@@ -129,8 +150,8 @@ impl<'a> ChildCorners<'a> {
     #[inline]
     pub(crate) fn next(&self, x: u32) -> u32 {
         match self.scheme {
-            Scheme::CatmullClark => (x & !3) | ((x + 1) & 3),
-            Scheme::Loop => x - x % 3 + (x + 1) % 3,
+            Split::Quads => (x & !3) | ((x + 1) & 3),
+            Split::Triangles => x - x % 3 + (x + 1) % 3,
         }
     }
 
@@ -139,8 +160,8 @@ impl<'a> ChildCorners<'a> {
     #[inline]
     pub(crate) fn prev(&self, x: u32) -> u32 {
         match self.scheme {
-            Scheme::CatmullClark => (x & !3) | ((x + 3) & 3),
-            Scheme::Loop => x - x % 3 + (x + 2) % 3,
+            Split::Quads => (x & !3) | ((x + 3) & 3),
+            Split::Triangles => x - x % 3 + (x + 2) % 3,
         }
     }
 
@@ -150,7 +171,7 @@ impl<'a> ChildCorners<'a> {
     pub(crate) fn twin(&self, x: u32) -> u32 {
         let t = self.topo;
         match self.scheme {
-            Scheme::CatmullClark => {
+            Split::Quads => {
                 let c = x / 4;
                 match x % 4 {
                     // Vertex point → edge point of e_c: back along e_c in the other face.
@@ -166,7 +187,7 @@ impl<'a> ChildCorners<'a> {
                     },
                 }
             }
-            Scheme::Loop => {
+            Split::Triangles => {
                 let (f, j, i) = (x / 12, (x % 12) / 3, x % 3);
                 match (j, i) {
                     (3, i) => 12 * f + 3 * ((i + 1) % 3) + 1,
@@ -191,8 +212,8 @@ impl<'a> ChildCorners<'a> {
         let (nv, ne) = (self.nv, self.ne);
         if w < nv {
             let first = |c: u32| match self.scheme {
-                Scheme::CatmullClark => 4 * c,
-                Scheme::Loop => 12 * (c / 3) + 3 * (c % 3),
+                Split::Quads => 4 * c,
+                Split::Triangles => 12 * (c / 3) + 3 * (c % 3),
             };
             out.extend(t.vertex_corners(w).iter().map(|&c| first(c)));
         } else if w < nv + ne {
@@ -201,10 +222,10 @@ impl<'a> ChildCorners<'a> {
                     continue;
                 }
                 match self.scheme {
-                    Scheme::CatmullClark => {
+                    Split::Quads => {
                         out.extend([4 * c + 1, 4 * t.corner_next(c) + 3]);
                     }
-                    Scheme::Loop => {
+                    Split::Triangles => {
                         let (f, k) = (c / 3, c % 3);
                         out.extend([
                             12 * f + 3 * k + 1,
@@ -234,11 +255,11 @@ impl<'a> ChildCorners<'a> {
             // boundary corner are those of the parent's lowest and boundary corners).
             for &c in t.vertex_corners(w) {
                 match scheme {
-                    Scheme::CatmullClark => {
+                    Split::Quads => {
                         ring.corners.push(4 * c);
                         ring.diagonals.push(nv + ne + t.corner_face(c));
                     }
-                    Scheme::Loop => ring.corners.push(12 * (c / 3) + 3 * (c % 3)),
+                    Split::Triangles => ring.corners.push(12 * (c / 3) + 3 * (c % 3)),
                 }
             }
             for &e in t.vertex_edges(w) {
@@ -248,7 +269,7 @@ impl<'a> ChildCorners<'a> {
         } else if w < nv + ne {
             let [c0, c1] = t.edge_corners(w - nv);
             match scheme {
-                Scheme::CatmullClark => {
+                Split::Quads => {
                     // Per side (corner c of the edge, n = next(c)): the child edges toward
                     // the vertex point of n's vertex and toward the face point.
                     let side = |c: u32| {
@@ -272,7 +293,7 @@ impl<'a> ChildCorners<'a> {
                         ring.push_rotated(&[a, b, c, d], true);
                     }
                 }
-                Scheme::Loop => {
+                Split::Triangles => {
                     // Per side (corner 3f + k of the edge): the child edges toward the vertex
                     // point of v_{k+1} and the edge points of e_{k+1} and e_{k+2}.
                     let side = |c: u32| {
@@ -309,7 +330,7 @@ impl<'a> ChildCorners<'a> {
                 ring.diagonals.push(t.corner_vertex(c));
             }
         }
-        if scheme == Scheme::Loop {
+        if scheme == Split::Triangles {
             ring.diagonals.clear();
         }
     }
@@ -337,7 +358,7 @@ impl<'a> ChildCorners<'a> {
             ring.corners.push(cur);
             ring.verts.push(self.vertex(self.next(cur)));
             ring.boundary.push(self.twin(cur) == NONE);
-            if self.scheme == Scheme::CatmullClark {
+            if self.scheme == Split::Quads {
                 ring.diagonals.push(self.vertex(self.next(self.next(cur))));
             }
             let pc = self.prev(cur);
@@ -427,6 +448,36 @@ impl ClosedForm for ChildCorners<'_> {
 ///
 /// Errors: [`SubdivError::TooLarge`] if the child has `u32::MAX` or more vertices or corners.
 /// Cost O(#child corners), parallel except for the edge numbering.
+///
+/// The quad/triangle scheme's children vary in size from face to face, so its child adjacency
+/// is built from the child face list ([`Topology::new`]) instead of the closed form.
 pub(crate) fn refined_topology(parent: &Topology, scheme: Scheme) -> Result<Topology, SubdivError> {
+    if scheme == Scheme::QuadTriangle {
+        let faces = crate::refine::child_faces(parent, scheme);
+        return Topology::new(&faces, crate::refine::child_num_vertices(parent, scheme));
+    }
     Topology::from_closed_form(&ChildCorners::new(parent, scheme))
+}
+
+impl ChildRing {
+    /// The ring of vertex `w` of a built adjacency, as [`ChildCorners::ring`] gives it for a
+    /// closed-form child.
+    pub(crate) fn from_topology(topo: &Topology, w: u32, ring: &mut ChildRing) {
+        ring.corners.clear();
+        ring.corners.extend_from_slice(topo.vertex_corners(w));
+        ring.verts.clear();
+        ring.verts.extend_from_slice(topo.vertex_ring(w));
+        ring.boundary.clear();
+        ring.boundary.extend(
+            topo.vertex_edges(w)
+                .iter()
+                .map(|&e| topo.is_boundary_edge(e)),
+        );
+        ring.diagonals.clear();
+        ring.diagonals.extend(
+            topo.vertex_corners(w)
+                .iter()
+                .map(|&c| topo.corner_vertex(topo.corner_next(topo.corner_next(c)))),
+        );
+    }
 }

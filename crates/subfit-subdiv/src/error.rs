@@ -55,6 +55,23 @@ pub enum SubdivError {
         /// Its number of vertices.
         len: usize,
     },
+    /// The quad/triangle scheme was asked for a vertex with both triangles and other faces
+    /// around it on more than 64 faces (its rules record the face kinds in a 64-bit mask).
+    #[error("vertex {vertex} has {num_faces} faces of mixed kinds; the quad/triangle scheme supports at most 64 there")]
+    MixedValence {
+        /// The vertex id.
+        vertex: u32,
+        /// Its number of incident faces.
+        num_faces: usize,
+    },
+    /// The scheme does not offer this operation yet.
+    #[error("{what} is not implemented for the {} scheme", scheme.name())]
+    Unsupported {
+        /// The scheme.
+        scheme: crate::scheme::Scheme,
+        /// The operation.
+        what: &'static str,
+    },
     /// The refined mesh would need more than `u32::MAX - 1` elements of one kind.
     #[error("the refined mesh is too large for 32-bit ids ({count} {what})")]
     TooLarge {

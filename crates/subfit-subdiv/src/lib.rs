@@ -1,5 +1,5 @@
-//! Subdivision surfaces for subfit: Loop and Catmull-Clark schemes with OpenSubdiv's boundary,
-//! crease and corner rules, expressed as sparse linear operators.
+//! Subdivision surfaces for subfit: Loop, Catmull-Clark and the Stam–Loop quad/triangle schemes
+//! with OpenSubdiv's boundary, crease and corner rules, expressed as sparse linear operators.
 //!
 //! * [`scheme`] — [`Scheme`], [`BoundaryRule`], [`Options`], the vertex rules and the
 //!   storage-free [`Neighborhood`] a scheme reads (OpenSubdiv `Sdc` vocabulary).
@@ -9,6 +9,8 @@
 //! * [`topology`] — the edge and vertex-ring adjacency the rules need.
 //! * [`mod@refine`] — one level of uniform refinement as a matrix, with a documented child order.
 //! * `child` (internal) — the adjacency of a refined mesh read off its parent's.
+//! * `mixed` (internal) — quad/triangle limit masks from the local subdivision matrix's
+//!   eigenvectors.
 //! * `regular` (internal) — tabulated limit rows of regular Catmull-Clark neighbourhoods.
 //! * [`limit`] — limit position and tangent stencils at every vertex.
 //! * [`sample`] — the sampling operator `C = L_l · M_l ⋯ M_1` (DESIGN §3.1).
@@ -27,6 +29,7 @@ pub mod stencil;
 pub mod topology;
 
 mod child;
+mod mixed;
 mod regular;
 
 pub use error::SubdivError;
@@ -34,7 +37,9 @@ pub use limit::{limit_stencils, LimitStencils};
 pub use mask::{EdgeMask, FaceWeights, Mask};
 pub use refine::{refine, Refinement};
 pub use sample::{normals_from_tangents, sampling_operator, LimitSamples, SamplingOperator};
-pub use scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
+pub use scheme::{
+    BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Options, Scheme, VertexRule,
+};
 pub use stencil::StencilMatrix;
 pub use topology::Topology;
 

@@ -28,11 +28,11 @@ use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
 use crate::refine::{
-    classify, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
+    classify, face_kinds, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
     VertexMaskCache,
 };
 use crate::regular::{is_regular, Regular, Tables};
-use crate::scheme::Neighborhood;
+use crate::scheme::{FaceKinds, Neighborhood};
 use crate::scheme::{Options, Scheme};
 use crate::stencil::{compose_rows, MultiRows, SparseSum, Stacked, StencilMatrix};
 use crate::topology::Topology;
@@ -137,7 +137,45 @@ fn push_topology_limit_row(
 }
 
 fn needs_refinement(topo: &Topology, options: &Options) -> bool {
-    options.scheme == Scheme::CatmullClark && (0..topo.num_faces()).any(|f| topo.face(f).len() != 4)
+    match options.scheme {
+        Scheme::Loop => false,
+        Scheme::CatmullClark => (0..topo.num_faces()).any(|f| topo.face(f).len() != 4),
+        Scheme::QuadTriangle => (0..topo.num_faces()).any(|f| topo.face(f).len() > 4),
+    }
+}
+
+/// The child mesh's adjacency as the last product reads it: the closed form of module `child`
+/// (Loop, Catmull-Clark), or built from the child faces (quad/triangle).
+enum ChildView<'a> {
+    Closed(ChildCorners<'a>),
+    Built(Box<Topology>),
+}
+
+impl ChildView<'_> {
+    fn num_vertices(&self) -> usize {
+        match self {
+            ChildView::Closed(c) => c.num_vertices(),
+            ChildView::Built(t) => t.num_vertices(),
+        }
+    }
+
+    /// The ring of child vertex `w` and the kinds of its faces.
+    fn ring(&self, w: u32, ring: &mut ChildRing) -> FaceKinds {
+        match self {
+            ChildView::Closed(c) => {
+                c.ring(w, ring);
+                if c.triangles() {
+                    FaceKinds::Triangles
+                } else {
+                    FaceKinds::Polygons
+                }
+            }
+            ChildView::Built(t) => {
+                ChildRing::from_topology(t, w, ring);
+                face_kinds(t, w)
+            }
+        }
+    }
 }
 
 /// Limit position and tangent weights sharing one support per vertex (`#V` rows over the same
@@ -213,7 +251,13 @@ fn limit_refine_compose_with(
         parent.num_vertices(),
         "inner dimensions differ"
     );
-    let child = ChildCorners::new(parent, options.scheme);
+    let child = match options.scheme {
+        Scheme::QuadTriangle => ChildView::Built(Box::new(
+            crate::child::refined_topology(parent, options.scheme)
+                .expect("the child of a valid mesh is valid"),
+        )),
+        s => ChildView::Closed(ChildCorners::new(parent, s)),
+    };
     let refine = RefineRows::new(parent, parent_tags, options);
     let regular = match options.scheme {
         Scheme::CatmullClark if tables => Regular::new(parent, refine.hoods()),
@@ -237,7 +281,7 @@ fn limit_refine_compose_with(
             } = st;
             let mut hood = None;
             let child_hood = |ring: &mut ChildRing| {
-                child.ring(w, ring);
+                let kinds = child.ring(w, ring);
                 // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
                 // tagged infinitely sharp.
                 let sharp = ring
@@ -246,7 +290,13 @@ fn limit_refine_compose_with(
                     .zip(&ring.boundary)
                     .map(|(&u, &b)| b || (tagged && child_tags.is_sharp_edge(w, u)));
                 let corner_tag = tagged && child_tags.is_corner(w);
-                classify(sharp, ring.corners.len(), corner_tag, options.boundary)
+                classify(
+                    sharp,
+                    ring.corners.len(),
+                    kinds,
+                    corner_tag,
+                    options.boundary,
+                )
             };
             // A regular parent neighbourhood: without tags the child vertex is regular too;
             // with tags, check.
@@ -281,7 +331,8 @@ fn limit_refine_compose_with(
                     sum.add(k, [l[0] * m, l[1] * m, l[2] * m]);
                 });
             }
-            sum.expand_faces(nv as u32, |f| parent.face(f as usize));
+            let points = refine.face_points();
+            sum.expand_faces(nv as u32, |k| parent.face(points.face(k as usize)));
             if fast {
                 tables.record(sum.entries());
             }

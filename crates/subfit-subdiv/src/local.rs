@@ -19,7 +19,7 @@
 
 use crate::mask::{FaceWeights, Mask};
 use crate::patch::{BSPLINE_PATCH_GRID, LOOP_PATCH_LATTICE};
-use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Scheme, VertexRule};
+use crate::scheme::{BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Scheme, VertexRule};
 
 /// Face-edge flag: the edge is on the boundary of the whole mesh.
 pub(crate) const BOUNDARY: u8 = 1;
@@ -215,7 +215,13 @@ impl LocalMesh {
     }
 
     /// The scheme's view of a complete vertex (rule as in [`crate::refine`]).
-    pub fn neighborhood(&self, v: u32, ring: &Ring, boundary_rule: BoundaryRule) -> Neighborhood {
+    pub fn neighborhood(
+        &self,
+        adj: &Adjacency,
+        v: u32,
+        ring: &Ring,
+        boundary_rule: BoundaryRule,
+    ) -> Neighborhood {
         let mut ends = [0usize; 2];
         let mut nsharp = 0;
         for (i, &f) in ring.eflags.iter().enumerate() {
@@ -233,6 +239,11 @@ impl LocalMesh {
             num_faces: nf,
             rule,
             crease_ends: ends,
+            faces: FaceKinds::from_triangles(
+                ring.corners
+                    .iter()
+                    .map(|&c| self.face(adj.cface[c as usize] as usize).len() == 3),
+            ),
         }
     }
 
@@ -304,12 +315,23 @@ fn edge_key(a: u32, b: u32) -> ChildVertex {
 const TRI_PARAMS: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
 const QUAD_PARAMS: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
 
+/// The scheme whose patch and split a face of `len` corners has: Loop's for a triangle under
+/// Loop or quad/triangle, Catmull-Clark's otherwise (the per-face split table of the three
+/// schemes).
+pub(crate) fn patch_scheme(scheme: Scheme, len: usize) -> Scheme {
+    if scheme.splits_into_quads(len) {
+        Scheme::CatmullClark
+    } else {
+        Scheme::Loop
+    }
+}
+
 fn mid(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
 }
 
-/// The children of parent face `f` of `mesh` (Loop: 4 triangles; Catmull-Clark: one quad per
-/// corner), in [`crate::refine`]'s order and corner order.
+/// The children of parent face `f` of `mesh` (a triangle under Loop or quad/triangle: 4
+/// triangles; otherwise one quad per corner), in [`crate::refine`]'s order and corner order.
 pub(crate) fn children(mesh: &LocalMesh, scheme: Scheme, f: usize) -> Vec<ChildFace> {
     let face = mesh.face(f);
     let base = mesh.fo[f] as usize;
@@ -317,7 +339,7 @@ pub(crate) fn children(mesh: &LocalMesh, scheme: Scheme, f: usize) -> Vec<ChildF
     let n = face.len();
     let e = |i: usize| edge_key(face[i % n], face[(i + 1) % n]);
     let vx = |i: usize| ChildVertex::Vertex(face[i % n]);
-    match scheme {
+    match patch_scheme(scheme, n) {
         Scheme::Loop => {
             let p = TRI_PARAMS;
             let (ab, bc, ca) = (mid(p[0], p[1]), mid(p[1], p[2]), mid(p[2], p[0]));
@@ -344,7 +366,7 @@ pub(crate) fn children(mesh: &LocalMesh, scheme: Scheme, f: usize) -> Vec<ChildF
                 },
             ]
         }
-        Scheme::CatmullClark => (0..n)
+        _ => (0..n)
             .map(|i| {
                 let params = if n == 4 {
                     let q = QUAD_PARAMS;
@@ -387,7 +409,7 @@ pub(crate) fn child_row(
             let Some(ring) = mesh.ring(adj, v) else {
                 return false;
             };
-            let hood = mesh.neighborhood(v, &ring, boundary);
+            let hood = mesh.neighborhood(adj, v, &ring, boundary);
             scheme.vertex_point_mask(&hood, mask);
             mesh.apply_mask(adj, v, &ring, mask, out);
             true
@@ -408,21 +430,28 @@ pub(crate) fn child_row(
             if cs.len() < 2 && flags & BOUNDARY == 0 {
                 return false;
             }
+            let tri = |k: usize| {
+                cs.get(k)
+                    .is_some_and(|&c| mesh.face(adj.cface[c as usize] as usize).len() == 3)
+            };
             let em = scheme.edge_point_mask(&EdgeNeighborhood {
                 num_faces: cs.len(),
                 sharp: flags & SHARP != 0,
+                triangles: [tri(0), tri(1)],
             });
             mesh.axpy(out, a, em.end);
             mesh.axpy(out, b, em.end);
-            if em.face != 0.0 {
-                for &c in &cs {
-                    match em.face_weights {
-                        FaceWeights::Opposite => {
-                            let o = mesh.fv[mesh.prev(adj, c) as usize];
-                            mesh.axpy(out, o, em.face);
-                        }
-                        FaceWeights::Centers => mesh.axpy_face(adj, out, c, em.face),
+            for (k, &c) in cs.iter().enumerate() {
+                let w = em.face[k];
+                if w == 0.0 {
+                    continue;
+                }
+                match em.face_weights[k] {
+                    FaceWeights::Opposite => {
+                        let o = mesh.fv[mesh.prev(adj, c) as usize];
+                        mesh.axpy(out, o, w);
                     }
+                    FaceWeights::Centers => mesh.axpy_face(adj, out, c, w),
                 }
             }
             true
@@ -445,23 +474,35 @@ pub(crate) fn child_nfaces(
     match cv {
         ChildVertex::Vertex(v) => mesh.nfaces[v as usize],
         ChildVertex::Edge(a, b) => {
-            // Boundary edge iff flagged BOUNDARY on any of its corners.
+            // Boundary edge iff flagged BOUNDARY on any of its corners; each face on the edge
+            // gives 3 children there if split as a triangle, 2 if into quads.
             let mut boundary = false;
+            let mut seen = 0;
+            let mut per_face = 0;
             for &c in mesh.vcorners(adj, a) {
                 let nx = mesh.fv[mesh.next(adj, c) as usize];
                 let pv = mesh.fv[mesh.prev(adj, c) as usize];
+                let len = mesh.face(adj.cface[c as usize] as usize).len();
+                let per = if patch_scheme(scheme, len) == Scheme::Loop {
+                    3
+                } else {
+                    2
+                };
                 if nx == b {
                     boundary |= mesh.fe[c as usize] & BOUNDARY != 0;
+                    seen += 1;
+                    per_face += per;
                 }
                 if pv == b {
                     boundary |= mesh.fe[mesh.prev(adj, c) as usize] & BOUNDARY != 0;
+                    seen += 1;
+                    per_face += per;
                 }
             }
-            let per = match scheme {
-                Scheme::Loop => 3,
-                Scheme::CatmullClark => 2,
-            };
-            per * if boundary { 1 } else { 2 }
+            // Faces of the edge outside the local mesh count as the scheme's regular kind.
+            let missing = if boundary { 1 } else { 2 } - seen.min(if boundary { 1 } else { 2 });
+            let per = if scheme == Scheme::Loop { 3 } else { 2 };
+            per_face + per * missing
         }
         ChildVertex::Face(f) => mesh.face(f as usize).len() as u32,
     }
@@ -512,12 +553,13 @@ pub(crate) fn regular_patch(
     t: usize,
 ) -> Option<Vec<Combo>> {
     let face = mesh.face(t);
+    let scheme = patch_scheme(scheme, face.len());
     if face.len() != scheme.regular_face_size() {
         return None;
     }
     let table: &[[i32; 2]] = match scheme {
         Scheme::Loop => &LOOP_PATCH_LATTICE,
-        Scheme::CatmullClark => &BSPLINE_PATCH_GRID,
+        _ => &BSPLINE_PATCH_GRID,
     };
     let mut pts: Vec<Option<Combo>> = vec![None; table.len()];
     for k in 0..face.len() {
@@ -549,10 +591,11 @@ pub(crate) fn corner_points(
     k: usize,
     set: &mut dyn FnMut([i32; 2], Combo),
 ) -> bool {
+    let scheme = patch_scheme(scheme, mesh.face(t).len());
     let reg = scheme.regular_face_size();
     let (dirs, corners): (&[[i32; 2]], &[[i32; 2]]) = match scheme {
         Scheme::Loop => (&LOOP_DIRS, &LOOP_CORNERS),
-        Scheme::CatmullClark => (&CC_DIRS, &CC_CORNERS),
+        _ => (&CC_DIRS, &CC_CORNERS),
     };
     let nslots = dirs.len() as i32;
     let face = mesh.face(t);
@@ -602,7 +645,7 @@ pub(crate) fn corner_points(
                 let rel = j as i32 - p as i32;
                 match scheme {
                     Scheme::Loop => set(dir(rel), Combo::one(edge_vert(j))),
-                    Scheme::CatmullClark => {
+                    _ => {
                         set(dir(2 * rel), Combo::one(edge_vert(j)));
                         set(dir(2 * rel + 1), Combo::one(diag(j)));
                     }
@@ -623,10 +666,7 @@ pub(crate) fn corner_points(
             } else {
                 (sharp[1], sharp[0] + nf - 1)
             };
-            let want = match scheme {
-                Scheme::Loop => 3,
-                Scheme::CatmullClark => 2,
-            };
+            let want = if scheme == Scheme::Loop { 3 } else { 2 };
             if hi + 1 - lo != want {
                 return false;
             }
@@ -647,7 +687,7 @@ pub(crate) fn corner_points(
                         Combo::three((v, 1.0), (ev(0), 1.0), (ev(1), -1.0)),
                     );
                 }
-                Scheme::CatmullClark => {
+                _ => {
                     let s = 2 * s;
                     let (e0, d0, e1, d1, e2) = (ev(0), diag(lo), ev(1), diag(lo + 1), ev(2));
                     set(dir(s), Combo::one(e0));

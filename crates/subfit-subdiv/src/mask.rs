@@ -12,8 +12,24 @@
 //!   OpenSubdiv 3.5 `sdc/loopScheme.h` and `sdc/catmarkScheme.h` (cos/sin weights around the
 //!   ring; Biermann et al. 2000 cross-boundary tangents), including OpenSubdiv's scale factors,
 //!   so that `normalize(t1 × t2)` reproduces OpenSubdiv's normals and follows the face winding.
+//! * Quad/triangle (Stam & Loop 2003, *Quad/triangle subdivision*; Lavoué et al. §3.1, Fig. 8):
+//!   the scheme is linear subdivision (edge midpoints, face centroids of non-triangles) followed
+//!   by averaging, where each vertex moves to the average of the centroids of its incident
+//!   children, a triangle's centroid weighting its own corner 1/4 and the other two 3/8. Worked
+//!   out over the coarse mesh this is: a vertex on triangles only → Loop's vertex rule; on no
+//!   triangle → Catmull-Clark's; on both (`k` faces) → `(1/k) Σ_f`, with a triangle `(v, a, b)`
+//!   contributing `5/8 v + 3/16 (a + b)` and any other face `v/2 + (a + b)/8 + F/4` (F its
+//!   centroid). An edge point is the weighted mean of its faces' contributions: a triangle
+//!   `(a, b, c)` gives `9/8 (a + b) + 3/4 c` (weight 3), another face `(a + b)/2 + F` (weight 2):
+//!   Loop's 3/8, 1/8 between two triangles, Catmull-Clark's 1/4 between two quads, and
+//!   `13/40 (a + b) + 3/20 c + 1/5 F` on a quad/triangle seam. At a regular seam vertex (three
+//!   triangles, two quads) the local subdivision matrix has the spectrum 1, 1/2, 1/2, 1/4, 1/4
+//!   of the regular schemes (checked in module `mixed`). Boundary, crease and corner rules are
+//!   the same as Loop's and Catmull-Clark's. Limit masks: Loop's or Catmull-Clark's where the
+//!   ring is pure, eigenvectors of the local subdivision matrix where it is mixed (module
+//!   `mixed`).
 
-use crate::scheme::{EdgeNeighborhood, Neighborhood, Scheme, VertexRule};
+use crate::scheme::{EdgeNeighborhood, FaceKinds, Neighborhood, Scheme, VertexRule};
 use std::f64::consts::PI;
 
 /// What the face weights of a [`Mask`] refer to.
@@ -45,7 +61,7 @@ pub struct Mask {
 }
 
 impl Mask {
-    fn reset(&mut self, num_edges: usize, num_faces: usize, face_weights: FaceWeights) {
+    pub(crate) fn reset(&mut self, num_edges: usize, num_faces: usize, face_weights: FaceWeights) {
         self.vertex = 0.0;
         self.edges.clear();
         self.edges.resize(num_edges, 0.0);
@@ -60,17 +76,39 @@ impl Mask {
     }
 }
 
-/// The weights of an edge point: both ends get `end`, each incident face gets `face`.
+/// The weights of an edge point: both ends get `end`, incident face `i` (in the order of
+/// [`EdgeNeighborhood::triangles`]) gets `face[i]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgeMask {
     /// Weight of each end vertex.
     pub end: f64,
-    /// Weight of each incident face, interpreted as `face_weights`: for Loop the vertex of the
-    /// triangle opposite the edge, for Catmull-Clark the face point.
-    pub face: f64,
-    /// What `face` refers to: [`FaceWeights::Opposite`] (Loop) or [`FaceWeights::Centers`]
-    /// (Catmull-Clark).
-    pub face_weights: FaceWeights,
+    /// Weight of each incident face, interpreted as `face_weights`: for a triangle the vertex
+    /// opposite the edge, for other faces the face point.
+    pub face: [f64; 2],
+    /// What each `face` weight refers to: [`FaceWeights::Opposite`] (the triangle's third
+    /// vertex) or [`FaceWeights::Centers`] (the face's centroid).
+    pub face_weights: [FaceWeights; 2],
+}
+
+/// Quad/triangle vertex point on a mixed ring (module docs): `(1/k) Σ_f` of the face
+/// contributions.
+fn mixed_vertex_point(hood: &Neighborhood, mask: &mut Mask) {
+    let (n, nf) = (hood.num_edges, hood.num_faces);
+    mask.reset(n, nf, FaceWeights::Centers);
+    let k = nf as f64;
+    for i in 0..nf {
+        let j = (i + 1) % n;
+        if hood.faces.is_triangle(i) {
+            mask.vertex += 0.625 / k;
+            mask.edges[i] += 0.1875 / k;
+            mask.edges[j] += 0.1875 / k;
+        } else {
+            mask.vertex += 0.5 / k;
+            mask.edges[i] += 0.125 / k;
+            mask.edges[j] += 0.125 / k;
+            mask.faces[i] = 0.25 / k;
+        }
+    }
 }
 
 /// Loop's β for a smooth vertex of valence `n` (Loop 1987): `(5/8 − (3/8 + ¼ cos 2π/n)²) / n`.
@@ -95,7 +133,8 @@ impl Scheme {
                 mask.edges[hood.crease_ends[0]] = 0.125;
                 mask.edges[hood.crease_ends[1]] = 0.125;
             }
-            VertexRule::Smooth | VertexRule::Dart => match self {
+            VertexRule::Smooth | VertexRule::Dart => match self.pure(hood.faces) {
+                Scheme::QuadTriangle => mixed_vertex_point(hood, mask),
                 Scheme::Loop => {
                     mask.reset(n, 0, FaceWeights::Centers);
                     let (v, e) = if n == 6 {
@@ -119,37 +158,65 @@ impl Scheme {
         }
     }
 
+    /// The scheme whose rules apply on a ring of `faces`: Loop or Catmull-Clark themselves;
+    /// for the quad/triangle scheme Loop on triangles only, Catmull-Clark without triangles, and
+    /// `QuadTriangle` (its mixed rules) otherwise.
+    pub fn pure(self, faces: FaceKinds) -> Scheme {
+        match (self, faces) {
+            (Scheme::QuadTriangle, FaceKinds::Triangles) => Scheme::Loop,
+            (Scheme::QuadTriangle, FaceKinds::Polygons) => Scheme::CatmullClark,
+            (s, _) => s,
+        }
+    }
+
     /// The mask of the child vertex of an edge (its "edge point"). Cost O(1).
     pub fn edge_point_mask(self, edge: &EdgeNeighborhood) -> EdgeMask {
-        let face_weights = match self {
-            Scheme::Loop => FaceWeights::Opposite,
-            Scheme::CatmullClark => FaceWeights::Centers,
+        let tri = |i: usize| match self {
+            Scheme::Loop => true,
+            Scheme::CatmullClark => false,
+            Scheme::QuadTriangle => edge.triangles[i],
         };
+        let kind = |i: usize| {
+            if tri(i) {
+                FaceWeights::Opposite
+            } else {
+                FaceWeights::Centers
+            }
+        };
+        let face_weights = [kind(0), kind(1)];
         if edge.sharp || edge.num_faces < 2 {
             return EdgeMask {
                 end: 0.5,
-                face: 0.0,
+                face: [0.0; 2],
                 face_weights,
             };
         }
-        match self {
-            Scheme::Loop => EdgeMask {
-                end: 0.375,
-                face: 0.125,
-                face_weights,
-            },
-            Scheme::CatmullClark => EdgeMask {
-                end: 0.25,
-                face: 0.5 / edge.num_faces as f64,
-                face_weights,
-            },
+        // Contributions (module docs): a triangle 9/8 per end and 3/4 opposite (weight 3),
+        // another face 1/2 per end and its centroid (weight 2).
+        let (mut end, mut face, mut total) = (0.0, [0.0; 2], 0.0);
+        for (i, f) in face.iter_mut().enumerate() {
+            if tri(i) {
+                end += 1.125;
+                *f = 0.75;
+                total += 3.0;
+            } else {
+                end += 0.5;
+                *f = 1.0;
+                total += 2.0;
+            }
+        }
+        EdgeMask {
+            end: end / total,
+            face: face.map(|f| f / total),
+            face_weights,
         }
     }
 
     /// Fills the limit position mask and the two limit tangent masks of a vertex.
     ///
     /// Requires the regular face size around the vertex for Catmull-Clark (quads: face weights
-    /// are [`FaceWeights::Opposite`]). Tangent conventions are OpenSubdiv's: at a smooth vertex
+    /// are [`FaceWeights::Opposite`]), and for the quad/triangle scheme triangles and quads only
+    /// (face weights of triangles are zero). Tangent conventions are OpenSubdiv's: at a smooth vertex
     /// `t1` points toward ring edge 0 and `t2` is rotated toward edge 1; at a crease `t1` runs
     /// along the crease toward the leading crease edge and `t2` points across the surface into the
     /// span between the crease edges; at a corner `t1`, `t2` point along edges 0 and 1. With the
@@ -170,9 +237,9 @@ impl Scheme {
                 t1.reset(n, 0, FaceWeights::Opposite);
                 t2.reset(n, 0, FaceWeights::Opposite);
                 if n >= 2 {
-                    let s = match self {
+                    let s = match self.pure(hood.faces) {
                         Scheme::Loop => 3.0,
-                        Scheme::CatmullClark => 1.0,
+                        Scheme::CatmullClark | Scheme::QuadTriangle => 1.0,
                     };
                     t1.vertex = -s;
                     t1.edges[0] = s;
@@ -185,14 +252,16 @@ impl Scheme {
                 pos.vertex = 2.0 / 3.0;
                 pos.edges[hood.crease_ends[0]] = 1.0 / 6.0;
                 pos.edges[hood.crease_ends[1]] = 1.0 / 6.0;
-                match self {
+                match self.pure(hood.faces) {
                     Scheme::Loop => loop_crease_tangents(hood, t1, t2),
                     Scheme::CatmullClark => catmark_crease_tangents(hood, t1, t2),
+                    Scheme::QuadTriangle => crate::mixed::limit_masks(hood, pos, t1, t2),
                 }
             }
-            VertexRule::Smooth | VertexRule::Dart => match self {
+            VertexRule::Smooth | VertexRule::Dart => match self.pure(hood.faces) {
                 Scheme::Loop => loop_smooth_limit(n, pos, t1, t2),
                 Scheme::CatmullClark => catmark_smooth_limit(n, pos, t1, t2),
+                Scheme::QuadTriangle => crate::mixed::limit_masks(hood, pos, t1, t2),
             },
         }
     }
@@ -359,6 +428,7 @@ mod tests {
             num_faces: nf,
             rule,
             crease_ends: ends,
+            faces: FaceKinds::Triangles,
         }
     }
 

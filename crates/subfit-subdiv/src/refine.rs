@@ -1,6 +1,8 @@
-//! Uniform refinement: one level of Loop or Catmull-Clark subdivision as a sparse matrix.
+//! Uniform refinement: one level of Loop, Catmull-Clark or quad/triangle subdivision as a sparse
+//! matrix.
 //!
-//! Loop 1987 (1→4 triangle split); Catmull & Clark 1978 (an `n`-gon becomes `n` quads);
+//! Loop 1987 (1→4 triangle split); Catmull & Clark 1978 (an `n`-gon becomes `n` quads); Stam &
+//! Loop 2003 (triangles split as Loop's, other faces as Catmull-Clark's);
 //! Hoppe et al. 1994 sharp creases and corners; OpenSubdiv 3.5 `Far::TopologyRefiner` for the
 //! vertex rules and boundary interpolation. The masks come from [`crate::mask`].
 //!
@@ -11,7 +13,9 @@
 //! * `V + e` (`0 ≤ e < E`) is the edge point of parent edge `e`, edges numbered in order of first
 //!   appearance when faces are scanned in order and each face's corners in winding order (face
 //!   edge `i` joins face vertices `i` and `i + 1`), see [`Topology`];
-//! * `V + E + f` (`0 ≤ f < F`, Catmull-Clark only) is the face point of parent face `f`.
+//! * `V + E + f` (`0 ≤ f < F`, Catmull-Clark only) is the face point of parent face `f`;
+//!   quad/triangle: `V + E + k` is the face point of the `k`-th non-triangle face (triangles have
+//!   none).
 //!
 //! (OpenSubdiv orders face points, edge points, vertex points; compare point sets, not indices.)
 //!
@@ -19,12 +23,15 @@
 //! Children of parent face `f` are consecutive, in parent face order. Loop: triangle
 //! `(a, b, c)` with edge points `ab, bc, ca` gives `(a, ab, ca)`, `(b, bc, ab)`, `(c, ca, bc)`,
 //! `(ab, bc, ca)`. Catmull-Clark: face `(v_0 … v_{n−1})` with face point `F` gives, for each `i`,
-//! the quad `(v_i, e_{i,i+1}, F, e_{i−1,i})`. Winding is preserved.
+//! the quad `(v_i, e_{i,i+1}, F, e_{i−1,i})`. Quad/triangle: each triangle as Loop's, each other
+//! face as Catmull-Clark's. Winding is preserved.
 
 use crate::child::ChildCorners;
 use crate::error::SubdivError;
 use crate::mask::{FaceWeights, Mask};
-use crate::scheme::{BoundaryRule, EdgeNeighborhood, Neighborhood, Options, Scheme, VertexRule};
+use crate::scheme::{
+    BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Options, Scheme, VertexRule,
+};
 use crate::stencil::{compose_rows, Stacked, StencilMatrix};
 use crate::topology::Topology;
 use rayon::prelude::*;
@@ -35,7 +42,8 @@ use subfit_mesh::{Polygons, Tags, SHARPNESS_INFINITE};
 pub struct Refinement {
     /// The child faces (order in the module docs).
     pub faces: Polygons,
-    /// Number of child vertices (`V + E` for Loop, `V + E + F` for Catmull-Clark).
+    /// Number of child vertices (`V + E` for Loop, `V + E + F` for Catmull-Clark, `V + E +`
+    /// the number of non-triangles for quad/triangle).
     pub num_vertices: usize,
     /// Tags carried to the child mesh: infinitely sharp creases on both child edges of a sharp
     /// parent edge, finite sharpness decremented by one, corner tags on the same vertex ids.
@@ -56,7 +64,28 @@ pub(crate) fn topology_for(
             return Err(SubdivError::NotTriangles { face, len: f.len() });
         }
     }
-    Topology::new(faces, num_vertices)
+    let topo = Topology::new(faces, num_vertices)?;
+    if scheme == Scheme::QuadTriangle {
+        for v in 0..topo.num_vertices() as u32 {
+            let num_faces = topo.vertex_corners(v).len();
+            if num_faces > 64 && matches!(face_kinds(&topo, v), FaceKinds::Mixed(_)) {
+                return Err(SubdivError::MixedValence {
+                    vertex: v,
+                    num_faces,
+                });
+            }
+        }
+    }
+    Ok(topo)
+}
+
+/// Which faces around vertex `v` are triangles, in ring order. Cost O(valence).
+pub(crate) fn face_kinds(topo: &Topology, v: u32) -> FaceKinds {
+    FaceKinds::from_triangles(
+        topo.vertex_corners(v)
+            .iter()
+            .map(|&c| topo.face(topo.corner_face(c) as usize).len() == 3),
+    )
 }
 
 /// Whether each edge is infinitely sharp: boundary edges, and edges tagged with sharpness
@@ -87,6 +116,7 @@ pub(crate) fn neighborhoods(
             classify(
                 edges.iter().map(|&e| sharp[e as usize]),
                 num_faces,
+                face_kinds(topo, v),
                 corner_tag,
                 boundary,
             )
@@ -95,11 +125,12 @@ pub(crate) fn neighborhoods(
 }
 
 /// The [`Neighborhood`] of a vertex from the sharpness of its ring edges (in ring order), its
-/// face count and whether it carries a corner tag. Cost O(valence).
+/// face count and kinds and whether it carries a corner tag. Cost O(valence).
 #[inline]
 pub(crate) fn classify(
     edge_sharp: impl ExactSizeIterator<Item = bool>,
     num_faces: usize,
+    faces: FaceKinds,
     corner_tag: bool,
     boundary: BoundaryRule,
 ) -> Neighborhood {
@@ -120,6 +151,7 @@ pub(crate) fn classify(
         num_faces,
         rule,
         crease_ends: ends,
+        faces,
     }
 }
 
@@ -142,7 +174,7 @@ pub fn refine(
 pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
     Refinement {
         faces: child_faces(topo, options.scheme),
-        num_vertices: ChildCorners::new(topo, options.scheme).num_vertices(),
+        num_vertices: child_num_vertices(topo, options.scheme),
         tags: child_tags(topo, tags),
         matrix: refine_matrix(topo, tags, options),
     }
@@ -189,11 +221,11 @@ pub(crate) fn refine_compose(
             );
             m
         }
-        Scheme::CatmullClark => {
+        Scheme::CatmullClark | Scheme::QuadTriangle => {
             // Face points first; vertex and edge points then use them as single rows instead
             // of re-expanding every face centre (about half the work).
             let [face_points] = compose_rows(
-                topo.num_faces(),
+                rows.num_rows() - nv - ne,
                 Stacked::one(rhs),
                 VertexMaskCache::default,
                 |cache, f, row| rows.row(cache, nv + ne + f, None, |c, w| row.push((c, [w]))),
@@ -225,6 +257,83 @@ pub(crate) struct RefineRows<'a> {
     scheme: Scheme,
     sharp: Vec<bool>,
     hoods: Vec<Neighborhood>,
+    points: FacePoints,
+}
+
+/// Which parent faces have a face point, and its index among the face points.
+#[derive(Clone, Debug)]
+pub(crate) enum FacePoints {
+    /// Loop: none.
+    None,
+    /// Catmull-Clark: every face, face point `f` of face `f`.
+    All(usize),
+    /// Quad/triangle: the non-triangles; `index[f]` (`u32::MAX` for a triangle) and `face[k]`.
+    Some {
+        /// Face point index of each face.
+        index: Vec<u32>,
+        /// Face of each face point.
+        face: Vec<u32>,
+    },
+}
+
+impl FacePoints {
+    /// The face points of `topo` under `scheme`. Cost O(#F).
+    pub(crate) fn new(topo: &Topology, scheme: Scheme) -> Self {
+        match scheme {
+            Scheme::Loop => FacePoints::None,
+            Scheme::CatmullClark => FacePoints::All(topo.num_faces()),
+            Scheme::QuadTriangle => {
+                let mut index = vec![u32::MAX; topo.num_faces()];
+                let mut face = Vec::new();
+                for (f, slot) in index.iter_mut().enumerate() {
+                    if topo.face(f).len() != 3 {
+                        *slot = face.len() as u32;
+                        face.push(f as u32);
+                    }
+                }
+                FacePoints::Some { index, face }
+            }
+        }
+    }
+
+    /// Number of face points.
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            FacePoints::None => 0,
+            FacePoints::All(n) => *n,
+            FacePoints::Some { face, .. } => face.len(),
+        }
+    }
+
+    /// The face point index of face `f` (which must have one).
+    #[inline]
+    pub(crate) fn index(&self, f: usize) -> u32 {
+        match self {
+            FacePoints::Some { index, .. } => index[f],
+            _ => f as u32,
+        }
+    }
+
+    /// The face of face point `k`.
+    #[inline]
+    pub(crate) fn face(&self, k: usize) -> usize {
+        match self {
+            FacePoints::Some { face, .. } => face[k] as usize,
+            _ => k,
+        }
+    }
+}
+
+/// Number of child vertices of `topo` under `scheme` (module docs). Cost O(#F).
+pub(crate) fn child_num_vertices(topo: &Topology, scheme: Scheme) -> usize {
+    let faces = match scheme {
+        Scheme::Loop => 0,
+        Scheme::CatmullClark => topo.num_faces(),
+        Scheme::QuadTriangle => (0..topo.num_faces())
+            .filter(|&f| topo.face(f).len() != 3)
+            .count(),
+    };
+    topo.num_vertices() + topo.num_edges() + faces
 }
 
 impl<'a> RefineRows<'a> {
@@ -237,6 +346,7 @@ impl<'a> RefineRows<'a> {
             scheme: options.scheme,
             sharp,
             hoods,
+            points: FacePoints::new(topo, options.scheme),
         }
     }
 
@@ -245,21 +355,15 @@ impl<'a> RefineRows<'a> {
         &self.hoods
     }
 
-    /// Number of child vertices (`V + E`, plus `F` for Catmull-Clark).
+    /// Number of child vertices (`V + E`, plus the face points).
     pub(crate) fn num_rows(&self) -> usize {
-        let t = self.topo;
-        t.num_vertices()
-            + t.num_edges()
-            + match self.scheme {
-                Scheme::CatmullClark => t.num_faces(),
-                Scheme::Loop => 0,
-            }
+        self.topo.num_vertices() + self.topo.num_edges() + self.points.len()
     }
 
     /// Calls `push(parent vertex, weight)` for the entries of child row `i` (a column may
     /// repeat; exact zeros may be pushed). With `face_points = Some(base)`, a face centre
     /// (Catmull-Clark face point of parent face `f`) is pushed as the single column `base + f`
-    /// instead of its vertices.
+    /// instead of its vertices (`base + k` for face point `k`).
     #[inline]
     pub(crate) fn row(
         &self,
@@ -284,62 +388,73 @@ impl<'a> RefineRows<'a> {
             }
             debug_assert!(mask.faces.is_empty() || mask.face_weights == FaceWeights::Centers);
             for (&c, &w) in topo.vertex_corners(v).iter().zip(&mask.faces) {
-                push_center(
-                    topo,
-                    face_points,
-                    topo.corner_face(c) as usize,
-                    w,
-                    &mut push,
-                );
+                if w != 0.0 {
+                    let f = topo.corner_face(c) as usize;
+                    self.push_center(face_points, f, w, &mut push);
+                }
             }
         } else if i < nv + ne {
             let e = (i - nv) as u32;
             let corners = topo.edge_corners(e);
             let num_faces = if corners[1] == u32::MAX { 1 } else { 2 };
+            let tri = |k: usize| {
+                k < num_faces && topo.face(topo.corner_face(corners[k]) as usize).len() == 3
+            };
             let em = self.scheme.edge_point_mask(&EdgeNeighborhood {
                 num_faces,
                 sharp: self.sharp[e as usize],
+                triangles: [tri(0), tri(1)],
             });
             let [a, b] = topo.edge_vertices(e);
             push(a, em.end);
             push(b, em.end);
-            if em.face != 0.0 {
-                for &c in &corners[..num_faces] {
-                    match em.face_weights {
-                        FaceWeights::Opposite => {
-                            push(topo.corner_vertex(topo.corner_prev(c)), em.face);
-                        }
-                        FaceWeights::Centers => {
-                            let f = topo.corner_face(c) as usize;
-                            push_center(topo, face_points, f, em.face, &mut push);
-                        }
+            for (k, &c) in corners[..num_faces].iter().enumerate() {
+                let w = em.face[k];
+                if w == 0.0 {
+                    continue;
+                }
+                match em.face_weights[k] {
+                    FaceWeights::Opposite => {
+                        push(topo.corner_vertex(topo.corner_prev(c)), w);
+                    }
+                    FaceWeights::Centers => {
+                        let f = topo.corner_face(c) as usize;
+                        self.push_center(face_points, f, w, &mut push);
                     }
                 }
             }
         } else {
-            push_center(topo, None, i - nv - ne, 1.0, &mut push);
+            let f = self.points.face(i - nv - ne);
+            self.push_center(None, f, 1.0, &mut push);
         }
     }
-}
 
-/// Pushes `w` times the centre of face `f`: its vertices, or the single column `base + f` when
-/// face points are given as rows (`face_points = Some(base)`).
-#[inline]
-fn push_center(
-    topo: &Topology,
-    face_points: Option<u32>,
-    f: usize,
-    w: f64,
-    push: &mut impl FnMut(u32, f64),
-) {
-    if let Some(base) = face_points {
-        push(base + f as u32, w);
-        return;
+    /// Pushes `w` times the centre of face `f`: its vertices, or the single column
+    /// `base + k` of its face point `k` when face points are given as rows
+    /// (`face_points = Some(base)`).
+    #[inline]
+    fn push_center(
+        &self,
+        face_points: Option<u32>,
+        f: usize,
+        w: f64,
+        push: &mut impl FnMut(u32, f64),
+    ) {
+        if let Some(base) = face_points {
+            push(base + self.points.index(f), w);
+            return;
+        }
+        let face = self.topo.face(f);
+        let wf = w / face.len() as f64;
+        for &u in face {
+            push(u, wf);
+        }
     }
-    let face = topo.face(f);
-    let wf = w / face.len() as f64;
-    for &u in face {
-        push(u, wf);
+
+    /// The parent face of child face-point row `nv + ne + k`'s face point `k`, for callers that
+    /// expand face-point columns.
+    pub(crate) fn face_points(&self) -> &FacePoints {
+        &self.points
     }
 }
 
@@ -350,12 +465,41 @@ fn push_center(
 /// If the child has `u32::MAX` or more face indices.
 #[track_caller]
 pub(crate) fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
+    if scheme == Scheme::QuadTriangle {
+        return mixed_child_faces(topo);
+    }
     let child = ChildCorners::new(topo, scheme);
     let (size, nf) = (child.face_size(), child.num_faces());
     let nc = u32::try_from(nf * size as usize).expect("more than u32::MAX child face indices");
     let indices = (0..nc).into_par_iter().map(|x| child.vertex(x)).collect();
     let offsets = (0..=nf as u32).map(|f| f * size).collect();
     Polygons::from_raw(offsets, indices).expect("offsets are those of equal-size faces")
+}
+
+/// Quad/triangle child faces: Loop's pattern for triangles, Catmull-Clark's for the others
+/// (module docs). Cost O(#corners), serial.
+fn mixed_child_faces(topo: &Topology) -> Polygons {
+    let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
+    let points = FacePoints::new(topo, Scheme::QuadTriangle);
+    let mut out = Polygons::new();
+    for f in 0..topo.num_faces() {
+        let v = topo.face(f);
+        let e = topo.face_edges(f);
+        let n = v.len();
+        if n == 3 {
+            let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
+            out.push(&[v[0], ab, ca]);
+            out.push(&[v[1], bc, ab]);
+            out.push(&[v[2], ca, bc]);
+            out.push(&[ab, bc, ca]);
+        } else {
+            let fp = nv + ne + points.index(f);
+            for i in 0..n {
+                out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
+            }
+        }
+    }
+    out
 }
 
 /// The tags of the child of `topo` (see [`Refinement::tags`]). Cost O(#tags · valence).
@@ -404,7 +548,7 @@ mod tests {
                     out.push(&[v[2], ca, bc]);
                     out.push(&[ab, bc, ca]);
                 }
-                Scheme::CatmullClark => {
+                Scheme::CatmullClark | Scheme::QuadTriangle => {
                     let fp = nv + ne + f as u32;
                     for i in 0..n {
                         out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
@@ -502,7 +646,7 @@ mod tests {
                                 .iter()
                                 .map(|&x| c.corner_vertex(c.corner_next(c.corner_next(x))))
                                 .collect(),
-                            Scheme::Loop => Vec::new(),
+                            _ => Vec::new(),
                         };
                         for walk in [false, true] {
                             if walk {

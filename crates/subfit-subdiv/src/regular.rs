@@ -28,6 +28,7 @@ const NONE: u32 = u32::MAX;
 
 /// The neighbourhood of a smooth interior vertex of valence 4 (with no sharp edge).
 const REGULAR: Neighborhood = Neighborhood {
+    faces: crate::scheme::FaceKinds::Polygons,
     num_edges: 4,
     num_faces: 4,
     rule: VertexRule::Smooth,

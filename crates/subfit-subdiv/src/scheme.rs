@@ -12,11 +12,6 @@
 //! edges are in its ring), and the scheme fills masks from it (see [`crate::mask`]).
 
 /// A subdivision scheme.
-///
-/// A future `QuadTriangle` variant (the Stam–Loop quad/triangle hybrid, Stam & Loop 2003) belongs
-/// here: it would use the Catmull-Clark rules on quads, Loop's on triangles and the mixed vertex
-/// rule of Stam & Loop §3 at vertices where both meet; refinement splits quads 1→4 and triangles
-/// 1→4 without face points for triangles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Scheme {
     /// Loop 1987: triangle meshes only; 1→4 triangle split; box-spline (quartic) regular patches.
@@ -26,22 +21,52 @@ pub enum Scheme {
     /// level (face point + edge points), after which the mesh is all quads; bicubic B-spline
     /// regular patches.
     CatmullClark,
+    /// The quad/triangle hybrid of Stam & Loop 2003 (*Quad/triangle subdivision*, CGF 22(1)), as
+    /// used by Lavoué et al. (§3.1, Fig. 8): triangles split 1→4 into triangles (no face point),
+    /// quads 1→4 into quads (face point), `n`-gons (`n ≥ 5`) into `n` quads as Catmull-Clark.
+    /// The rules are "linear subdivision, then averaging": Loop's exactly where a vertex or edge
+    /// sees only triangles, Catmull-Clark's where it sees no triangle, and the average of the
+    /// incident children's centroids (triangles weighted 1/4, 3/8, 3/8) where both meet (see
+    /// [`crate::mask`]). Limits at mixed vertices come from the eigenvectors of the local
+    /// subdivision matrix (module `mixed`).
+    QuadTriangle,
 }
 
 impl Scheme {
     /// The face size of the regular case (3 for Loop, 4 for Catmull-Clark).
+    /// For [`Scheme::QuadTriangle`] 4 (its regular quads; its regular triangles are Loop's).
     pub fn regular_face_size(self) -> usize {
         match self {
             Scheme::Loop => 3,
-            Scheme::CatmullClark => 4,
+            Scheme::CatmullClark | Scheme::QuadTriangle => 4,
+        }
+    }
+
+    /// Whether a non-triangle face gets a face point (and is split into quads): Catmull-Clark and
+    /// quad/triangle; Loop has triangles only.
+    pub fn splits_into_quads(self, face_len: usize) -> bool {
+        match self {
+            Scheme::Loop => false,
+            Scheme::CatmullClark => true,
+            Scheme::QuadTriangle => face_len != 3,
         }
     }
 
     /// The valence of a regular interior vertex (6 for Loop, 4 for Catmull-Clark).
+    /// For [`Scheme::QuadTriangle`] 4 (all-quad regions).
     pub fn regular_valence(self) -> usize {
         match self {
             Scheme::Loop => 6,
-            Scheme::CatmullClark => 4,
+            Scheme::CatmullClark | Scheme::QuadTriangle => 4,
+        }
+    }
+
+    /// The name used on command lines and in files (`loop`, `catmull-clark`, `quad-tri`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Scheme::Loop => "loop",
+            Scheme::CatmullClark => "catmull-clark",
+            Scheme::QuadTriangle => "quad-tri",
         }
     }
 }
@@ -137,7 +162,7 @@ impl VertexRule {
 /// edge `i` joins the vertex to its `i`-th ring neighbour and face `i` lies between edges `i` and
 /// `i + 1`. At a boundary vertex edge 0 is the leading boundary edge, so there is one more edge
 /// than faces. This is OpenSubdiv's `Vtr` ordering.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Neighborhood {
     /// Number of incident edges (the valence).
     pub num_edges: usize,
@@ -147,8 +172,57 @@ pub struct Neighborhood {
     /// The rule at the vertex.
     pub rule: VertexRule,
     /// For [`VertexRule::Crease`]: the ring positions of the two sharp edges, ascending; the
-    /// first is the "leading" crease edge. Ignored for other rules.
+    /// first is the "leading" crease edge. For [`VertexRule::Dart`]: `crease_ends[0]` is the
+    /// ring position of the sharp edge. Ignored for other rules.
     pub crease_ends: [usize; 2],
+    /// Which incident faces are triangles (only the quad/triangle scheme's rules read it).
+    pub faces: FaceKinds,
+}
+
+/// Which faces around a vertex are triangles, in ring order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum FaceKinds {
+    /// Every incident face is a triangle.
+    #[default]
+    Triangles,
+    /// No incident face is a triangle (quads, or `n`-gons before their first split).
+    Polygons,
+    /// Both: bit `i` is set when ring face `i` is a triangle. Only for vertices on at most 64
+    /// faces (the quad/triangle scheme refuses mixed vertices on more, see
+    /// [`crate::SubdivError::MixedValence`]).
+    Mixed(u64),
+}
+
+impl FaceKinds {
+    /// The kinds of faces given in ring order (`true` = triangle).
+    pub fn from_triangles(is_triangle: impl IntoIterator<Item = bool>) -> Self {
+        let (mut bits, mut tris, mut n) = (0u64, 0usize, 0usize);
+        for (i, t) in is_triangle.into_iter().enumerate() {
+            if t {
+                tris += 1;
+                if i < 64 {
+                    bits |= 1 << i;
+                }
+            }
+            n += 1;
+        }
+        if tris == n {
+            FaceKinds::Triangles
+        } else if tris == 0 {
+            FaceKinds::Polygons
+        } else {
+            FaceKinds::Mixed(bits)
+        }
+    }
+
+    /// Whether ring face `i` is a triangle.
+    pub fn is_triangle(self, i: usize) -> bool {
+        match self {
+            FaceKinds::Triangles => true,
+            FaceKinds::Polygons => false,
+            FaceKinds::Mixed(bits) => i < 64 && bits >> i & 1 == 1,
+        }
+    }
 }
 
 /// What a scheme needs to know about an edge to fill its mask.
@@ -158,4 +232,7 @@ pub struct EdgeNeighborhood {
     pub num_faces: usize,
     /// Whether the edge is infinitely sharp (boundary edges always are).
     pub sharp: bool,
+    /// Whether each incident face (the first `num_faces`) is a triangle (only the quad/triangle
+    /// scheme reads it).
+    pub triangles: [bool; 2],
 }

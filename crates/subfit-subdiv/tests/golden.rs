@@ -10,7 +10,8 @@
 use std::path::PathBuf;
 use subfit_mesh::{Polygons, Tags};
 use subfit_subdiv::{
-    normals_from_tangents, sampling_operator, Neighborhood, Options, Scheme, Topology, VertexRule,
+    normals_from_tangents, sampling_operator, FaceKinds, Neighborhood, Options, Scheme, Topology,
+    VertexRule,
 };
 
 const MESHES: [&str; 10] = [
@@ -134,46 +135,54 @@ fn limit_points_and_normals_match_opensubdiv() {
     println!("{:<26} lvl  max |dp|/diag   max angle (rad)", "mesh");
     for name in MESHES {
         let (pts, faces) = read_obj(&dir.join(format!("{name}.obj")));
-        let scheme = if name.starts_with("tri_") {
+        let native = if name.starts_with("tri_") {
             Scheme::Loop
         } else {
             Scheme::CatmullClark
         };
-        let options = Options::new(scheme);
-        let scale = diag(&pts);
-        let has_ngons = faces.iter().any(|f| f.len() != scheme.regular_face_size());
-        for level in 0..=3 {
-            let what = format!("{name} L{level}");
-            let (refp, ref_n) = read_lim(&dir.join(format!("{name}.L{level}.lim")));
-            if level == 0 && has_ngons {
-                // OpenSubdiv's `Limit` at level 0 applies quad masks to n-gons (it weights the
-                // vertex two corners away); we return the exact limit instead. Check that the
-                // reference is exactly that rule (below), and that our exact level-0 limit
-                // equals our level-1 limit at the same vertices (the vertex points come first).
-                let quirk = opensubdiv_level0_quirk(&pts, &faces, scheme);
-                let (d, a) = compare(&quirk.0, &quirk.1, &refp, &ref_n, scale, &what);
-                println!("{name:<26} L0   {d:.3e}      {a:.3e}   (OpenSubdiv's n-gon rule)");
+        // The quad/triangle scheme is Loop on all-triangle meshes and Catmull-Clark on meshes
+        // without triangles: the same references hold for it.
+        for scheme in [native, Scheme::QuadTriangle] {
+            let options = Options::new(scheme);
+            let scale = diag(&pts);
+            let has_ngons = faces.iter().any(|f| f.len() != native.regular_face_size());
+            for level in 0..=3 {
+                let what = format!("{name} L{level} ({})", scheme.name());
+                let (refp, ref_n) = read_lim(&dir.join(format!("{name}.L{level}.lim")));
+                if level == 0 && has_ngons {
+                    // OpenSubdiv's `Limit` at level 0 applies quad masks to n-gons (it weights the
+                    // vertex two corners away); we return the exact limit instead. Check that the
+                    // reference is exactly that rule (below), and that our exact level-0 limit
+                    // equals our level-1 limit at the same vertices (the vertex points come first).
+                    let quirk = opensubdiv_level0_quirk(&pts, &faces, native);
+                    let (d, a) = compare(&quirk.0, &quirk.1, &refp, &ref_n, scale, &what);
+                    println!("{name:<26} L0   {d:.3e}      {a:.3e}   (OpenSubdiv's n-gon rule)");
+                    if d > POS_TOL || a > ANGLE_TOL {
+                        failures.push(what.clone());
+                    }
+                    let s0 = sampling_operator(&faces, pts.len(), &Tags::new(), &options, 0)
+                        .unwrap()
+                        .evaluate(&pts);
+                    let s1 = sampling_operator(&faces, pts.len(), &Tags::new(), &options, 1)
+                        .unwrap()
+                        .evaluate(&pts);
+                    for v in 0..pts.len() {
+                        assert!(dist(&s0.positions[v], &s1.positions[v]) < 1e-14 * scale);
+                        assert!(angle(&s0.normals[v], &s1.normals[v]) < 1e-12);
+                    }
+                    continue;
+                }
+                let op =
+                    sampling_operator(&faces, pts.len(), &Tags::new(), &options, level).unwrap();
+                let s = op.evaluate(&pts);
+                let (d, a) = compare(&s.positions, &s.normals, &refp, &ref_n, scale, &what);
+                println!(
+                    "{name:<26} L{level}   {d:.3e}      {a:.3e}   {}",
+                    scheme.name()
+                );
                 if d > POS_TOL || a > ANGLE_TOL {
-                    failures.push(what.clone());
+                    failures.push(what);
                 }
-                let s0 = sampling_operator(&faces, pts.len(), &Tags::new(), &options, 0)
-                    .unwrap()
-                    .evaluate(&pts);
-                let s1 = sampling_operator(&faces, pts.len(), &Tags::new(), &options, 1)
-                    .unwrap()
-                    .evaluate(&pts);
-                for v in 0..pts.len() {
-                    assert!(dist(&s0.positions[v], &s1.positions[v]) < 1e-14 * scale);
-                    assert!(angle(&s0.normals[v], &s1.normals[v]) < 1e-12);
-                }
-                continue;
-            }
-            let op = sampling_operator(&faces, pts.len(), &Tags::new(), &options, level).unwrap();
-            let s = op.evaluate(&pts);
-            let (d, a) = compare(&s.positions, &s.normals, &refp, &ref_n, scale, &what);
-            println!("{name:<26} L{level}   {d:.3e}      {a:.3e}");
-            if d > POS_TOL || a > ANGLE_TOL {
-                failures.push(what);
             }
         }
     }
@@ -198,6 +207,7 @@ fn opensubdiv_level0_quirk(
             num_faces: n,
             rule: VertexRule::Smooth,
             crease_ends: [0, 0],
+            faces: FaceKinds::Polygons,
         };
         scheme.limit_masks(&hood, &mut p, &mut a, &mut b);
         for (k, m) in [&p, &a, &b].into_iter().enumerate() {

@@ -21,7 +21,7 @@ fn basis(scheme: Scheme, u: f64, v: f64) -> (usize, [[f64; 16]; 6]) {
             }
             (12, out)
         }
-        Scheme::CatmullClark => {
+        Scheme::CatmullClark | Scheme::QuadTriangle => {
             let b = bicubic_bspline(u, v);
             (16, [b.point, b.du, b.dv, b.duu, b.duv, b.dvv])
         }

@@ -41,7 +41,9 @@ impl Evaluator {
             }
             let corners: &[[f64; 2]] = match scheme {
                 Scheme::Loop => &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-                Scheme::CatmullClark => &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+                Scheme::CatmullClark | Scheme::QuadTriangle => {
+                    &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+                }
             };
             let at = corners.iter().position(|c| c[0] == u && c[1] == v);
             let limit_ok = scheme == Scheme::Loop || depth >= 1;
@@ -110,7 +112,7 @@ impl Evaluator {
         scratch: &mut Mask,
     ) -> Option<EvalWeights> {
         let ring = mesh.ring(adj, x)?;
-        let hood = mesh.neighborhood(x, &ring, self.options.boundary);
+        let hood = mesh.neighborhood(adj, x, &ring, self.options.boundary);
         let (mut t1, mut t2) = (Mask::default(), Mask::default());
         self.options
             .scheme

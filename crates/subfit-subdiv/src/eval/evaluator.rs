@@ -60,6 +60,13 @@ impl Evaluator {
                 return Err(SubdivError::NotTriangles { face, len: f.len() }.into());
             }
         }
+        if options.scheme == Scheme::QuadTriangle {
+            return Err(SubdivError::Unsupported {
+                scheme: options.scheme,
+                what: "exact evaluation at (face, u, v) and closest points (use the sampling operator)",
+            }
+            .into());
+        }
         let topo = Topology::new(faces, num_vertices)?;
         let nf = faces.len();
         let mut flags = vec![0u8; faces.indices().len()];
