@@ -322,6 +322,9 @@ pub enum SchemeArg {
     Loop,
     /// Catmull-Clark (any polygons).
     CatmullClark,
+    /// The Stam–Loop quad/triangle hybrid: Catmull-Clark on quads, Loop on triangles.
+    #[value(name = "quad-tri")]
+    QuadTri,
 }
 
 /// A boundary rule named on the command line.

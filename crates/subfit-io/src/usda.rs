@@ -5,7 +5,9 @@
 //! The layer holds one `Xform` prim `/subfit` (the default prim) with one `Mesh` child `cage`:
 //! `points` (`point3f[]`: USD stores mesh points in single precision — the cage written here
 //! is rounded to f32, document-level precision is in the OBJ/PLY outputs), `faceVertexCounts`,
-//! `faceVertexIndices`, `extent`, `subdivisionScheme` (`loop` or `catmullClark`),
+//! `faceVertexIndices`, `extent`, `subdivisionScheme` (`loop` or `catmullClark`; a quad/triangle
+//! cage as `catmullClark` with `triangleSubdivisionRule = "smooth"` and the custom attribute
+//! `subfit:scheme = "quadTriangle"`),
 //! `interpolateBoundary` (`edgeOnly` or `edgeAndCorner`), `creaseIndices`/`creaseLengths`/
 //! `creaseSharpnesses` (one two-vertex crease per tagged edge) and `cornerIndices`/
 //! `cornerSharpnesses`. Orientation is right-handed (counter-clockwise faces), as OBJ/PLY.
@@ -22,6 +24,10 @@ pub enum UsdScheme {
     Loop,
     /// `catmullClark`.
     CatmullClark,
+    /// A Stam–Loop quad/triangle cage: USD has no such scheme, so the nearest standard is
+    /// written (`catmullClark` with `triangleSubdivisionRule = "smooth"`) and the real scheme
+    /// is kept in the custom attribute `subfit:scheme = "quadTriangle"`.
+    QuadTriangle,
     /// `none`: a plain polygon mesh.
     None,
 }
@@ -45,9 +51,10 @@ pub fn write(
     out: &mut Vec<u8>,
 ) {
     let mut s = String::with_capacity(64 * mesh.positions.len() + 32 * mesh.faces.len() + 512);
+    let quad_triangle = scheme == UsdScheme::QuadTriangle;
     let scheme = match scheme {
         UsdScheme::Loop => "loop",
-        UsdScheme::CatmullClark => "catmullClark",
+        UsdScheme::CatmullClark | UsdScheme::QuadTriangle => "catmullClark",
         UsdScheme::None => "none",
     };
     let boundary = match boundary {
@@ -88,6 +95,16 @@ pub fn write(
     );
     let _ = writeln!(s, "        uniform token orientation = \"rightHanded\"");
     let _ = writeln!(s, "        uniform token subdivisionScheme = \"{scheme}\"");
+    if quad_triangle {
+        let _ = writeln!(
+            s,
+            "        uniform token triangleSubdivisionRule = \"smooth\""
+        );
+        let _ = writeln!(
+            s,
+            "        custom uniform token subfit:scheme = \"quadTriangle\""
+        );
+    }
     let _ = writeln!(
         s,
         "        uniform token interpolateBoundary = \"{boundary}\""

@@ -204,16 +204,20 @@ pub fn tags_to_py<'py>(
     )
 }
 
-/// A scheme name: `loop`, `catmull-clark` (also `catmull_clark`, `catmullclark`, `cc`), or
+/// A scheme name: `loop`, `catmull-clark` (also `catmull_clark`, `catmullclark`, `cc`),
+/// `quad-tri`, or
 /// `auto` (`None`) when `allow_auto`.
 pub fn scheme(name: &str, allow_auto: bool) -> PyResult<Option<subfit::subdiv::Scheme>> {
     use subfit::subdiv::Scheme;
     match name.to_ascii_lowercase().as_str() {
         "loop" => Ok(Some(Scheme::Loop)),
         "catmull-clark" | "catmull_clark" | "catmullclark" | "cc" => Ok(Some(Scheme::CatmullClark)),
+        "quad-tri" | "quad_tri" | "quadtriangle" | "quad-triangle" => {
+            Ok(Some(Scheme::QuadTriangle))
+        }
         "auto" if allow_auto => Ok(None),
         _ => Err(value_error(format!(
-            "scheme must be {}\"loop\" or \"catmull-clark\", got {name:?}",
+            "scheme must be {}\"loop\", \"catmull-clark\" or \"quad-tri\", got {name:?}",
             if allow_auto { "\"auto\", " } else { "" }
         ))),
     }
@@ -221,8 +225,5 @@ pub fn scheme(name: &str, allow_auto: bool) -> PyResult<Option<subfit::subdiv::S
 
 /// The Python name of a scheme.
 pub fn scheme_name(s: subfit::subdiv::Scheme) -> &'static str {
-    match s {
-        subfit::subdiv::Scheme::Loop => "loop",
-        _ => "catmull-clark",
-    }
+    s.name()
 }

@@ -113,10 +113,11 @@ pub fn write(
         let scheme = match scheme.to_ascii_lowercase().as_str() {
             "loop" => UsdScheme::Loop,
             "catmull-clark" | "catmull_clark" | "catmullclark" | "cc" => UsdScheme::CatmullClark,
+            "quad-tri" | "quad_tri" | "quadtriangle" | "quad-triangle" => UsdScheme::QuadTriangle,
             "none" => UsdScheme::None,
             _ => {
                 return Err(value_error(format!(
-                    "scheme must be \"loop\", \"catmull-clark\" or \"none\", got {scheme:?}"
+                    "scheme must be \"loop\", \"catmull-clark\", \"quad-tri\" or \"none\", got {scheme:?}"
                 )))
             }
         };

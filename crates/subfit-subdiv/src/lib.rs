@@ -38,7 +38,8 @@ pub use mask::{EdgeMask, FaceWeights, Mask};
 pub use refine::{refine, Refinement};
 pub use sample::{normals_from_tangents, sampling_operator, LimitSamples, SamplingOperator};
 pub use scheme::{
-    BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Options, Scheme, VertexRule,
+    BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Options, Scheme, TriangleRule,
+    VertexRule,
 };
 pub use stencil::StencilMatrix;
 pub use topology::Topology;

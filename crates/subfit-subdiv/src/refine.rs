@@ -258,6 +258,7 @@ pub(crate) struct RefineRows<'a> {
     sharp: Vec<bool>,
     hoods: Vec<Neighborhood>,
     points: FacePoints,
+    smooth_triangles: bool,
 }
 
 /// Which parent faces have a face point, and its index among the face points.
@@ -347,6 +348,8 @@ impl<'a> RefineRows<'a> {
             sharp,
             hoods,
             points: FacePoints::new(topo, options.scheme),
+            smooth_triangles: options.scheme == Scheme::CatmullClark
+                && options.triangles == crate::scheme::TriangleRule::Smooth,
         }
     }
 
@@ -400,11 +403,18 @@ impl<'a> RefineRows<'a> {
             let tri = |k: usize| {
                 k < num_faces && topo.face(topo.corner_face(corners[k]) as usize).len() == 3
             };
-            let em = self.scheme.edge_point_mask(&EdgeNeighborhood {
+            let mut em = self.scheme.edge_point_mask(&EdgeNeighborhood {
                 num_faces,
                 sharp: self.sharp[e as usize],
                 triangles: [tri(0), tri(1)],
             });
+            if self.smooth_triangles && num_faces == 2 && em.face[0] != 0.0 && (tri(0) || tri(1)) {
+                // OpenSubdiv's TRI_SUB_SMOOTH (catmarkScheme.h): 0.47 per triangle, averaged.
+                let w = |t: bool| if t { 0.47 } else { 0.25 };
+                let fw = 0.5 * (w(tri(0)) + w(tri(1)));
+                em.face = [fw; 2];
+                em.end = 0.5 * (1.0 - 2.0 * fw);
+            }
             let [a, b] = topo.edge_vertices(e);
             push(a, em.end);
             push(b, em.end);

@@ -100,6 +100,22 @@ pub struct Options {
     pub scheme: Scheme,
     /// The boundary interpolation rule. Default: [`BoundaryRule::EdgeOnly`].
     pub boundary: BoundaryRule,
+    /// Catmull-Clark's edge rule next to triangles (OpenSubdiv `TriangleSubdivision`, USD
+    /// `triangleSubdivisionRule`). Default: [`TriangleRule::Catmark`]. Only the refinement
+    /// matrices and the sampling operator honour [`TriangleRule::Smooth`].
+    pub triangles: TriangleRule,
+}
+
+/// OpenSubdiv's `Sdc::Options::TriangleSubdivision` for Catmull-Clark.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum TriangleRule {
+    /// `TRI_SUB_CATMARK`: the plain Catmull-Clark rules on triangles.
+    #[default]
+    Catmark,
+    /// `TRI_SUB_SMOOTH`: an edge point next to a triangle weights the face points by the mean
+    /// of 0.47 (per triangle) and 1/4 (per other face), OpenSubdiv `catmarkScheme.h`; USD's
+    /// `triangleSubdivisionRule = "smooth"`.
+    Smooth,
 }
 
 impl Options {
@@ -108,7 +124,20 @@ impl Options {
         Self {
             scheme,
             boundary: BoundaryRule::default(),
+            triangles: TriangleRule::default(),
         }
+    }
+
+    /// Builder-style setter for the scheme.
+    pub fn with_scheme(mut self, scheme: Scheme) -> Self {
+        self.scheme = scheme;
+        self
+    }
+
+    /// Builder-style setter for the Catmull-Clark triangle rule.
+    pub fn with_triangles(mut self, triangles: TriangleRule) -> Self {
+        self.triangles = triangles;
+        self
     }
 
     /// Builder-style setter for the boundary rule.

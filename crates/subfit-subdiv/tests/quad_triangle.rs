@@ -114,6 +114,7 @@ fn angle(a: [f64; 3], b: [f64; 3]) -> f64 {
 const QT: Options = Options {
     scheme: Scheme::QuadTriangle,
     boundary: subfit_subdiv::BoundaryRule::EdgeOnly,
+    triangles: subfit_subdiv::TriangleRule::Catmark,
 };
 
 fn meshes() -> Vec<(&'static str, Vec<[f64; 3]>, Polygons, bool)> {

@@ -51,7 +51,8 @@ impl Fitted {
         subfit_io::write_file(&dir.join("control.obj"), &self.cage, &ascii)?;
         let usd_scheme = match self.scheme {
             Scheme::Loop => UsdScheme::Loop,
-            _ => UsdScheme::CatmullClark,
+            Scheme::CatmullClark => UsdScheme::CatmullClark,
+            Scheme::QuadTriangle => UsdScheme::QuadTriangle,
         };
         let usd_boundary = match self.fit.boundary {
             BoundaryRule::EdgeOnly => UsdBoundary::EdgeOnly,

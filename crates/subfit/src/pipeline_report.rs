@@ -364,6 +364,21 @@ pub struct Timings {
     pub total: f64,
 }
 
+/// How far the surface a USD reader subdivides lies from the fitted one (quad/triangle cages,
+/// written as Catmull-Clark with the smooth triangle rule): both ways between the two limit
+/// tessellations at the same level.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct UsdDifference {
+    /// The scheme written to control.usda.
+    pub written_as: String,
+    /// Root mean square distance, fraction of the target's bounding-box diagonal.
+    pub rms_fraction_of_diagonal: f64,
+    /// Largest distance, fraction of the diagonal.
+    pub max_fraction_of_diagonal: f64,
+    /// Largest distance in the input's units.
+    pub max_original_units: f64,
+}
+
 /// `report.json`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Report {
@@ -410,6 +425,11 @@ pub struct Report {
     pub tolerance_reached_two_sided: bool,
     /// Warnings (also given to the progress callback).
     pub warnings: Vec<String>,
+    /// For a quad/triangle cage: the distance between its limit surface and that of the
+    /// standard scheme control.usda declares (Catmull-Clark, smooth triangle rule); `None` for
+    /// Loop and Catmull-Clark cages, which USD describes exactly.
+    #[serde(default)]
+    pub usd_difference: Option<UsdDifference>,
     /// Stages.
     pub stages: Vec<StageSummary>,
     /// Iterations, all stages.

@@ -60,6 +60,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             SchemeArg::Auto => None,
             SchemeArg::Loop => Some(Scheme::Loop),
             SchemeArg::CatmullClark => Some(Scheme::CatmullClark),
+            SchemeArg::QuadTri => Some(Scheme::QuadTriangle),
         },
         fit: FitOptions {
             sample_level: a.sample_level as usize,

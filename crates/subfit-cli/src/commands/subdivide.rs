@@ -16,6 +16,7 @@ pub fn pick_scheme(arg: SchemeArg, control: &PolyMesh) -> Scheme {
     match arg {
         SchemeArg::Loop => Scheme::Loop,
         SchemeArg::CatmullClark => Scheme::CatmullClark,
+        SchemeArg::QuadTri => Scheme::QuadTriangle,
         SchemeArg::Auto if control.faces.is_triangles() => Scheme::Loop,
         SchemeArg::Auto => Scheme::CatmullClark,
     }
