@@ -1,6 +1,8 @@
 //! Local refinement of polygon cages (`refine_polygons`): conformity (no T-vertex), topology
 //! kept, tags carried, the limit surface barely changed, quads kept.
 
+mod common;
+
 use std::collections::HashMap;
 
 use subfit_fit::internals::face_owners;
@@ -10,45 +12,7 @@ use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons, Tags, SHARPNESS_INFINITE};
 use subfit_report::MeshDistance;
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 
-/// A cube of `n × n` quads per side projected onto the unit sphere (outward winding): a closed
-/// all-quad cage with 8 valence-3 vertices.
-fn quad_sphere(n: usize) -> PolyMesh {
-    let mut ids: HashMap<[i64; 3], u32> = HashMap::new();
-    let mut pos = Vec::new();
-    let mut faces = Polygons::new();
-    let h = n as i64;
-    // Each side: a fixed axis at ±n, two running axes (u, v) with u × v pointing outward.
-    let sides: [(usize, i64, usize, usize); 6] = [
-        (0, 1, 1, 2),
-        (0, -1, 2, 1),
-        (1, 1, 2, 0),
-        (1, -1, 0, 2),
-        (2, 1, 0, 1),
-        (2, -1, 1, 0),
-    ];
-    for &(axis, sign, u, v) in &sides {
-        let mut id = |i: i64, j: i64| {
-            // The cube [-n, n]³ with grid spacing 2 on the running axes.
-            let mut key = [0i64; 3];
-            key[axis] = sign * h;
-            key[u] = 2 * i - h;
-            key[v] = 2 * j - h;
-            *ids.entry(key).or_insert_with(|| {
-                let p = key.map(|x| x as f64);
-                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-                pos.push(p.map(|x| x / r));
-                (pos.len() - 1) as u32
-            })
-        };
-        for i in 0..h {
-            for j in 0..h {
-                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
-                faces.push(&q);
-            }
-        }
-    }
-    PolyMesh::new(pos, faces)
-}
+use common::quad_sphere;
 
 /// An open `n × n` quad grid on z = 0 (one boundary loop), with the two quads at the centre
 /// merged into a hexagon when `hexagon`.
