@@ -4,8 +4,9 @@
 //! a stage stalls above the tolerance, the control mesh is changed where the error is large:
 //! edge flips that lower the error are kept, then the faces with large error are split 1-to-4
 //! with red-green closure (Cheng et al. 2004 §4.5) for Loop, or with the polygon templates of
-//! [`crate::refine_polygons`] for every other scheme (Lavoué et al. 2005 §5.2). Stops at the tolerance (`E_rms`, and `E_max`
-//! when asked), at the control-point budget, or when nothing more can be changed.
+//! [`crate::refine_polygons`] for every other scheme (Lavoué et al. 2005 §5.2). Stops at the
+//! tolerance (`E_rms`, and `E_max` when asked), at the control-point budget, or when nothing
+//! more can be changed.
 //!
 //! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
 //! surface against the data (Cheng's measure) and the data against the limit surface (the
