@@ -53,6 +53,7 @@ mod grouped_fill;
 mod options;
 mod ordering;
 mod pcg;
+mod refine_polygons;
 mod remesh;
 mod report;
 mod smooth;
@@ -65,6 +66,7 @@ pub use fitter::{fit, FitResult, Fitter};
 pub use foot_point_term::{FootPointSource, FootPointTerm};
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use pcg::PcgStats;
+pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};
 pub use remesh::RefineStats;
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
@@ -82,7 +84,7 @@ pub mod internals {
     pub use crate::foot_point_term::error_matrix;
     pub use crate::ordering::{block_amd, nested_dissection, BlockGraph};
     pub use crate::pcg::PcgSolver;
-    pub use crate::remesh::refine_red_green;
+    pub use crate::remesh::{face_owners, refine_red_green};
     pub use crate::smooth::Laplacian;
     pub use crate::solve::{CholeskySolver, SolveFailure};
     pub use crate::term::{mul, quadratic};

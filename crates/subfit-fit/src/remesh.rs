@@ -3,12 +3,13 @@
 //! large errors with red-green closure (Bank, Sherman & Weiser 1983) so that no T-vertex
 //! appears, and edge flips in high-error regions.
 //!
-//! Everything here works on triangle control meshes (Loop); the stage driver in
-//! [`crate::fit_stages`] does not refine Catmull-Clark cages.
+//! The face scores work for any cage and scheme; the red-green split is for triangle cages
+//! (Loop), polygon cages (Catmull-Clark and other schemes) are split by
+//! [`crate::refine_polygons`]; flips change triangle pairs only, in either kind of cage.
 
 use std::collections::HashMap;
 
-use subfit_mesh::{PolyMesh, Polygons};
+use subfit_mesh::{FaceId, PolyMesh, Polygons};
 use subfit_subdiv::mask::loop_beta;
 use subfit_subdiv::SamplingOperator;
 
@@ -36,20 +37,26 @@ impl FaceError {
 }
 
 /// For each face of the level-`l` mesh of `op`, the control face it descends from. Relies on
-/// the documented child order of the refinement (children of a face are consecutive; a Loop
-/// triangle has 4 children, a Catmull-Clark `n`-gon `n` at the first level and 4 after).
+/// the documented child order of the refinement (children of a face are consecutive) and on
+/// the face splits of the schemes: a quad gives 4 quads and an `n`-gon (`n ≥ 5`) `n` quads under
+/// every scheme; a triangle gives 4 triangles (Loop, the quad/triangle hybrid) or 3 quads
+/// (Catmull-Clark). Which of the two is read off the refined faces: a level `l ≥ 1` with no
+/// triangle means triangles became quads. Works for triangle, quad and mixed cages. Cost
+/// O(#faces at level `l`).
 pub fn face_owners(control_faces: &Polygons, op: &SamplingOperator) -> Vec<u32> {
     let mut owners: Vec<u32> = (0..control_faces.len() as u32).collect();
     let mut sizes: Vec<usize> = control_faces.iter().map(<[u32]>::len).collect();
-    // The scheme shows in the refined faces: Loop keeps triangles (4 children each), while
-    // Catmull-Clark splits every n-gon, triangles included, into n quads, then quads into 4.
-    let tri = op.faces.is_triangles();
+    let triangles_stay = op.faces.iter().any(|f| f.len() == 3);
     for _ in 0..op.level {
         let mut next = Vec::with_capacity(owners.len() * 4);
         let mut next_sizes = Vec::with_capacity(owners.len() * 4);
         for (&o, &s) in owners.iter().zip(&sizes) {
-            let children = if tri { 4 } else { s };
-            let child_size = if tri { 3 } else { 4 };
+            let (children, child_size) = match s {
+                3 if triangles_stay => (4, 3),
+                3 => (3, 4),
+                4 => (4, 4),
+                n => (n, 4),
+            };
             for _ in 0..children {
                 next.push(o);
                 next_sizes.push(child_size);
@@ -272,38 +279,47 @@ pub struct Flip {
     pub d: u32,
 }
 
-/// Interior edges of a triangle cage whose flip keeps the mesh manifold (no existing edge
-/// `(c, d)`, valences of `a` and `b` stay ≥ 4), whose two faces both score `≥ threshold`,
-/// ordered by decreasing score and chosen so that no two flips change the limit surface on a
-/// common face: a flip changes the limit only on faces incident to `a, b, c, d`, so the vertex
-/// sets are kept at least two rings apart. Then each flip can be judged on its own faces.
+/// Interior edges between two triangles of a cage (all triangles, or mixed: quads and
+/// `n`-gons are left alone) whose flip keeps the mesh manifold (no existing edge `(c, d)`,
+/// valences of `a` and `b` at least 4 before it), whose two faces both score
+/// `≥ threshold`, ordered by decreasing score and chosen so that no two flips change the limit
+/// surface on a common face: a flip changes the limit only on faces incident to `a, b, c, d`,
+/// so the vertex sets are kept at least two rings apart (rings of faces: vertices sharing a
+/// face). Then each flip can be judged on its own faces.
 pub fn independent_flips(
     faces: &Polygons,
     num_vertices: usize,
     score: &[f64],
     threshold: f64,
 ) -> Vec<Flip> {
-    if !faces.is_triangles() {
-        return Vec::new();
-    }
-    let tris: Vec<[u32; 3]> = faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
-    let mut edge_face: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3);
+    let mut edge_face: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.indices().len());
     let mut valence = vec![0u32; num_vertices];
+    // Edge neighbours (for the manifold test) and face neighbours (for the locking).
     let mut neighbors: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
-    for (f, t) in tris.iter().enumerate() {
-        for i in 0..3 {
-            edge_face.insert((t[i], t[(i + 1) % 3]), f as u32);
-            let (a, b) = (t[i], t[(i + 1) % 3]);
+    let mut face_neighbors: Vec<Vec<u32>> = vec![Vec::new(); num_vertices];
+    for (f, t) in faces.iter().enumerate() {
+        let n = t.len();
+        for i in 0..n {
+            let (a, b) = (t[i], t[(i + 1) % n]);
+            edge_face.insert((a, b), f as u32);
             if !neighbors[a as usize].contains(&b) {
                 neighbors[a as usize].push(b);
                 neighbors[b as usize].push(a);
                 valence[a as usize] += 1;
                 valence[b as usize] += 1;
             }
+            for &w in t {
+                if w != a && !face_neighbors[a as usize].contains(&w) {
+                    face_neighbors[a as usize].push(w);
+                }
+            }
         }
     }
     let mut cands: Vec<(f64, Flip)> = Vec::new();
-    for (f, t) in tris.iter().enumerate() {
+    for (f, t) in faces.iter().enumerate() {
+        if t.len() != 3 {
+            continue;
+        }
         for i in 0..3 {
             let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
             if a > b {
@@ -312,7 +328,10 @@ pub fn independent_flips(
             let Some(&g) = edge_face.get(&(b, a)) else {
                 continue;
             };
-            let tg = tris[g as usize];
+            let tg = faces.face(FaceId(g));
+            if tg.len() != 3 {
+                continue;
+            }
             let j = (0..3).find(|&j| tg[j] == b).unwrap_or(0);
             let d = tg[(j + 2) % 3];
             let s = score[f].min(score[g as usize]);
@@ -345,7 +364,7 @@ pub fn independent_flips(
         }
         for &v in &vs {
             locked[v as usize] = true;
-            for &w in &neighbors[v as usize] {
+            for &w in &face_neighbors[v as usize] {
                 locked[w as usize] = true;
             }
         }
@@ -355,14 +374,21 @@ pub fn independent_flips(
 }
 
 /// The faces with the given flips applied: `face0` becomes `(a, d, c)` and `face1` becomes
-/// `(b, c, d)` (face ids and winding kept).
+/// `(b, c, d)` (face ids and winding kept; other faces, of any size, unchanged).
 pub fn apply_flips(faces: &Polygons, flips: &[Flip]) -> Polygons {
-    let mut tris: Vec<[u32; 3]> = faces.iter().map(|f| [f[0], f[1], f[2]]).collect();
+    let mut replaced: HashMap<u32, [u32; 3]> = HashMap::with_capacity(2 * flips.len());
     for fl in flips {
-        tris[fl.face0 as usize] = [fl.a, fl.d, fl.c];
-        tris[fl.face1 as usize] = [fl.b, fl.c, fl.d];
+        replaced.insert(fl.face0, [fl.a, fl.d, fl.c]);
+        replaced.insert(fl.face1, [fl.b, fl.c, fl.d]);
     }
-    Polygons::from_triangles(&tris)
+    let mut out = Polygons::with_capacity(faces.len(), faces.indices().len());
+    for (f, face) in faces.iter().enumerate() {
+        match replaced.get(&(f as u32)) {
+            Some(t) => out.push(t),
+            None => out.push(face),
+        }
+    }
+    out
 }
 
 #[cfg(test)]

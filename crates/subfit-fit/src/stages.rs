@@ -3,16 +3,18 @@
 //! weight `λ` is lowered from stage to stage (default 1e-3 → 1e-5, ×0.1 per stage) and, when
 //! a stage stalls above the tolerance, the control mesh is changed where the error is large:
 //! edge flips that lower the error are kept, then the faces with large error are split 1-to-4
-//! with red-green closure (Cheng et al. 2004 §4.5). Stops at the tolerance (`E_rms`, and `E_max`
-//! when asked), at the control-point budget, or when nothing more can be changed.
+//! with red-green closure (Cheng et al. 2004 §4.5) for Loop, or with the polygon templates of
+//! [`crate::refine_polygons`] for every other scheme (Lavoué et al. 2005 §5.2). Stops at the
+//! tolerance (`E_rms`, and `E_max` when asked), at the control-point budget, or when nothing
+//! more can be changed.
 //!
 //! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
 //! surface against the data (Cheng's measure) and the data against the limit surface (the
 //! tessellation of the fitter's samples, [`subfit_report::MeshDistance`]). Tolerances hold only when both do; faces
 //! that miss in either direction are refined; the best cage measured is the one returned.
 //!
-//! Only triangle cages (Loop) are refined and flipped; a Catmull-Clark cage goes through the
-//! `λ` schedule alone.
+//! Every scheme is refined; flips change pairs of triangles only (a quad's edge is never
+//! rotated), so an all-quad cage is refined but not flipped.
 
 use std::time::{Duration, Instant};
 
@@ -21,12 +23,13 @@ use std::collections::HashSet;
 use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_report::data_samples::SampleKind;
 use subfit_report::{data_samples, DistanceStats, MeshDistance, TwoSided};
-use subfit_subdiv::sampling_operator;
+use subfit_subdiv::{sampling_operator, Options, Scheme};
 use subfit_target::Target;
 
 use crate::error::FitError;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
+use crate::refine_polygons::refine_polygons;
 use crate::remesh::{
     apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
     FaceError, RefineStats,
@@ -543,7 +546,10 @@ pub fn fit_stages(
         let room = used < stages.max_iterations && stage + 1 < stages.max_stages;
         if stages.met(&last, &m.two_sided) {
             stop = StageStop::Tolerance;
-        } else if room && mesh.faces.is_triangles() && (stages.refine || stages.edge_flips) {
+        } else if room
+            && (base.scheme != Scheme::Loop || mesh.faces.is_triangles())
+            && (stages.refine || stages.edge_flips)
+        {
             let unmet = stages.unmet(&last, &m.two_sided);
             let mut score: Vec<f64> = m
                 .surface_faces
@@ -571,12 +577,13 @@ pub fn fit_stages(
                 }
             }
             if stages.refine && n < stages.max_control_points {
-                if let Some((refined, rs, d)) = refine_step(&mesh, &score, &depth, stages) {
-                    changed |= rs.new_points > 0;
-                    tags = carry_tags(&tags, n, &refined.faces);
-                    mesh = refined;
-                    depth = d;
-                    report.refine = Some(rs);
+                let how = Splitter::for_options(&stage_opts);
+                if let Some(r) = refine_step(&mesh, &tags, &score, &depth, stages, &how)? {
+                    changed |= r.stats.new_points > 0;
+                    tags = r.tags;
+                    mesh = r.mesh;
+                    depth = r.per_face;
+                    report.refine = Some(r.stats);
                 }
             }
             if mesh.faces != before {
@@ -703,20 +710,78 @@ fn flip_pass(
     Ok((flips.len(), kept.len()))
 }
 
+/// A refined cage: what was done, a value per new face (its parent, or its depth) and the
+/// carried tags.
+struct Refined<T> {
+    mesh: PolyMesh,
+    stats: RefineStats,
+    per_face: Vec<T>,
+    tags: Tags,
+}
+
+/// How a cage is split: red-green for Loop, the polygon templates for every other scheme
+/// (whatever the cage's faces are: "not Loop" means polygons).
+enum Splitter {
+    RedGreen,
+    Polygons(Options),
+}
+
+impl Splitter {
+    fn for_options(opts: &FitOptions) -> Self {
+        if opts.scheme == Scheme::Loop {
+            Self::RedGreen
+        } else {
+            Self::Polygons(opts.subdivision())
+        }
+    }
+
+    /// The refined cage, what was done, the parent of every face and the carried tags; `None`
+    /// when this splitter does not apply (red-green on a non-triangle cage).
+    fn split(
+        &self,
+        mesh: &PolyMesh,
+        tags: &Tags,
+        marked: &[bool],
+    ) -> Result<Option<Refined<u32>>, FitError> {
+        Ok(match self {
+            Self::RedGreen => refine_red_green_with_parents(mesh, marked).map(|(m, stats, p)| {
+                let tags = carry_tags(tags, mesh.num_vertices(), &m.faces);
+                Refined {
+                    mesh: m,
+                    stats,
+                    per_face: p,
+                    tags,
+                }
+            }),
+            Self::Polygons(opts) => {
+                let r = refine_polygons(mesh, tags, marked, opts)?;
+                Some(Refined {
+                    mesh: r.mesh,
+                    stats: r.stats,
+                    per_face: r.parents,
+                    tags: r.tags,
+                })
+            }
+        })
+    }
+}
+
 /// Marks the faces scoring above 1, worst first, within the growth and control-point budget
-/// and the refinement depth, and refines them with red-green closure. Returns the new mesh,
-/// what was done, and the depth of every new face.
+/// and the refinement depth, and refines them with `how`. Returns the new mesh, what was done,
+/// the depth of every new face and the carried tags.
 fn refine_step(
     mesh: &PolyMesh,
+    tags: &Tags,
     score: &[f64],
     depth: &[u8],
     stages: &StageOptions,
-) -> Option<(PolyMesh, RefineStats, Vec<u8>)> {
+    how: &Splitter,
+) -> Result<Option<Refined<u8>>, FitError> {
     let n = mesh.num_vertices();
     let room = stages.max_control_points.saturating_sub(n);
     let allowed = room.min(((n as f64) * stages.growth).ceil() as usize);
     if allowed == 0 {
-        return None;
+        return Ok(None);
     }
     let mut order: Vec<(f64, usize)> = score
         .iter()
@@ -727,7 +792,7 @@ fn refine_step(
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     if order.is_empty() {
-        return None;
+        return Ok(None);
     }
     // A split face adds about 1.5 points (3 edges, each shared by two faces), plus closure.
     let mut take = order
@@ -739,10 +804,18 @@ fn refine_step(
         for &(_, f) in &order[..take] {
             marked[f] = true;
         }
-        let (refined, rs, parents) = refine_red_green_with_parents(mesh, &marked)?;
+        let Some(Refined {
+            mesh: refined,
+            stats,
+            per_face: parents,
+            tags: new_tags,
+        }) = how.split(mesh, tags, &marked)?
+        else {
+            return Ok(None);
+        };
         if refined.num_vertices() <= n + allowed || take == 1 {
             if refined.num_vertices() > stages.max_control_points {
-                return None;
+                return Ok(None);
             }
             // An unsplit face (its parent's only child) keeps its depth; children of a split
             // face (red or green) are one deeper.
@@ -761,7 +834,12 @@ fn refine_step(
                     }
                 })
                 .collect();
-            return Some((refined, rs, d));
+            return Ok(Some(Refined {
+                mesh: refined,
+                stats,
+                per_face: d,
+                tags: new_tags,
+            }));
         }
         take = (take * 3 / 4).max(1);
     }

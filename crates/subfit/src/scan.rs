@@ -369,12 +369,6 @@ pub fn fit_scan(
     } else {
         Scheme::CatmullClark
     });
-    if options.stages.refine && scheme != Scheme::Loop {
-        warn(
-            "local refinement is implemented for Loop cages only; this Catmull-Clark cage keeps its connectivity".into(),
-            &mut progress,
-        );
-    }
     let fit = FitOptions {
         scheme,
         tags,

@@ -1,8 +1,10 @@
 //! Shared fixtures: the paper ellipsoid target and its 14-vertex initial control mesh.
 #![allow(dead_code)]
 
+use std::collections::HashMap;
 use subfit_mesh::shapes::Shape;
-use subfit_mesh::PolyMesh;
+
+use subfit_mesh::{PolyMesh, Polygons};
 use subfit_target::{Target, TargetOptions};
 
 /// Semi-axes of Cheng 2007's ellipsoid (original units).
@@ -35,4 +37,44 @@ pub fn normalized(target: &Target, mesh: &PolyMesh) -> PolyMesh {
         *p = target.to_normalized(*p);
     }
     m
+}
+
+/// A cube of `n × n` quads per side projected onto the unit sphere (outward winding): a closed
+/// all-quad cage with 8 valence-3 vertices.
+pub fn quad_sphere(n: usize) -> PolyMesh {
+    let mut ids: HashMap<[i64; 3], u32> = HashMap::new();
+    let mut pos = Vec::new();
+    let mut faces = Polygons::new();
+    let h = n as i64;
+    // Each side: a fixed axis at ±n, two running axes (u, v) with u × v pointing outward.
+    let sides: [(usize, i64, usize, usize); 6] = [
+        (0, 1, 1, 2),
+        (0, -1, 2, 1),
+        (1, 1, 2, 0),
+        (1, -1, 0, 2),
+        (2, 1, 0, 1),
+        (2, -1, 1, 0),
+    ];
+    for &(axis, sign, u, v) in &sides {
+        let mut id = |i: i64, j: i64| {
+            // The cube [-n, n]³ with grid spacing 2 on the running axes.
+            let mut key = [0i64; 3];
+            key[axis] = sign * h;
+            key[u] = 2 * i - h;
+            key[v] = 2 * j - h;
+            *ids.entry(key).or_insert_with(|| {
+                let p = key.map(|x| x as f64);
+                let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+                pos.push(p.map(|x| x / r));
+                (pos.len() - 1) as u32
+            })
+        };
+        for i in 0..h {
+            for j in 0..h {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                faces.push(&q);
+            }
+        }
+    }
+    PolyMesh::new(pos, faces)
 }
