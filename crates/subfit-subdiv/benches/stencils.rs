@@ -1,5 +1,5 @@
 //! Build time of the sampling operator `C = L_3 · M_3 M_2 M_1` for 1k- and 10k-face control
-//! meshes (Loop and Catmull-Clark), on torus grids with extraordinary vertices.
+//! meshes (Loop, Catmull-Clark and quad/triangle), on torus grids with extraordinary vertices.
 #![allow(missing_docs, clippy::print_stdout, reason = "benchmark program")]
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -76,6 +76,9 @@ fn bench(c: &mut Criterion) {
         ("loop_10k", Scheme::Loop, 100, 50),
         ("catmark_1k", Scheme::CatmullClark, 40, 25),
         ("catmark_10k", Scheme::CatmullClark, 125, 80),
+        // The same meshes as mixed quad/triangle cages.
+        ("quadtri_1k", Scheme::QuadTriangle, 40, 25),
+        ("quadtri_10k", Scheme::QuadTriangle, 125, 80),
     ];
     for (name, scheme, n, m) in cases {
         // `ONLY=<case>` times (and profiles) a single case.

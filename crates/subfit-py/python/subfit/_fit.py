@@ -32,7 +32,7 @@ class Fit:
     faces : (m, 3) or (m, 4) int64, or a list of int64 arrays
         Cage faces (uniform faces as one array).
     scheme : str
-        ``"loop"`` or ``"catmull-clark"``.
+        ``"loop"``, ``"catmull-clark"`` or ``"quad-tri"``.
     tags : dict
         Crease and corner tags: ``crease_edges (k, 2)``, ``crease_sharpness (k,)``,
         ``corners (c,)``, ``corner_sharpness (c,)``.
@@ -171,7 +171,7 @@ def fit(
         Faces of a mesh target (a dense triangle mesh, say).
     normals : (n, 3) array_like of float, optional
         Normals of the points (orientation hints; estimated when absent).
-    scheme : {"loop", "catmull-clark", "auto"}
+    scheme : {"loop", "catmull-clark", "quad-tri", "auto"}
         Subdivision scheme (``auto``: Loop for an all-triangle cage).
     method : {"sdm", "tdm", "pdm"}
         Error term (Cheng et al. 2007): squared, tangent or point distance minimization.

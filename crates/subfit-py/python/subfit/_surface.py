@@ -96,7 +96,7 @@ class Surface:
         Control points.
     faces : (m, 3) or (m, 4) array_like of int, or a list of polygons
         Faces over the control points, counter-clockwise seen from outside.
-    scheme : {"loop", "catmull-clark"}
+    scheme : {"loop", "catmull-clark", "quad-tri"}
         Loop needs triangles; Catmull-Clark takes any polygons.
     tags : dict, optional
         ``{"crease_edges": (k, 2) int, "crease_sharpness": (k,) float, "corners": (c,) int,
@@ -148,7 +148,7 @@ class Surface:
 
     @property
     def scheme(self) -> str:
-        """``"loop"`` or ``"catmull-clark"``."""
+        """``"loop"``, ``"catmull-clark"`` or ``"quad-tri"``."""
         return self._native.scheme
 
     @property

@@ -74,7 +74,7 @@ class LimitSurface(torch.nn.Module):
     ----------
     faces : (m, 3) or (m, 4) array_like of int, or a list of polygons
         The control mesh's faces (its topology; positions come in ``forward``).
-    scheme : {"loop", "catmull-clark"}
+    scheme : {"loop", "catmull-clark", "quad-tri"}
         Subdivision scheme.
     level : int
         Sampling level: the samples are the limit positions of the vertices of the
