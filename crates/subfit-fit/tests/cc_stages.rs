@@ -85,3 +85,56 @@ fn catmull_clark_quad_cage_is_refined_to_the_two_sided_tolerance() {
     assert_eq!(h.euler_characteristic(), 2);
     assert!(h.boundary_loops().is_empty());
 }
+
+/// The same cage with every third quad split into two triangles: a mixed quad/triangle cage.
+fn mixed_ellipsoid_cage() -> PolyMesh {
+    let m = quad_ellipsoid_cage();
+    let mut faces = subfit_mesh::Polygons::new();
+    for (i, f) in m.faces.iter().enumerate() {
+        if i % 3 == 0 && f.len() == 4 {
+            faces.push(&[f[0], f[1], f[2]]);
+            faces.push(&[f[0], f[2], f[3]]);
+        } else {
+            faces.push(f);
+        }
+    }
+    PolyMesh::new(m.positions, faces)
+}
+
+/// The quad/triangle scheme (Stam & Loop 2003) fits a mixed cage with refinement: triangles
+/// split into triangles, quads into quads, and the two-sided tolerance is reached.
+#[test]
+fn quad_triangle_mixed_cage_is_refined_to_the_two_sided_tolerance() {
+    let target = ellipsoid_target(20_000);
+    let cage = normalized(&target, &mixed_ellipsoid_cage());
+    let base = FitOptions {
+        scheme: Scheme::QuadTriangle,
+        sample_level: 3,
+        ..FitOptions::default()
+    };
+    let stages = StageOptions {
+        tolerance_rms: 2e-4,
+        max_control_points: 600,
+        max_stages: 12,
+        ..StageOptions::default()
+    };
+    let out = fit_stages(&target, &cage, &base, &stages, None).unwrap();
+    let r = &out.report;
+    let summary: Vec<_> = r
+        .stages
+        .iter()
+        .map(|s| (s.num_control_points, s.two_sided.rms(), s.two_sided.max()))
+        .collect();
+    assert_eq!(r.stop, StageStop::Tolerance, "{summary:?}");
+    assert!(r.two_sided.rms() <= stages.tolerance_rms, "{summary:?}");
+    assert!(out.mesh.num_vertices() > cage.num_vertices(), "{summary:?}");
+    let tris = out.mesh.faces.iter().filter(|f| f.len() == 3).count();
+    let quads = out.mesh.faces.iter().filter(|f| f.len() == 4).count();
+    assert!(
+        tris > 0 && quads > 0,
+        "{:?}",
+        out.mesh.faces.size_histogram()
+    );
+    let h = subfit_mesh::HalfEdgeMesh::from_mesh(&out.mesh).unwrap();
+    assert_eq!(h.euler_characteristic(), 2);
+}
