@@ -120,11 +120,11 @@ impl<'a> ClosestPointFinder<'a> {
             });
         }
         let r = opts.resolution.max(1);
-        let tri = evaluator.triangular();
         let per_patch: Vec<Vec<TessTriangle>> = (0..evaluator.num_patches())
             .into_par_iter()
             .map(|pi| {
                 let (face, sub) = evaluator.patch(pi);
+                let tri = evaluator.triangle_patch(face);
                 let prm = |i: u32, j: u32| SurfaceParam {
                     face,
                     sub,
@@ -200,7 +200,7 @@ impl<'a> ClosestPointFinder<'a> {
             v += w * p.v;
         }
         // Start off the patch corners, where the parametrisation may be singular.
-        let (cu, cv) = if self.ev.triangular() {
+        let (cu, cv) = if self.ev.triangle_patch(ps[0].face) {
             (1.0 / 3.0, 1.0 / 3.0)
         } else {
             (0.5, 0.5)
@@ -219,7 +219,7 @@ impl<'a> ClosestPointFinder<'a> {
             return Ok(r);
         }
         // Exactly at an irregular vertex there are no parametric derivatives: nudge inside.
-        let (cu, cv) = if self.ev.triangular() {
+        let (cu, cv) = if self.ev.triangle_patch(p.face) {
             (1.0 / 3.0, 1.0 / 3.0)
         } else {
             (0.5, 0.5)
@@ -325,7 +325,8 @@ impl<'a> ClosestPointFinder<'a> {
                         .cross(p, e)
                         .map(|(np, _)| self.ev.patch_index(np.face, np.sub) as u32);
                     if cand == p && back.is_some() && back == came_from && f >= f_at_cross {
-                        (cand, exit) = self.clip(p, along_edge(self.ev.triangular(), e, d));
+                        (cand, exit) =
+                            self.clip(p, along_edge(self.ev.triangle_patch(p.face), e, d));
                     }
                 }
                 let cs = self.eval(cand)?;
@@ -388,7 +389,7 @@ impl<'a> ClosestPointFinder<'a> {
         &self,
         p: SurfaceParam,
     ) -> Result<Option<(SurfaceParam, SurfacePoint)>, EvalError> {
-        let corners: &[(f64, f64)] = if self.ev.triangular() {
+        let corners: &[(f64, f64)] = if self.ev.triangle_patch(p.face) {
             &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
         } else {
             &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
@@ -462,7 +463,7 @@ impl<'a> ClosestPointFinder<'a> {
         const ON: f64 = 1e-14;
         let s2 = std::f64::consts::FRAC_1_SQRT_2;
         // (distance to the edge, inward normal, unit tangent, edge id)
-        let cands: &[(f64, [f64; 2], [f64; 2], u8)] = if self.ev.triangular() {
+        let cands: &[(f64, [f64; 2], [f64; 2], u8)] = if self.ev.triangle_patch(p.face) {
             &[
                 (p.v, [0.0, 1.0], [1.0, 0.0], 0),
                 (1.0 - p.u - p.v, [-1.0, -1.0], [-s2, s2], 1),
@@ -487,7 +488,8 @@ impl<'a> ClosestPointFinder<'a> {
     fn clip(&self, p: SurfaceParam, d: [f64; 2]) -> (SurfaceParam, Option<u8>) {
         let (u, v) = (p.u, p.v);
         // Each constraint: (value now, rate of change, edge id); value must stay ≥ 0.
-        let cons: Vec<(f64, f64, u8)> = if self.ev.triangular() {
+        let tri = self.ev.triangle_patch(p.face);
+        let cons: Vec<(f64, f64, u8)> = if tri {
             vec![(v, d[1], 0), (1.0 - u - v, -d[0] - d[1], 1), (u, d[0], 2)]
         } else {
             vec![
@@ -514,7 +516,7 @@ impl<'a> ClosestPointFinder<'a> {
             ..p
         };
         // Land exactly on the edge.
-        match (self.ev.triangular(), edge) {
+        match (tri, edge) {
             (true, Some(0)) | (false, Some(0)) => c.v = 0.0,
             (true, Some(2)) | (false, Some(3)) => c.u = 0.0,
             (true, Some(1)) => {
@@ -530,7 +532,7 @@ impl<'a> ClosestPointFinder<'a> {
         }
         c.u = c.u.clamp(0.0, 1.0);
         c.v = c.v.clamp(0.0, 1.0);
-        if self.ev.triangular() && c.u + c.v > 1.0 {
+        if tri && c.u + c.v > 1.0 {
             let s = c.u + c.v;
             c.u /= s;
             c.v /= s;
@@ -540,8 +542,7 @@ impl<'a> ClosestPointFinder<'a> {
 
     /// The same surface point seen from the patch across `edge`, and the patch index left.
     fn cross(&self, p: SurfaceParam, edge: u8) -> Option<(SurfaceParam, u32)> {
-        let tri = self.ev.triangular();
-        let s = edge_param(tri, edge, p.u, p.v);
+        let s = edge_param(self.ev.triangle_patch(p.face), edge, p.u, p.v);
         let pi = self.ev.patch_index(p.face, p.sub) as u32;
         let (key, t0, t1) = self.patch_edges[pi as usize][edge as usize];
         let t = t0 + s * (t1 - t0);
@@ -549,8 +550,8 @@ impl<'a> ClosestPointFinder<'a> {
             e.patch != pi && t >= e.t0.min(e.t1) - 1e-15 && t <= e.t0.max(e.t1) + 1e-15
         })?;
         let s2 = ((t - other.t0) / (other.t1 - other.t0)).clamp(0.0, 1.0);
-        let (u, v) = edge_point(tri, other.edge, s2);
         let (face, sub) = self.ev.patch(other.patch as usize);
+        let (u, v) = edge_point(self.ev.triangle_patch(face), other.edge, s2);
         Some((SurfaceParam { face, sub, u, v }, pi))
     }
 }
@@ -655,7 +656,7 @@ fn edge_spans(ev: &Evaluator) -> EdgeMaps {
             }
             per_patch.push(e);
         } else {
-            debug_assert_eq!(ev.options().scheme, Scheme::CatmullClark);
+            debug_assert_ne!(ev.options().scheme, Scheme::Loop);
             let f = fi as u32;
             for k in 0..n {
                 let (vk, vn, vp) = (face[k], face[(k + 1) % n], face[(k + n - 1) % n]);
@@ -673,8 +674,12 @@ fn edge_spans(ev: &Evaluator) -> EdgeMaps {
         }
     }
     let mut map: HashMap<EdgeKey, Vec<EdgeSpan>> = HashMap::new();
-    let nedges = if ev.triangular() { 3 } else { 4 };
     for (pi, es) in per_patch.iter().enumerate() {
+        let nedges = if ev.triangle_patch(ev.patch(pi).0) {
+            3
+        } else {
+            4
+        };
         for (j, &(key, t0, t1)) in es.iter().enumerate().take(nedges) {
             map.entry(key).or_default().push(EdgeSpan {
                 patch: pi as u32,

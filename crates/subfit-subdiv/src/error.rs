@@ -64,14 +64,6 @@ pub enum SubdivError {
         /// Its number of incident faces.
         num_faces: usize,
     },
-    /// The scheme does not offer this operation yet.
-    #[error("{what} is not implemented for the {} scheme", scheme.name())]
-    Unsupported {
-        /// The scheme.
-        scheme: crate::scheme::Scheme,
-        /// The operation.
-        what: &'static str,
-    },
     /// The refined mesh would need more than `u32::MAX - 1` elements of one kind.
     #[error("the refined mesh is too large for 32-bit ids ({count} {what})")]
     TooLarge {

@@ -157,6 +157,89 @@ fn corpus() -> Vec<Mesh> {
         };
         out.push((format!("creased_grid_tri{tri}"), scheme, p, f, tags));
     }
+    // The quad/triangle scheme: on the pure meshes above it is Loop or Catmull-Clark; on mixed
+    // ones (a half-quad, half-triangle grid, a prism with triangle caps, and the creased grid
+    // made mixed) it has patches of both kinds.
+    let pure: Vec<Mesh> = out
+        .iter()
+        .filter(|m| !m.0.starts_with("creased"))
+        .map(|(n, _, p, f, t)| {
+            (
+                format!("{n} (quad-tri)"),
+                Scheme::QuadTriangle,
+                p.clone(),
+                f.clone(),
+                t.clone(),
+            )
+        })
+        .collect();
+    out.extend(pure);
+    let (p, quads) = grid(4, false, |x, y| 0.2 * (3.0 * x).sin() * y + 0.1 * x * x);
+    let mut half = Polygons::new();
+    for (i, q) in quads.iter().enumerate() {
+        if i % 4 >= 2 {
+            half.push(&[q[0], q[1], q[2]]);
+            half.push(&[q[0], q[2], q[3]]);
+        } else {
+            half.push(q);
+        }
+    }
+    let mut tags = Tags::new();
+    tags.set_crease(2, 7, SHARPNESS_INFINITE);
+    tags.set_crease(7, 12, SHARPNESS_INFINITE);
+    out.push((
+        "half_grid (quad-tri)".into(),
+        Scheme::QuadTriangle,
+        p.clone(),
+        half.clone(),
+        Tags::new(),
+    ));
+    out.push((
+        "half_grid_creased (quad-tri)".into(),
+        Scheme::QuadTriangle,
+        p,
+        half,
+        tags,
+    ));
+    for n in [3u32, 5, 6] {
+        // A prism of quads with triangle-fan caps, and a triangular prism with triangle caps
+        // (n = 3: quad/triangle vertices of valence 3).
+        let mut p = Vec::new();
+        for z in [0.0, 1.0] {
+            for i in 0..n {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                p.push([
+                    a.cos() * (1.0 + 0.2 * z),
+                    a.sin(),
+                    z + 0.05 * (2.0 * a).cos(),
+                ]);
+            }
+        }
+        let mut f = Polygons::new();
+        if n == 3 {
+            f.push(&[2, 1, 0]);
+            f.push(&[3, 4, 5]);
+        } else {
+            p.push([0.0, 0.0, -0.2]);
+            p.push([0.1, 0.0, 1.2]);
+            for i in 0..n {
+                let j = (i + 1) % n;
+                f.push(&[2 * n, j, i]);
+                f.push(&[2 * n + 1, n + i, n + j]);
+            }
+        }
+        for i in 0..n {
+            let j = (i + 1) % n;
+            f.push(&[i, j, n + j, n + i]);
+        }
+        out.push((
+            format!("capped_prism{n} (quad-tri)"),
+            Scheme::QuadTriangle,
+            p,
+            f,
+            Tags::new(),
+        ));
+    }
     out
 }
 
@@ -178,7 +261,7 @@ fn dyadic(ev: &Evaluator, l: u32) -> Vec<SurfaceParam> {
         let m = 1u32 << ll;
         for j in 0..=m {
             for i in 0..=m {
-                if ev.triangular() && i + j > m {
+                if ev.triangle_patch(face) && i + j > m {
                     continue;
                 }
                 out.push(SurfaceParam {

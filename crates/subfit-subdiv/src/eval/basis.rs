@@ -34,6 +34,8 @@ pub(super) struct PatchCoef {
     pub(super) cols: Vec<u32>,
     /// `npts × cols.len()`.
     pub(super) coef: Vec<f64>,
+    /// Patch control points: 12 (box spline) or 16 (bicubic).
+    pub(super) npts: usize,
 }
 
 impl PatchCoef {
@@ -59,7 +61,11 @@ impl PatchCoef {
         for i in 0..combos.len() {
             coef.extend(order.iter().map(|&j| dense[i * k + j]));
         }
-        Self { cols, coef }
+        Self {
+            cols,
+            coef,
+            npts: combos.len(),
+        }
     }
 
     /// Evaluates at child parameters `(u, v)` with `a` = ∂(child params)/∂(original params).
@@ -71,7 +77,14 @@ impl PatchCoef {
         a: [[f64; 2]; 2],
         depth: u32,
     ) -> EvalWeights {
-        let (np, [p, du, dv, duu, duv, dvv]) = basis(scheme, u, v);
+        // A 12-point patch is Loop's box spline (a triangle), a 16-point one the bicubic
+        // B-spline, whatever the mesh's scheme (the quad/triangle scheme has both).
+        let patch = if self.npts == 12 {
+            Scheme::Loop
+        } else {
+            scheme
+        };
+        let (np, [p, du, dv, duu, duv, dvv]) = basis(patch, u, v);
         let n = self.cols.len();
         let mut out = [
             vec![0.0; n],

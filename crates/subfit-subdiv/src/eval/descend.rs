@@ -6,8 +6,8 @@ use super::basis::{best_child, child_local, mul2, PatchCoef};
 use super::types::{EvalError, EvalKind, EvalWeights};
 use super::Evaluator;
 use crate::local::{
-    child_nfaces, child_row, children, corner_points, regular_patch, two_ring, Adjacency,
-    ChildVertex, LocalMesh,
+    child_nfaces, child_row, children, corner_points, patch_scheme, regular_patch, two_ring,
+    Adjacency, ChildVertex, LocalMesh,
 };
 use crate::mask::Mask;
 use crate::scheme::Scheme;
@@ -39,11 +39,9 @@ impl Evaluator {
             if let Some(c) = regular_patch(&mesh, &adj, scheme, t) {
                 return Ok(PatchCoef::new(&mesh, &c).eval(scheme, u, v, a, depth));
             }
-            let corners: &[[f64; 2]] = match scheme {
+            let corners: &[[f64; 2]] = match patch_scheme(scheme, mesh.face(t).len()) {
                 Scheme::Loop => &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-                Scheme::CatmullClark | Scheme::QuadTriangle => {
-                    &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
-                }
+                _ => &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
             };
             let at = corners.iter().position(|c| c[0] == u && c[1] == v);
             let limit_ok = scheme == Scheme::Loop || depth >= 1;

@@ -5,7 +5,9 @@ use super::basis::{best_child, child_local, mul2, PatchCoef};
 use super::memo::{make_node, MemoBudget, Node, CACHE_DEPTH, DEFAULT_CACHE_BYTES};
 use super::types::{EvalError, EvalWeights, SurfaceParam, SurfacePoint};
 use crate::error::SubdivError;
-use crate::local::{children, corner_points, regular_patch, two_ring, LocalMesh, BOUNDARY, SHARP};
+use crate::local::{
+    children, corner_points, patch_scheme, regular_patch, two_ring, LocalMesh, BOUNDARY, SHARP,
+};
 use crate::scheme::{Options, Scheme};
 use crate::topology::Topology;
 use rayon::prelude::*;
@@ -60,13 +62,6 @@ impl Evaluator {
                 return Err(SubdivError::NotTriangles { face, len: f.len() }.into());
             }
         }
-        if options.scheme == Scheme::QuadTriangle {
-            return Err(SubdivError::Unsupported {
-                scheme: options.scheme,
-                what: "exact evaluation at (face, u, v) and closest points (use the sampling operator)",
-            }
-            .into());
-        }
         let topo = Topology::new(faces, num_vertices)?;
         let nf = faces.len();
         let mut flags = vec![0u8; faces.indices().len()];
@@ -106,8 +101,11 @@ impl Evaluator {
         let mut patch_start = Vec::with_capacity(nf + 1);
         patch_start.push(0u32);
         for face in faces.iter() {
+            // n-gons (Catmull-Clark: any non-quad; quad/triangle: five sides or more) are
+            // split into quad sub-patches.
             let n = match (options.scheme, face.len()) {
                 (Scheme::CatmullClark, n) if n != 4 => n as u32,
+                (Scheme::QuadTriangle, n) if n > 4 => n as u32,
                 _ => 1,
             };
             patch_start.push(patch_start.last().unwrap() + n);
@@ -130,9 +128,8 @@ impl Evaluator {
         let regular: Vec<Option<PatchCoef>> = (0..nf)
             .into_par_iter()
             .map(|f| {
-                if ev.faces.face_len(subfit_mesh::FaceId(f as u32))
-                    != options.scheme.regular_face_size()
-                {
+                let len = ev.faces.face_len(subfit_mesh::FaceId(f as u32));
+                if len != patch_scheme(options.scheme, len).regular_face_size() {
                     return None;
                 }
                 let (mesh, t) = ev.extract(f as u32);
@@ -255,9 +252,16 @@ impl Evaluator {
         )
     }
 
-    /// Whether patches of this evaluator are triangles (Loop) rather than quads.
+    /// Whether every patch of this evaluator is a triangle (Loop) rather than a quad.
     pub fn triangular(&self) -> bool {
         self.options.scheme == Scheme::Loop
+    }
+
+    /// Whether the patches of control face `face` are triangles (parameters `u, v ≥ 0`,
+    /// `u + v ≤ 1`) rather than unit squares: a triangle under Loop or quad/triangle.
+    pub fn triangle_patch(&self, face: u32) -> bool {
+        let len = self.faces.face_len(subfit_mesh::FaceId(face));
+        !self.options.scheme.splits_into_quads(len)
     }
 
     fn check(&self, p: &SurfaceParam) -> Result<(f64, f64), EvalError> {
@@ -291,7 +295,7 @@ impl Evaluator {
         }
         u = u.max(0.0);
         v = v.max(0.0);
-        if self.triangular() {
+        if self.triangle_patch(p.face) {
             if u + v > 1.0 + TOL {
                 return Err(bad());
             }
@@ -422,7 +426,7 @@ impl Evaluator {
     fn root_node(&self, face: u32, sub: u32) -> Node {
         let scheme = self.options.scheme;
         let (mesh, t) = self.extract(face);
-        if scheme == Scheme::CatmullClark && mesh.face(t).len() != 4 {
+        if self.options.scheme.splits_into_quads(mesh.face(t).len()) && mesh.face(t).len() != 4 {
             return self
                 .refine_local(&mesh, t, sub as usize)
                 .map_or(Node::Failed, |(m, c, _)| make_node(m, c, scheme));
@@ -432,7 +436,11 @@ impl Evaluator {
 
     /// Whether `(u, v)` is exactly a corner of face `t` of `mesh` at an irregular vertex.
     fn irregular_corner(&self, mesh: &LocalMesh, t: usize, u: f64, v: f64) -> bool {
-        let k = match (self.triangular(), u, v) {
+        let k = match (
+            patch_scheme(self.options.scheme, mesh.face(t).len()) == Scheme::Loop,
+            u,
+            v,
+        ) {
             (_, 0.0, 0.0) => 0,
             (_, 1.0, 0.0) => 1,
             (true, 0.0, 1.0) => 2,

@@ -18,7 +18,7 @@ impl Evaluator {
                 let p = (rng.next_f64() * np as f64) as usize;
                 let (face, sub) = self.patch(p.min(np - 1));
                 let (mut u, mut v) = (rng.next_f64(), rng.next_f64());
-                if self.triangular() && u + v > 1.0 {
+                if self.triangle_patch(face) && u + v > 1.0 {
                     (u, v) = (1.0 - u, 1.0 - v);
                 }
                 SurfaceParam { face, sub, u, v }
