@@ -61,6 +61,14 @@ pub struct InitArgs {
     /// Genus expected of a point-cloud target (checked with `--require-genus`, reported otherwise).
     #[arg(long)]
     pub genus: Option<u32>,
+    /// Pair the cage's triangles into quads along the target's principal curvature directions
+    /// (a quad-dominant cage for Catmull-Clark, same vertex count) [default: off, a triangle
+    /// cage].
+    #[arg(long, conflicts_with = "no_quad_dominant")]
+    pub quad_dominant: bool,
+    /// Keep the cage all triangles (the default).
+    #[arg(long)]
+    pub no_quad_dominant: bool,
     /// Output control mesh (.obj, .ply, .off or .stl), in the target's coordinates.
     #[arg(short, long, default_value = "control.obj")]
     pub output: PathBuf,
@@ -213,10 +221,27 @@ pub struct FitArgs {
     /// Subdivision scheme; `auto` picks Loop for all-triangle meshes, Catmull-Clark otherwise.
     #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
     pub scheme: SchemeArg,
+    /// Pair the cage's triangles into quads along the target's principal curvature directions
+    /// (a quad-dominant cage, same control points) [default: on for `--scheme catmull-clark`,
+    /// off for Loop and for `auto`, which picks Loop for the all-triangle automatic cage].
+    #[arg(long, conflicts_with = "no_quad_dominant")]
+    pub quad_dominant: bool,
+    /// Keep the cage all triangles (see `--quad-dominant`).
+    #[arg(long)]
+    pub no_quad_dominant: bool,
     /// Output directory (control.obj, control.usda, limit.ply, error.ply, log.csv,
     /// report.json).
     #[arg(short, long, default_value = "subfit-fit")]
     pub output: PathBuf,
+}
+
+/// `--quad-dominant` / `--no-quad-dominant` as the library's `Option<bool>` (`None`: neither).
+pub fn quad_dominant_flag(on: bool, off: bool) -> Option<bool> {
+    match (on, off) {
+        (true, _) => Some(true),
+        (_, true) => Some(false),
+        _ => None,
+    }
 }
 
 /// An error term named on the command line.

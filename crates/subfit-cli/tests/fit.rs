@@ -323,3 +323,77 @@ fn fit_local_optimizes_only_around_refinements() {
     );
     assert!(e1 < e0, "{e0} -> {e1}");
 }
+
+/// Runs `subfit fit CLOUD --scheme catmull-clark -o DIR EXTRA…` and returns report.json.
+fn fit_cc(cloud: &Path, dir: &Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "fit",
+        cloud.to_str().unwrap(),
+        "--scheme",
+        "catmull-clark",
+        "-o",
+        dir.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let r = subfit(&args);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    report(dir)
+}
+
+#[test]
+fn catmull_clark_fits_start_from_a_quad_dominant_cage() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = d.path().join("ellipsoid.ply");
+    save(&cloud, &Shape::PAPER_ELLIPSOID.sample(8_000, 0.0, 3));
+    let quads = fit_cc(&cloud, &d.path().join("quads"), &[]);
+    let tris = fit_cc(&cloud, &d.path().join("tris"), &["--no-quad-dominant"]);
+    // The cage is paired before the fit, with the same control points.
+    assert_eq!(quads["init"]["paired"], true);
+    assert!(
+        quads["init"]["quad_fraction"].as_f64().unwrap() >= 0.85,
+        "{}",
+        quads["init"]
+    );
+    assert!(quads["control_quad_fraction"].as_f64().unwrap() >= 0.7);
+    assert_eq!(
+        quads["init"]["control_points"],
+        tris["init"]["control_points"]
+    );
+    assert_eq!(tris["init"]["paired"], false);
+    assert_eq!(tris["control_quad_fraction"].as_f64().unwrap(), 0.0);
+    let q = quads["init"]["quads"].as_u64().unwrap();
+    let t = quads["init"]["triangles"].as_u64().unwrap();
+    assert_eq!(q + t, quads["init"]["faces"].as_u64().unwrap());
+    // Both reach the default tolerance both ways; the quad cage fits about as well.
+    for rep in [&quads, &tris] {
+        assert!(
+            rep["tolerance_reached_two_sided"].as_bool().unwrap(),
+            "{rep}"
+        );
+    }
+    let e = |r: &serde_json::Value| r["final"]["two_sided"]["e_rms"].as_f64().unwrap();
+    assert!(e(&quads) <= 1.5 * e(&tris), "{} vs {}", e(&quads), e(&tris));
+    // Without a scheme the all-triangle automatic cage is fitted with Loop, unpaired.
+    let auto = d.path().join("auto");
+    let r = subfit(&["fit", cloud.to_str().unwrap(), "-o", auto.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(0));
+    let rep = report(&auto);
+    assert_eq!(rep["options"]["scheme"], "Loop");
+    assert_eq!(rep["init"]["paired"], false);
+    // Quads and Loop do not mix.
+    let r = subfit(&[
+        "fit",
+        cloud.to_str().unwrap(),
+        "--scheme",
+        "loop",
+        "--quad-dominant",
+        "-o",
+        d.path().join("bad").to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+}

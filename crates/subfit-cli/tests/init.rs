@@ -259,3 +259,54 @@ fn known_genus_rescues_a_cloud_with_bad_normals() {
     assert!(v.len() <= 150);
     assert_eq!(closed_genus(v.len(), &f), 1, "{text}");
 }
+
+#[test]
+fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
+    let d = tempfile::tempdir().unwrap();
+    let torus = write(d.path(), "torus.obj", &torus_obj(60, 24));
+    let out = d.path().join("quads.obj");
+    let r = subfit(&[
+        "init",
+        torus.to_str().unwrap(),
+        "--control-points",
+        "120",
+        "--quad-dominant",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&r.stdout);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert!(stdout.contains("triangles paired"), "{stdout}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let sizes: Vec<usize> = text
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .map(|l| l.split_whitespace().count() - 1)
+        .collect();
+    let quads = sizes.iter().filter(|&&n| n == 4).count();
+    assert!(sizes.iter().all(|&n| n == 3 || n == 4));
+    assert!(
+        quads as f64 >= 0.85 * sizes.len() as f64,
+        "{quads} of {}",
+        sizes.len()
+    );
+    // Genus 1 with mixed faces: χ = V − E + F, E = Σ sizes / 2.
+    let v = text.lines().filter(|l| l.starts_with("v ")).count() as i64;
+    let e = sizes.iter().sum::<usize>() as i64 / 2;
+    assert_eq!(v - e + sizes.len() as i64, 0, "χ of a torus");
+    // The flags conflict.
+    let r = subfit(&[
+        "init",
+        torus.to_str().unwrap(),
+        "--quad-dominant",
+        "--no-quad-dominant",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+}

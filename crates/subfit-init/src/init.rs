@@ -13,6 +13,7 @@ use subfit_target::Target;
 
 use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
+use crate::quads::{pair_triangles, PairOptions, PairReport};
 use crate::simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
 
 /// Options of [`initial_control_mesh`].
@@ -37,6 +38,13 @@ pub struct InitOptions {
     /// [`ContourOptions::max_resolution`]), so that the simplification has room to place the
     /// control vertices. Default 8.
     pub contour_vertices_per_control: f64,
+    /// Pair the simplified triangle cage into a quad-dominant one
+    /// ([`crate::quads::pair_triangles`], along the target's principal directions) for
+    /// Catmull-Clark or quad/triangle fits. The vertices (control points) do not change.
+    /// Default `false` (all triangles, for Loop).
+    pub quad_dominant: bool,
+    /// Options of the pairing (used with [`Self::quad_dominant`]).
+    pub pairing: PairOptions,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
     /// level and per batch of cells, evaluations and edge collapses; once cancelled,
@@ -53,6 +61,8 @@ impl Default for InitOptions {
             expected_genus: None,
             require_genus: false,
             contour_vertices_per_control: 8.0,
+            quad_dominant: false,
+            pairing: PairOptions::default(),
             cancel: Cancel::default(),
         }
     }
@@ -101,6 +111,8 @@ pub struct InitTimings {
     pub contour: Duration,
     /// Simplification.
     pub simplify: Duration,
+    /// Pairing triangles into quads (zero unless [`InitOptions::quad_dominant`]).
+    pub pair: Duration,
     /// Everything, including validation.
     pub total: Duration,
 }
@@ -133,6 +145,8 @@ pub struct InitReport {
     /// [`InitOptions::expected_genus`] and the space-carving fallback ([`crate::carve()`]) was
     /// used; `None` otherwise.
     pub carve_radius: Option<f64>,
+    /// The pairing into quads, with [`InitOptions::quad_dominant`].
+    pub pairing: Option<PairReport>,
     /// Step times.
     pub timings: InitTimings,
 }
@@ -214,7 +228,8 @@ impl From<Cancelled> for InitError {
     }
 }
 
-/// An initial triangle control mesh with about `n_vertices` vertices and the target's topology.
+/// An initial triangle control mesh with about `n_vertices` vertices and the target's topology
+/// (quad-dominant with [`InitOptions::quad_dominant`]).
 ///
 /// * `mesh = Some(m)` with faces: `m` (in the target's **original** coordinates, e.g. the mesh the
 ///   target was built from) is mapped into normalized units and simplified.
@@ -235,7 +250,7 @@ impl From<Cancelled> for InitError {
 ///
 /// Cost: contouring `O(n log n + n·k)` for the `n` octree points (proportional to the band around
 /// the data, see [`crate::contour()`]) and `k` points per IMLS neighbourhood, simplification
-/// `O(E log E)`.
+/// `O(E log E)`, pairing `O(E log E)` (see [`crate::quads`](mod@crate::quads)).
 pub fn initial_control_mesh(
     target: &Target,
     mesh: Option<&PolyMesh>,
@@ -291,9 +306,22 @@ pub fn initial_control_mesh(
         cancel: options.cancel.clone(),
         ..options.simplify.clone()
     };
-    let (out, srep) = simplify(&dense, &sopt)?;
+    let (mut out, srep) = simplify(&dense, &sopt)?;
     report.timings.simplify = t.elapsed();
     report.simplify = srep;
+    if options.quad_dominant {
+        options.cancel.check()?;
+        let t = Instant::now();
+        let (paired, prep) = pair_triangles(
+            &out,
+            &subfit_mesh::Tags::new(),
+            Some(target),
+            &options.pairing,
+        )?;
+        out = paired;
+        report.timings.pair = t.elapsed();
+        report.pairing = Some(prep);
+    }
 
     let after = HalfEdgeMesh::from_mesh(&out)?;
     report.genus_after = after.genus();

@@ -12,6 +12,8 @@
 //!   fallback when the IMLS contour misses an expected genus (e.g. badly oriented normals).
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
 //!   contoured then simplified; the genus is checked against the target's and reported.
+//! * [`quads`](mod@quads): [`pair_triangles`] turns a triangle cage into a quad-dominant one,
+//!   pairing triangles along the principal curvature directions (Lavoué et al. 2007 §4.3).
 //!
 //! Everything works in the target's normalized units (the unit cube). The library prints nothing.
 
@@ -23,6 +25,7 @@ pub mod contour;
 pub mod init;
 mod march;
 mod octree;
+pub mod quads;
 pub mod simplify;
 
 pub use carve::carve;
@@ -31,4 +34,5 @@ pub use init::{
     default_control_points, initial_control_mesh, min_vertices_for_topology, InitError,
     InitOptions, InitReport, InitSource, InitTimings,
 };
+pub use quads::{coherency_score, pair_triangles, PairOptions, PairReport};
 pub use simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};

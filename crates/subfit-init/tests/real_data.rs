@@ -129,3 +129,46 @@ fn every_model_gives_a_cage_of_its_topology() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Pairing the cages of every model into quads (Lavoué et al. 2007 §4.3) keeps their topology
+/// and leaves at least 70 % of the faces quads.
+#[test]
+fn every_model_gives_a_quad_dominant_cage() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    let opts = InitOptions {
+        quad_dominant: true,
+        ..InitOptions::default()
+    };
+    let mut failures = Vec::new();
+    for name in CLOSED.iter().chain(OPEN) {
+        let mesh = match subfit_io::read_file(&dir.join(name), &subfit_io::ReadOptions::default()) {
+            Ok((m, _)) => m,
+            Err(e) => {
+                failures.push(format!("{name}: {e}"));
+                continue;
+            }
+        };
+        let d = diagnose_mesh(&mesh);
+        let (genus, loops) = (d.genus.unwrap_or(0), d.boundary_loops);
+        let t = Target::from_mesh(&mesh, &TargetOptions::default()).unwrap();
+        match initial_control_mesh(&t, Some(&mesh), N, &opts) {
+            Ok((cage, rep)) => {
+                let p = rep.pairing.clone().expect("paired");
+                #[allow(clippy::print_stderr)] // the figures are the point
+                {
+                    eprintln!("{name}: {:.1} % quads ({p:?})", 100.0 * p.quad_fraction());
+                }
+                if let Err(e) = check_cage(&cage, &rep, genus, loops) {
+                    failures.push(format!("{name}: {e}"));
+                }
+                if p.quad_fraction() < 0.7 {
+                    failures.push(format!("{name}: {p:?}"));
+                }
+            }
+            Err(e) => failures.push(format!("{name}: {e}")),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}

@@ -108,6 +108,18 @@ pub struct InitSummary {
     pub control_points: usize,
     /// Faces.
     pub faces: usize,
+    /// Quads among the faces.
+    #[serde(default)]
+    pub quads: usize,
+    /// Triangles among the faces.
+    #[serde(default)]
+    pub triangles: usize,
+    /// Quads over all faces, in `[0, 1]`.
+    #[serde(default)]
+    pub quad_fraction: f64,
+    /// Whether the triangle cage was paired into a quad-dominant one (`quad_dominant`).
+    #[serde(default)]
+    pub paired: bool,
     /// The target's genus (as the initial mesh saw it).
     pub genus_target: u32,
     /// The cage's genus.
@@ -118,6 +130,18 @@ pub struct InitSummary {
     pub boundary_loops: BoundaryLoops,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
+}
+
+/// Quads and triangles of `faces`, and the fraction of quads (0 without faces). Cost `O(F)`.
+pub fn face_counts(faces: &subfit_mesh::Polygons) -> (usize, usize, f64) {
+    let quads = faces.iter().filter(|f| f.len() == 4).count();
+    let triangles = faces.iter().filter(|f| f.len() == 3).count();
+    let fraction = if faces.is_empty() {
+        0.0
+    } else {
+        quads as f64 / faces.len() as f64
+    };
+    (quads, triangles, fraction)
 }
 
 /// Boundary loops of the target and the cage.
@@ -136,6 +160,9 @@ pub struct InitTimings {
     pub contour: f64,
     /// Simplification.
     pub simplify: f64,
+    /// Pairing triangles into quads.
+    #[serde(default)]
+    pub pair: f64,
     /// All of it.
     pub total: f64,
 }
@@ -404,6 +431,9 @@ pub struct Report {
     pub control_points: usize,
     /// Faces of the cage written.
     pub control_faces: usize,
+    /// Quads over all faces of the cage written, in `[0, 1]`.
+    #[serde(default)]
+    pub control_quad_fraction: f64,
     /// Crease edges and corners of the cage written.
     pub tags: TagCounts,
     /// Surface → data errors of the initial cage.

@@ -15,7 +15,9 @@ use subfit_fit::{
     fit_stages, DataTerm, FitOptions, FootPointTerm, IterationRow, StageEvent, StageOptions,
     StageReport, StagesResult,
 };
-use subfit_init::{default_control_points, initial_control_mesh, InitOptions, InitReport};
+use subfit_init::{
+    default_control_points, initial_control_mesh, pair_triangles, InitOptions, InitReport,
+};
 use subfit_mesh::{reorient_faces, Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::{Target, TargetOptions};
@@ -24,9 +26,9 @@ use crate::error::Error;
 use subfit_report::{data_samples, limit_tessellation, DistanceStats, MeshDistance, TwoSided};
 
 use crate::pipeline_report::{
-    BoundaryLoops, Errors, FinalErrors, InitSummary, InitTimings, IterationSummary, OptionsSummary,
-    Reorientation, Report, RmsMax, StageSummary, TagCounts, TessellationSummary, Timings, Topology,
-    TwoSidedErrors, UsdDifference,
+    face_counts, BoundaryLoops, Errors, FinalErrors, InitSummary, InitTimings, IterationSummary,
+    OptionsSummary, Reorientation, Report, RmsMax, StageSummary, TagCounts, TessellationSummary,
+    Timings, Topology, TwoSidedErrors, UsdDifference,
 };
 
 /// The scan to fit.
@@ -78,6 +80,15 @@ pub struct FitScanOptions {
     /// Subdivision scheme; `None` (default): Loop for an all-triangle cage, Catmull-Clark
     /// otherwise.
     pub scheme: Option<Scheme>,
+    /// Pair the triangles of the initial cage into quads before the fit
+    /// ([`subfit_init::pair_triangles`]: a quad-dominant cage along the target's principal
+    /// directions, same control points). `None` (default): on for an automatic cage when
+    /// [`Self::scheme`] is given and is not Loop (Catmull-Clark, quad/triangle), off otherwise
+    /// (an automatic cage is all triangles, so an inferred scheme is Loop). `Some(true)` also
+    /// pairs the triangles of a given cage (keeping its tagged creases) and, with no scheme
+    /// given, makes the inferred scheme Catmull-Clark; it cannot be combined with Loop.
+    /// It replaces [`InitOptions::quad_dominant`] in [`Self::init_options`].
+    pub quad_dominant: Option<bool>,
     /// Per-iteration options (method, step control, sample level, solver). Its scheme, tags,
     /// `λ`, tolerances and iteration caps are set by the pipeline.
     pub fit: FitOptions,
@@ -103,6 +114,7 @@ impl Default for FitScanOptions {
             control_points: None,
             as_points: false,
             scheme: None,
+            quad_dominant: None,
             fit: FitOptions::default(),
             stages: StageOptions::default(),
             target: TargetOptions::default(),
@@ -251,6 +263,10 @@ pub fn fit_scan(
     // what topology to aim for.
     let mut init_options = options.init_options.clone();
     init_options.cancel = options.cancel.clone();
+    // Catmull-Clark and quad/triangle cages start quad-dominant; Loop needs triangles.
+    init_options.quad_dominant = options
+        .quad_dominant
+        .unwrap_or(options.scheme.is_some_and(|s| s != Scheme::Loop));
     if options.as_points && !mesh.faces.is_empty() {
         init_options.expected_genus = topology(&mesh).ok().map(|t| t.genus);
         mesh.faces = Polygons::new();
@@ -299,19 +315,32 @@ pub fn fit_scan(
                     c.num_vertices()
                 )));
             }
-            let normalized = PolyMesh::new(
+            let mut normalized = PolyMesh::new(
                 c.positions
                     .iter()
                     .map(|&p| target.to_normalized(p))
                     .collect(),
                 c.faces.clone(),
             );
+            let t_pair = Instant::now();
+            let paired = options.quad_dominant == Some(true);
+            if paired {
+                let (m, _) =
+                    pair_triangles(&normalized, tags, Some(&target), &init_options.pairing)
+                        .map_err(|e| Error::input(cname, e))?;
+                normalized = m;
+            }
+            let (quads, triangles, quad_fraction) = face_counts(&normalized.faces);
             let summary = InitSummary {
                 source: "File".into(),
                 file: Some(cname.clone()),
                 requested_control_points: None,
                 control_points: c.num_vertices(),
-                faces: c.faces.len(),
+                faces: normalized.faces.len(),
+                quads,
+                triangles,
+                quad_fraction,
+                paired,
                 genus_target: target_topology.map_or(topo.genus, |t| t.genus),
                 genus: topo.genus,
                 genus_matches: target_topology.is_none_or(|t| t.genus == topo.genus),
@@ -319,7 +348,11 @@ pub fn fit_scan(
                     target: target_topology.map_or(topo.boundary_loops, |t| t.boundary_loops),
                     cage: topo.boundary_loops,
                 },
-                timings_s: InitTimings::default(),
+                timings_s: InitTimings {
+                    pair: t_pair.elapsed().as_secs_f64(),
+                    total: t_pair.elapsed().as_secs_f64(),
+                    ..InitTimings::default()
+                },
             };
             (normalized, tags.clone(), summary)
         }
@@ -510,6 +543,7 @@ pub fn fit_scan(
         },
         control_points: result.mesh.num_vertices(),
         control_faces: result.mesh.faces.len(),
+        control_quad_fraction: face_counts(&result.mesh.faces).2,
         tags: TagCounts {
             creases: result.tags.creases().len(),
             corners: result.tags.corners().len(),
@@ -659,6 +693,9 @@ fn validate(o: &FitScanOptions) -> Result<(), Error> {
             ));
         }
     }
+    if o.quad_dominant == Some(true) && o.scheme == Some(Scheme::Loop) {
+        return bad("--quad-dominant makes quads, and the Loop scheme needs triangles: use --scheme catmull-clark (or drop --quad-dominant)".into());
+    }
     if matches!(o.init, InitialCage::Given { .. }) && o.control_points.is_some() {
         return bad("--control-points sets the size of the automatic initial mesh; it cannot be used with --init FILE".into());
     }
@@ -687,12 +724,17 @@ fn topology(m: &PolyMesh) -> Result<Topology, subfit_mesh::TopologyError> {
 }
 
 fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
+    let (quads, triangles, quad_fraction) = face_counts(&m.faces);
     InitSummary {
         source: format!("{:?}", r.source),
         file: None,
         requested_control_points: Some(requested),
         control_points: m.num_vertices(),
         faces: m.faces.len(),
+        quads,
+        triangles,
+        quad_fraction,
+        paired: r.pairing.is_some(),
         genus_target: r.genus_target,
         genus: r.genus_after,
         genus_matches: r.genus_matches,
@@ -703,6 +745,7 @@ fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
         timings_s: InitTimings {
             contour: r.timings.contour.as_secs_f64(),
             simplify: r.timings.simplify.as_secs_f64(),
+            pair: r.timings.pair.as_secs_f64(),
             total: r.timings.total.as_secs_f64(),
         },
     }

@@ -10,10 +10,11 @@ use subfit::fit::{FitOptions, Method, StageOptions, StepControl};
 use subfit::subdiv::Scheme;
 use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, OUTPUTS};
 
-use crate::cli::{FitArgs, MethodArg, SchemeArg, StepArg};
+use crate::cli::{quad_dominant_flag, FitArgs, MethodArg, SchemeArg, StepArg};
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let fitted = execute(&a)?;
+    eprintln!("subfit: {}", init_line(&fitted.report.init));
     println!(
         "{}; wrote {} (look at {})",
         fitted.summary(),
@@ -62,6 +63,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             SchemeArg::CatmullClark => Some(Scheme::CatmullClark),
             SchemeArg::QuadTri => Some(Scheme::QuadTriangle),
         },
+        quad_dominant: quad_dominant_flag(a.quad_dominant, a.no_quad_dominant),
         fit: FitOptions {
             sample_level: a.sample_level as usize,
             method,
@@ -156,6 +158,20 @@ pub fn run_with_progress(
         b.finish_and_clear();
     }
     Ok(out?)
+}
+
+/// The initial cage in one line: control points, faces, quads and triangles.
+pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
+    format!(
+        "initial cage ({}): {} control points, {} faces: {} quads, {} triangles ({:.0}% quads{})",
+        i.source,
+        i.control_points,
+        i.faces,
+        i.quads,
+        i.triangles,
+        100.0 * i.quad_fraction,
+        if i.paired { ", triangles paired" } else { "" }
+    )
 }
 
 /// Blender subdivides Catmull-Clark meshes only: says so when a Loop cage is written.

@@ -4,6 +4,7 @@
 //! Mesh targets are simplified (topology-preserving QEM); point clouds, or any target with
 //! `--from-points`, are contoured (IMLS on an adaptive octree + marching tetrahedra) and then simplified. The default
 //! size is [`subfit::init::default_control_points`]: `clamp(round(1.5·√points), 200, 2000)`.
+//! `--quad-dominant` pairs the triangles into quads ([`subfit::init::pair_triangles`]).
 
 use std::process::ExitCode;
 use std::time::Instant;
@@ -79,6 +80,8 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     let options = InitOptions {
         expected_genus,
         require_genus: a.require_genus,
+        quad_dominant: crate::cli::quad_dominant_flag(a.quad_dominant, a.no_quad_dominant)
+            .unwrap_or(false),
         cancel: crate::interrupt::token(),
         ..InitOptions::default()
     };
@@ -128,11 +131,12 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         );
     }
     println!(
-        "time: read {:.3} s, target {:.3} s, contour {:.3} s, simplify {:.3} s, write {:.3} s, total {:.3} s",
+        "time: read {:.3} s, target {:.3} s, contour {:.3} s, simplify {:.3} s, pair {:.3} s, write {:.3} s, total {:.3} s",
         read_time.as_secs_f64(),
         target_time.as_secs_f64(),
         report.timings.contour.as_secs_f64(),
         report.timings.simplify.as_secs_f64(),
+        report.timings.pair.as_secs_f64(),
         write_time.as_secs_f64(),
         t0.elapsed().as_secs_f64()
     );
@@ -208,10 +212,13 @@ fn print_summary(
             if r.genus_matches { "same" } else { "DIFFERENT" }
         )
     };
+    let quads = out.faces.iter().filter(|f| f.len() == 4).count();
+    let triangles = out.faces.iter().filter(|f| f.len() == 3).count();
     println!(
-        "cage: {} vertices ({requested} requested), {} faces, {}, {} component(s); {versus}",
+        "cage: {} vertices ({requested} requested), {} faces ({quads} quads, {triangles} triangles{}), {}, {} component(s); {versus}",
         out.num_vertices(),
         out.num_faces(),
+        if r.pairing.is_some() { ", triangles paired" } else { "" },
         topo(Some(r.genus_after), r.boundary_loops.1),
         r.components,
     );
