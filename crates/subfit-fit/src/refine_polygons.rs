@@ -46,11 +46,14 @@ pub enum TriangleSplit {
 }
 
 impl TriangleSplit {
-    /// The split the scheme itself makes: three quads for Catmull-Clark, four triangles for
-    /// every other scheme (Loop, the quad/triangle hybrid), so that the refinement is one
-    /// uniform subdivision step where it is uniform.
+    /// Four triangles for Loop (its own split, so the refinement is one uniform subdivision
+    /// step where it is uniform); three quads for Catmull-Clark (its own split) and for the
+    /// quad/triangle hybrid, whose own split (four triangles) would let triangles multiply: a
+    /// quad/triangle cage refined with three quads per triangle stays quad-dominant (fandisk:
+    /// 70% quads at 1,116 control points instead of 47% at 1,029, both at the tolerance). The
+    /// new face point is the triangle's centroid, so the limit surface moves a little there.
     pub fn for_scheme(scheme: Scheme) -> Self {
-        if scheme == Scheme::CatmullClark {
+        if scheme != Scheme::Loop {
             Self::ThreeQuads
         } else {
             Self::FourTriangles
