@@ -37,10 +37,12 @@ use subfit_target::Target;
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairOptions {
     /// Largest angle between the two triangles' normals (degrees) for which they may become a
-    /// quad; larger angles are folds. Default 45.
+    /// quad; larger angles are folds (sharp features of the target stay edges). Default 60.
     pub max_dihedral_deg: f64,
     /// Largest corner angle of a quad (degrees); near 180° the quad degenerates into a
-    /// triangle with a vertex on an edge. Default 165.
+    /// triangle with a vertex on an edge. Such quads score low (they are paired only when
+    /// nothing better is left), but on QEM cages of CAD parts, whose vertices line up along
+    /// the features, they pair many triangles that would stay alone. Default 175.
     pub max_corner_deg: f64,
     /// Weight of the coherency part of the score, in `[0, 1]` (the shape part gets the rest).
     /// Default 0.5. Ignored without a target.
@@ -55,8 +57,8 @@ pub struct PairOptions {
 impl Default for PairOptions {
     fn default() -> Self {
         Self {
-            max_dihedral_deg: 45.0,
-            max_corner_deg: 165.0,
+            max_dihedral_deg: 60.0,
+            max_corner_deg: 175.0,
             coherency_weight: 0.5,
             edge_samples: 5,
             search_limit: 400,
@@ -75,8 +77,11 @@ pub struct PairReport {
     pub other_faces: usize,
     /// Interior, untagged diagonals between two triangles.
     pub candidates: usize,
-    /// Candidates rejected as folds, non-convex or degenerate quads.
-    pub rejected: usize,
+    /// Candidates rejected as folds (dihedral above [`PairOptions::max_dihedral_deg`]).
+    pub rejected_folds: usize,
+    /// Candidates rejected as non-convex or degenerate quads (a corner above
+    /// [`PairOptions::max_corner_deg`], a reflex corner, a zero-length edge or area).
+    pub rejected_shape: usize,
     /// Pairs made by the greedy pass.
     pub greedy_pairs: usize,
     /// Augmenting paths applied (each adds one pair).
@@ -123,9 +128,10 @@ pub fn pair_triangles(
 ) -> Result<(PolyMesh, PairReport), TopologyError> {
     let he = HalfEdgeMesh::from_mesh(mesh)?;
     let mut report = PairReport::default();
-    let (cands, rejected) = candidates(&he, &mesh.positions, tags, target, options);
-    report.candidates = cands.len() + rejected;
-    report.rejected = rejected;
+    let (cands, [folds, shape]) = candidates(&he, &mesh.positions, tags, target, options);
+    report.candidates = cands.len() + folds + shape;
+    report.rejected_folds = folds;
+    report.rejected_shape = shape;
     let mut m = Matching::new(&he, &cands);
     report.greedy_pairs = m.greedy();
     report.augmentations = m.augment(options.search_limit);
@@ -167,14 +173,21 @@ struct Candidate {
     coherency_deg: f64,
 }
 
-/// The scored candidates (in half-edge order) and the number rejected.
+/// Why a candidate is not a quad.
+enum Reject {
+    Fold,
+    Shape,
+}
+
+/// The scored candidates (in half-edge order) and the numbers rejected as folds and for
+/// their shape.
 fn candidates(
     he: &HalfEdgeMesh,
     pos: &[[f64; 3]],
     tags: &Tags,
     target: Option<&Target>,
     o: &PairOptions,
-) -> (Vec<Candidate>, usize) {
+) -> (Vec<Candidate>, [usize; 2]) {
     let mut sc = EdgeCoherency::new(he, pos, target, o.edge_samples.max(2));
     let w = if target.is_some() {
         o.coherency_weight.clamp(0.0, 1.0)
@@ -182,7 +195,7 @@ fn candidates(
         0.0
     };
     let mut out = Vec::new();
-    let mut rejected = 0;
+    let mut rejected = [0, 0];
     for h in 0..he.num_half_edges() {
         let h = HalfEdgeId::from_usize(h);
         let Some(t) = he.twin(h) else { continue };
@@ -197,12 +210,21 @@ fn candidates(
         let b = he.dest(he.next(h)).0;
         let d = he.dest(he.next(t)).0;
         let quad = [a, b, c, d];
-        let Some(shape) = (b != d)
-            .then(|| shape_score(quad.map(|v| pos[v as usize]), o))
-            .flatten()
-        else {
-            rejected += 1;
-            continue;
+        let shape = if b == d {
+            Err(Reject::Shape)
+        } else {
+            shape_score(quad.map(|v| pos[v as usize]), o)
+        };
+        let shape = match shape {
+            Ok(s) => s,
+            Err(Reject::Fold) => {
+                rejected[0] += 1;
+                continue;
+            }
+            Err(Reject::Shape) => {
+                rejected[1] += 1;
+                continue;
+            }
         };
         // The quad's edges a→b, b→c (in f) and c→d, d→a (in g).
         let sides = [he.next(h), he.prev(h), he.next(t), he.prev(t)];
@@ -217,22 +239,22 @@ fn candidates(
     (out, rejected)
 }
 
-/// Shape score in `[0, 1]` of the quad `p` (corners in order, diagonal `p0`–`p2`), or `None`
-/// for a fold, a non-convex or degenerate quad: `(1 − (mean + max corner deviation from
+/// Shape score in `[0, 1]` of the quad `p` (corners in order, diagonal `p0`–`p2`), or why it
+/// is rejected (a fold, a non-convex or degenerate quad): `(1 − (mean + max corner deviation from
 /// 90°) / 180°) · (1 − ½ dihedral / max dihedral)`.
-fn shape_score(p: [[f64; 3]; 4], o: &PairOptions) -> Option<f64> {
+fn shape_score(p: [[f64; 3]; 4], o: &PairOptions) -> Result<f64, Reject> {
     let n1 = cross(sub(p[1], p[0]), sub(p[2], p[0]));
     let n2 = cross(sub(p[2], p[0]), sub(p[3], p[0]));
     let (l1, l2) = (norm(n1), norm(n2));
     if !(l1 > 0.0 && l2 > 0.0) {
-        return None;
+        return Err(Reject::Shape);
     }
     let dihedral = (dot(n1, n2) / (l1 * l2))
         .clamp(-1.0, 1.0)
         .acos()
         .to_degrees();
     if !(dihedral <= o.max_dihedral_deg) {
-        return None;
+        return Err(Reject::Fold);
     }
     let n = add(scale(n1, 1.0 / l1), scale(n2, 1.0 / l2));
     let (mut sum, mut worst) = (0.0, 0.0f64);
@@ -241,18 +263,18 @@ fn shape_score(p: [[f64; 3]; 4], o: &PairOptions) -> Option<f64> {
         let (u, v) = (sub(prev, cur), sub(next, cur));
         let (lu, lv) = (norm(u), norm(v));
         if !(lu > 0.0 && lv > 0.0) || dot(cross(sub(cur, prev), v), n) <= 0.0 {
-            return None; // a zero-length edge, or a reflex corner
+            return Err(Reject::Shape); // a zero-length edge, or a reflex corner
         }
         let angle = (dot(u, v) / (lu * lv)).clamp(-1.0, 1.0).acos().to_degrees();
         if angle > o.max_corner_deg {
-            return None;
+            return Err(Reject::Shape);
         }
         let dev = (angle - 90.0).abs();
         sum += dev;
         worst = worst.max(dev);
     }
     let angles = 1.0 - (sum / 4.0 + worst) / 180.0;
-    Some(angles * (1.0 - 0.5 * dihedral / o.max_dihedral_deg.max(1e-9)))
+    Ok(angles * (1.0 - 0.5 * dihedral / o.max_dihedral_deg.max(1e-9)))
 }
 
 /// Lavoué's `SC` per cage edge, computed once per edge and cached.
