@@ -62,13 +62,17 @@ pub struct InitArgs {
     #[arg(long)]
     pub genus: Option<u32>,
     /// Pair the cage's triangles into quads along the target's principal curvature directions
-    /// (a quad-dominant cage for Catmull-Clark, same vertex count) [default: off, a triangle
-    /// cage].
+    /// (a quad-dominant cage for Catmull-Clark, same vertex count) [default: on for
+    /// `--scheme catmull-clark` and `quad-tri`, off otherwise (a triangle cage)].
     #[arg(long, conflicts_with = "no_quad_dominant")]
     pub quad_dominant: bool,
-    /// Keep the cage all triangles (the default).
+    /// Keep the cage all triangles.
     #[arg(long)]
     pub no_quad_dominant: bool,
+    /// The scheme the cage is for: `catmull-clark` and `quad-tri` make it quad-dominant unless
+    /// `--no-quad-dominant`; `loop` and `auto` keep triangles.
+    #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
+    pub scheme: SchemeArg,
     /// Output control mesh (.obj, .ply, .off or .stl), in the target's coordinates.
     #[arg(short, long, default_value = "control.obj")]
     pub output: PathBuf,

@@ -309,4 +309,36 @@ fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(r.status.code(), Some(2));
+    // `--scheme quad-tri` (and catmull-clark) pairs by default; `--scheme loop` keeps triangles
+    // and refuses `--quad-dominant`.
+    for (scheme, paired) in [("quad-tri", true), ("catmull-clark", true), ("loop", false)] {
+        let r = subfit(&[
+            "init",
+            torus.to_str().unwrap(),
+            "--control-points",
+            "120",
+            "--scheme",
+            scheme,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(r.status.code(), Some(0), "{scheme}");
+        let stdout = String::from_utf8_lossy(&r.stdout);
+        assert_eq!(
+            stdout.contains("triangles paired"),
+            paired,
+            "{scheme}: {stdout}"
+        );
+    }
+    let r = subfit(&[
+        "init",
+        torus.to_str().unwrap(),
+        "--scheme",
+        "loop",
+        "--quad-dominant",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("Loop"));
 }

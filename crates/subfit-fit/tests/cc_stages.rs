@@ -21,15 +21,10 @@ fn quad_ellipsoid_cage() -> PolyMesh {
     m
 }
 
-/// Before local refinement for Catmull-Clark, this cage kept its 26 points and stalled above
-/// the tolerance (the `refine: false` run below is that behaviour); now it grows across stages,
-/// reaches the two-sided tolerance and stays quad-dominant.
-#[test]
-fn catmull_clark_quad_cage_is_refined_to_the_two_sided_tolerance() {
-    let target = ellipsoid_target(20_000);
-    let cage = normalized(&target, &quad_ellipsoid_cage());
+/// Level-3 samples, two-sided RMS tolerance 2e-4, at most 600 control points and 12 stages.
+fn options(scheme: Scheme) -> (FitOptions, StageOptions) {
     let base = FitOptions {
-        scheme: Scheme::CatmullClark,
+        scheme,
         sample_level: 3,
         ..FitOptions::default()
     };
@@ -39,6 +34,17 @@ fn catmull_clark_quad_cage_is_refined_to_the_two_sided_tolerance() {
         max_stages: 12,
         ..StageOptions::default()
     };
+    (base, stages)
+}
+
+/// Before local refinement for Catmull-Clark, this cage kept its 26 points and stalled above
+/// the tolerance (the `refine: false` run below is that behaviour); now it grows across stages,
+/// reaches the two-sided tolerance and stays quad-dominant.
+#[test]
+fn catmull_clark_quad_cage_is_refined_to_the_two_sided_tolerance() {
+    let target = ellipsoid_target(20_000);
+    let cage = normalized(&target, &quad_ellipsoid_cage());
+    let (base, stages) = options(Scheme::CatmullClark);
     let run = |refine: bool| {
         let opts = StageOptions {
             refine,
@@ -101,23 +107,14 @@ fn mixed_ellipsoid_cage() -> PolyMesh {
     PolyMesh::new(m.positions, faces)
 }
 
-/// The quad/triangle scheme (Stam & Loop 2003) fits a mixed cage with refinement: triangles
-/// split into triangles, quads into quads, and the two-sided tolerance is reached.
+/// The quad/triangle scheme (Stam & Loop 2003) fits a mixed cage with refinement (marked faces
+/// split into quads, transitions closed with quads and triangles), and the two-sided tolerance
+/// is reached.
 #[test]
 fn quad_triangle_mixed_cage_is_refined_to_the_two_sided_tolerance() {
     let target = ellipsoid_target(20_000);
     let cage = normalized(&target, &mixed_ellipsoid_cage());
-    let base = FitOptions {
-        scheme: Scheme::QuadTriangle,
-        sample_level: 3,
-        ..FitOptions::default()
-    };
-    let stages = StageOptions {
-        tolerance_rms: 2e-4,
-        max_control_points: 600,
-        max_stages: 12,
-        ..StageOptions::default()
-    };
+    let (base, stages) = options(Scheme::QuadTriangle);
     let out = fit_stages(&target, &cage, &base, &stages, None).unwrap();
     let r = &out.report;
     let summary: Vec<_> = r

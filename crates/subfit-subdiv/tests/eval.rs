@@ -43,9 +43,8 @@ fn bicone(n: usize) -> (Vec<[f64; 3]>, Polygons) {
     (p, f)
 }
 
-/// An `n`-gon prism (two `n`-gons, `n` quads) refined once by Catmull-Clark: quads only, with
-/// valence-`n` face points.
-fn cc_prism(n: usize) -> (Vec<[f64; 3]>, Polygons) {
+/// The two rings of `n` points of a slightly tapered, wavy prism (bottom ring first).
+fn prism_points(n: usize) -> Vec<[f64; 3]> {
     let mut p = Vec::new();
     for z in [0.0, 1.0] {
         for i in 0..n {
@@ -57,6 +56,13 @@ fn cc_prism(n: usize) -> (Vec<[f64; 3]>, Polygons) {
             ]);
         }
     }
+    p
+}
+
+/// An `n`-gon prism (two `n`-gons, `n` quads) refined once by Catmull-Clark: quads only, with
+/// valence-`n` face points.
+fn cc_prism(n: usize) -> (Vec<[f64; 3]>, Polygons) {
+    let p = prism_points(n);
     let mut f = Polygons::new();
     let nn = n as u32;
     f.push(&(0..nn).rev().collect::<Vec<_>>());
@@ -204,17 +210,7 @@ fn corpus() -> Vec<Mesh> {
     for n in [3u32, 5, 6] {
         // A prism of quads with triangle-fan caps, and a triangular prism with triangle caps
         // (n = 3: quad/triangle vertices of valence 3).
-        let mut p = Vec::new();
-        for z in [0.0, 1.0] {
-            for i in 0..n {
-                let a = std::f64::consts::TAU * i as f64 / n as f64;
-                p.push([
-                    a.cos() * (1.0 + 0.2 * z),
-                    a.sin(),
-                    z + 0.05 * (2.0 * a).cos(),
-                ]);
-            }
-        }
+        let mut p = prism_points(n as usize);
         let mut f = Polygons::new();
         if n == 3 {
             f.push(&[2, 1, 0]);

@@ -77,11 +77,17 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     if a.require_genus && !use_mesh && expected_genus.is_none() {
         bail!("--require-genus on a point cloud needs --genus G (the genus it should have)");
     }
+    if a.scheme == crate::cli::SchemeArg::Loop && a.quad_dominant {
+        bail!("--quad-dominant makes quads, but Loop subdivision needs triangles: use --scheme catmull-clark or quad-tri");
+    }
     let options = InitOptions {
         expected_genus,
         require_genus: a.require_genus,
         quad_dominant: crate::cli::quad_dominant_flag(a.quad_dominant, a.no_quad_dominant)
-            .unwrap_or(false),
+            .unwrap_or(matches!(
+                a.scheme,
+                crate::cli::SchemeArg::CatmullClark | crate::cli::SchemeArg::QuadTri
+            )),
         cancel: crate::interrupt::token(),
         ..InitOptions::default()
     };
