@@ -9,7 +9,7 @@
 //! # Templates (a face that is not marked, by its split edges)
 //! | face | split edges | children |
 //! | --- | --- | --- |
-//! | triangle | 1 | 2 triangles (green bisection) |
+//! | triangle | 1 | split fully (red) when no unsplit edge borders a triangle, else 2 triangles (green bisection) |
 //! | triangle | 2 or 3 | split fully (red), as red-green does |
 //! | quad | 1 | 1 quad + 1 triangle (the shorter of the two new edges from the edge point) |
 //! | quad | 2 opposite | 2 quads |
@@ -82,16 +82,67 @@ pub struct PolyRefinement {
 }
 
 /// Whether a face of `n` sides with `k` split edges must be split fully (no template closes
-/// it). A triangle with one split edge is bisected, even under Catmull-Clark where a full split
-/// (3 quads) would keep more quads: on a triangle cage (today's initial cages) that rule
-/// spreads over every face; on the quad ellipsoid of `tests/cc_stages.rs` it gained little
-/// (79% quads at 124 points against 77% at 131).
-fn needs_full_split(n: usize, k: usize) -> bool {
+/// it). `small_cluster`: the face is a triangle of a small cluster of triangles
+/// ([`small_triangle_clusters`]).
+///
+/// A triangle of a small cluster with one split edge is split fully (3 quads under Catmull-Clark and the
+/// quad/triangle scheme) instead of bisected into 2 triangles: in a quad-dominant cage the
+/// full split turns a triangle into quads and the propagation stops at the quads around it
+/// (fandisk, defaults: quad/tri 68% → 81% quads and 1,081 → 938 control points; Catmull-Clark
+/// 72% → 80%, 1,258 → 1,027; rocker-arm 75% / 71% → 80% / 80%, 744 / 707 → 726 / 776
+/// control points). A triangle of a larger cluster is bisected, as red-green does: otherwise a triangle
+/// region (a cage built with `--no-quad-dominant`) would be split fully from one edge to every
+/// face.
+fn needs_full_split(n: usize, k: usize, small_cluster: bool) -> bool {
     match n {
-        3 => k >= 2,
+        3 => k >= 2 || (k == 1 && small_cluster),
         4 => k >= 3,
         _ => k >= 1,
     }
+}
+
+/// Triangles in a cluster (triangles connected through shared edges) of at most this many
+/// faces are split fully from one split edge; larger clusters are bisected.
+const SMALL_CLUSTER: usize = 8;
+
+/// For every face, whether it is a triangle in a cluster of at most [`SMALL_CLUSTER`]
+/// triangles. Cost O(#faces).
+fn small_triangle_clusters(topo: &Topology) -> Vec<bool> {
+    let nf = topo.num_faces();
+    let is_tri = |f: usize| topo.face_edges(f).len() == 3;
+    let mut small = vec![false; nf];
+    let mut seen = vec![false; nf];
+    let mut cluster = Vec::new();
+    for f0 in 0..nf {
+        if seen[f0] || !is_tri(f0) {
+            continue;
+        }
+        seen[f0] = true;
+        cluster.clear();
+        cluster.push(f0);
+        let mut i = 0;
+        while i < cluster.len() {
+            let f = cluster[i];
+            i += 1;
+            for &e in topo.face_edges(f) {
+                for c in topo.edge_corners(e) {
+                    if c == u32::MAX {
+                        continue;
+                    }
+                    let g = topo.corner_face(c) as usize;
+                    if !seen[g] && is_tri(g) {
+                        seen[g] = true;
+                        cluster.push(g);
+                    }
+                }
+            }
+        }
+        let is_small = cluster.len() <= SMALL_CLUSTER;
+        for &f in &cluster {
+            small[f] = is_small;
+        }
+    }
+    small
 }
 
 /// Splits the `marked` faces of a polygon cage 1-to-4 and closes the transition conformingly
@@ -198,6 +249,7 @@ pub fn refine_polygons(
 /// face needs a full split that does not have one.
 fn closure(topo: &Topology, marked: &[bool]) -> (Vec<bool>, Vec<bool>) {
     let nf = topo.num_faces();
+    let small = small_triangle_clusters(topo);
     let mut red: Vec<bool> = (0..nf)
         .map(|f| marked.get(f).copied().unwrap_or(false))
         .collect();
@@ -220,7 +272,7 @@ fn closure(topo: &Topology, marked: &[bool]) -> (Vec<bool>, Vec<bool>) {
                 }
                 let es = topo.face_edges(g);
                 let k = es.iter().filter(|&&x| split[x as usize]).count();
-                if needs_full_split(es.len(), k) {
+                if needs_full_split(es.len(), k, small[g]) {
                     red[g] = true;
                     todo.push(g);
                 }

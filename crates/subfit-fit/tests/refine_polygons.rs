@@ -428,3 +428,65 @@ fn face_owners_handle_quads_triangles_and_ngons() {
         }
     }
 }
+
+/// `quad_patch` with the quad at `(i, j)` of every `(i, j)` in `cut` split into two
+/// triangles along its diagonal.
+fn quad_patch_with_triangles(n: usize, cut: &[(usize, usize)]) -> PolyMesh {
+    let mut m = quad_patch(n, false);
+    let mut faces = Polygons::new();
+    for (f, q) in m.faces.iter().enumerate() {
+        if cut.contains(&(f / n, f % n)) {
+            faces.push(&[q[0], q[1], q[2]]);
+            faces.push(&[q[0], q[2], q[3]]);
+        } else {
+            faces.push(q);
+        }
+    }
+    m.faces = faces;
+    m
+}
+
+/// A triangle of a small cluster with one split edge turns into quads (a full split), so a
+/// quad-dominant cage stays quad-dominant; a large triangle region is bisected instead, so one
+/// split does not spread over it.
+#[test]
+fn small_triangle_clusters_split_into_quads_large_ones_are_bisected() {
+    // One triangle pair at (2, 3), next to the marked quad (2, 2).
+    let cage = quad_patch_with_triangles(5, &[(2, 3)]);
+    let marked_at = |cage: &PolyMesh, i: usize, j: usize| {
+        // The quad whose first corner is grid point (i, j).
+        let mut marked = vec![false; cage.faces.len()];
+        let f = cage
+            .faces
+            .iter()
+            .position(|q| q.len() == 4 && q[0] == (i * 6 + j) as u32)
+            .unwrap();
+        marked[f] = true;
+        marked
+    };
+    let r = refine_polygons(&cage, &Tags::new(), &marked_at(&cage, 2, 2), &cc()).unwrap();
+    assert_conforming(&cage, &r, "triangle pair");
+    // The pair's triangle on the split edge becomes 3 quads; its partner gets one split edge
+    // and becomes 3 quads too; the quads around close with quad + triangle templates.
+    let pair_children: Vec<usize> = (0..r.parents.len())
+        .filter(|&g| {
+            let p = r.parents[g] as usize;
+            cage.faces.iter().nth(p).unwrap().len() == 3
+        })
+        .map(|g| r.mesh.faces.iter().nth(g).unwrap().len())
+        .collect();
+    assert_eq!(
+        pair_children,
+        vec![4; 6],
+        "both triangles of the pair split into quads"
+    );
+
+    // A 5 × 2 block of cut quads (20 triangles) beside the marked quad: the triangle on the split
+    // edge is bisected, nothing spreads through the block.
+    let block: Vec<(usize, usize)> = (0..5).flat_map(|i| (3..5).map(move |j| (i, j))).collect();
+    let cage = quad_patch_with_triangles(5, &block);
+    let r = refine_polygons(&cage, &Tags::new(), &marked_at(&cage, 2, 2), &cc()).unwrap();
+    assert_conforming(&cage, &r, "triangle block");
+    assert_eq!(r.stats.red, 1, "only the marked quad is split fully");
+    assert_eq!(r.stats.new_points, 5);
+}
