@@ -1,9 +1,11 @@
 //! Regular Catmull-Clark neighbourhoods: the limit rows of a once-refined mesh in regular
 //! regions are fixed tables over the parent vertices, computed once and reused.
 //!
-//! In an all-quad parent mesh, a child vertex whose parent neighbourhood is regular — the
-//! vertex point of a smooth interior valence-4 vertex, the edge point of an interior edge
-//! between two such vertices, the face point of a quad with four such corners — has the
+//! In a parent mesh refined by Catmull-Clark or the quad/triangle scheme, a child vertex whose
+//! parent neighbourhood is regular — the vertex point of a smooth interior valence-4 vertex
+//! all of whose faces are quads, the edge point of an interior edge between two such
+//! vertices, the face point of a quad with four such corners — sees Catmull-Clark's rules
+//! only (the quad/triangle scheme reduces to them where no triangle is near) and has the
 //! same row of `L · M` (limit stencil of the child times one refinement step; see
 //! [`crate::limit`]) up to where its parent neighbourhood sits: a bicubic B-spline patch
 //! neighbourhood (Catmull & Clark 1978; the tables are OpenSubdiv's `Far::PatchTable` idea of
@@ -20,6 +22,9 @@
 //! are summed, as the general path sums them. So the rows are the general path's, up to the
 //! order of floating-point additions (checked to 1e-14 in the tests of [`crate::limit`]).
 
+use rayon::prelude::*;
+
+use crate::refine::FacePoints;
 use crate::scheme::{Neighborhood, VertexRule};
 use crate::stencil::SparseSum;
 use crate::topology::Topology;
@@ -43,10 +48,12 @@ pub(crate) fn is_regular(hood: &Neighborhood) -> bool {
     *hood == REGULAR
 }
 
-/// Finds the regular neighbourhoods of the children of an all-quad parent mesh.
+/// Finds the regular neighbourhoods of the children of a parent mesh.
 pub(crate) struct Regular<'a> {
     topo: &'a Topology,
-    hoods: &'a [Neighborhood],
+    points: &'a FacePoints,
+    /// Whether each parent vertex is regular: [`is_regular`] with quads only around it.
+    regular: Vec<bool>,
     nv: u32,
     ne: u32,
 }
@@ -67,21 +74,34 @@ pub(crate) struct Tables {
 }
 
 impl<'a> Regular<'a> {
-    /// For the children of `topo` (all quads), with `hoods` its vertices' neighbourhoods.
-    /// `None` if `topo` has faces other than quads.
-    pub(crate) fn new(topo: &'a Topology, hoods: &'a [Neighborhood]) -> Option<Self> {
-        (0..topo.num_faces())
-            .all(|f| topo.face(f).len() == 4)
-            .then_some(Self {
-                topo,
-                hoods,
-                nv: topo.num_vertices() as u32,
-                ne: topo.num_edges() as u32,
+    /// For the children of `topo` under Catmull-Clark or the quad/triangle scheme, with
+    /// `hoods` its vertices' neighbourhoods and `points` its face points. Cost O(#V).
+    pub(crate) fn new(
+        topo: &'a Topology,
+        hoods: &'a [Neighborhood],
+        points: &'a FacePoints,
+    ) -> Self {
+        let regular = (0..topo.num_vertices() as u32)
+            .into_par_iter()
+            .map(|v| {
+                is_regular(&hoods[v as usize])
+                    && topo
+                        .vertex_corners(v)
+                        .iter()
+                        .all(|&c| topo.face(topo.corner_face(c) as usize).len() == 4)
             })
+            .collect();
+        Self {
+            topo,
+            points,
+            regular,
+            nv: topo.num_vertices() as u32,
+            ne: topo.num_edges() as u32,
+        }
     }
 
     fn regular(&self, v: u32) -> bool {
-        is_regular(&self.hoods[v as usize])
+        self.regular[v as usize]
     }
 
     /// The 1-ring of parent vertex `v` as positions: `v`, its ring vertices, its quads'
@@ -91,13 +111,11 @@ impl<'a> Regular<'a> {
         let t = self.topo;
         out.push(v);
         out.extend_from_slice(t.vertex_ring(v));
-        // All faces are quads, so face f has corners 4f … 4f + 3 and the corner two steps
-        // around from c is c ^ 2.
-        debug_assert!(t
-            .vertex_corners(v)
-            .iter()
-            .all(|&c| { t.corner_next(t.corner_next(c)) == c ^ 2 }));
-        out.extend(t.vertex_corners(v).iter().map(|&c| t.corner_vertex(c ^ 2)));
+        out.extend(
+            t.vertex_corners(v)
+                .iter()
+                .map(|&c| t.corner_vertex(t.corner_next(t.corner_next(c)))),
+        );
     }
 
     /// Position of corner `c` among the corners of its vertex.
@@ -134,14 +152,18 @@ impl<'a> Regular<'a> {
             if !self.regular(a) || !self.regular(b) {
                 return false;
             }
-            // The child ring's start: its lowest corner (module `child`).
+            // The child ring's start: its lowest corner (module `child`; the quad/triangle
+            // child numbers the corners of the same four child quads in the same order).
             let cycle = [4 * n0 + 3, 4 * c0 + 1, 4 * n1 + 3, 4 * c1 + 1];
             let r = (0..4).min_by_key(|&i| cycle[i]).expect("four corners");
             self.push_block(a, pos);
             self.push_block(b, pos);
             1 + r * 16 + self.corner_index(c0) * 4 + self.corner_index(c1)
         } else {
-            let f = (w - nv - ne) as usize;
+            let f = self.points.face((w - nv - ne) as usize);
+            if t.face(f).len() != 4 {
+                return false;
+            }
             let c0 = t.face_first_corner(f) as u32;
             let mut key = 0;
             for k in (0..4).rev() {
