@@ -577,3 +577,81 @@ fn compare_measures_two_sided_distances_between_concentric_cubes() {
     assert_eq!(c["a_to_b"]["samples"], 4);
     assert!(c["a_to_b"]["max"].as_f64().unwrap() < 1e-15);
 }
+
+#[test]
+fn analyze_writes_the_sharp_features_of_a_mesh() {
+    let d = tempfile::tempdir().unwrap();
+    // A unit cube, each face a fan of 4 triangles around its centre: 12 crease edges, 8
+    // corners (the fan edges are flat).
+    let corners = [
+        "0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1",
+    ];
+    let quads = [
+        [1, 4, 3, 2],
+        [5, 6, 7, 8],
+        [1, 2, 6, 5],
+        [2, 3, 7, 6],
+        [3, 4, 8, 7],
+        [4, 1, 5, 8],
+    ];
+    let mut obj: String = corners.iter().map(|c| format!("v {c}\n")).collect();
+    for (k, q) in quads.iter().enumerate() {
+        let p = |i: usize| -> Vec<f64> {
+            corners[q[i] - 1]
+                .split(' ')
+                .map(|x| x.parse().unwrap())
+                .collect()
+        };
+        let c: Vec<f64> = (0..3)
+            .map(|j| (0..4).map(|i| p(i)[j]).sum::<f64>() / 4.0)
+            .collect();
+        obj += &format!("v {} {} {}\n", c[0], c[1], c[2]);
+        for i in 0..4 {
+            obj += &format!("f {} {} {}\n", q[i], q[(i + 1) % 4], 9 + k);
+        }
+    }
+    let cube = write(d.path(), "cube.obj", obj.as_bytes());
+    let out = d.path().join("features.ply");
+    let r = subfit(&[
+        "analyze",
+        cube.to_str().unwrap(),
+        "--features",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    let f = &s["features"];
+    assert_eq!(
+        (&f["sharp_edges"], &f["curves"], &f["corners"], &f["darts"]),
+        (&12.into(), &12.into(), &8.into(), &0.into()),
+        "{s}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("element vertex 8\n") && text.contains("element edge 12\n"),
+        "{text}"
+    );
+    let body = text.split("end_header\n").nth(1).unwrap();
+    let kinds: Vec<&str> = body
+        .lines()
+        .take(8)
+        .map(|l| l.split(' ').nth(3).unwrap())
+        .collect();
+    assert_eq!(kinds, vec!["1"; 8], "every feature vertex is a corner");
+
+    // A point cloud has no faces: a clear error before any work, no file.
+    let cloud = write(d.path(), "c.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n");
+    let bad = d.path().join("none.ply");
+    let r = subfit(&[
+        "analyze",
+        cloud.to_str().unwrap(),
+        "--features",
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("needs a mesh target"));
+    assert!(!bad.exists());
+    let r = subfit(&["analyze", cube.to_str().unwrap(), "--feature-angle", "200"]);
+    assert_eq!(r.status.code(), Some(2));
+}

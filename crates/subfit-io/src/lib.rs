@@ -337,6 +337,55 @@ pub fn write_ply_with_properties(
     write_atomic(path, &out)
 }
 
+/// Writes line segments as an ASCII PLY with `vertex` (x, y, z and a `uchar kind` per vertex)
+/// and `edge` (`int vertex1, vertex2`) elements, the form MeshLab, CloudCompare and Blender's
+/// PLY importer read as a wire mesh; atomically like [`write_file`]. `kinds` has one entry per
+/// position (or is empty: all 0). Used for feature curves (kind 0 curve vertex, 1 corner,
+/// 2 dart).
+pub fn write_ply_edges(
+    path: &Path,
+    positions: &[[f64; 3]],
+    kinds: &[u8],
+    edges: &[[u32; 2]],
+) -> Result<()> {
+    use std::fmt::Write as _;
+    let bad = |what: String| Err(Error::file(path, ErrorKind::CannotWrite(what)));
+    if !kinds.is_empty() && kinds.len() != positions.len() {
+        return bad(format!(
+            "{} kinds for {} vertices",
+            kinds.len(),
+            positions.len()
+        ));
+    }
+    if let Some(e) = edges
+        .iter()
+        .find(|e| e.iter().any(|&v| v as usize >= positions.len()))
+    {
+        return bad(format!(
+            "edge {e:?} names a vertex beyond {}",
+            positions.len()
+        ));
+    }
+    let mut s = String::with_capacity(64 * (positions.len() + edges.len()) + 256);
+    let _ = write!(
+        s,
+        "ply\nformat ascii 1.0\ncomment written by subfit {}\nelement vertex {}\n\
+         property double x\nproperty double y\nproperty double z\nproperty uchar kind\n\
+         element edge {}\nproperty int vertex1\nproperty int vertex2\nend_header\n",
+        env!("CARGO_PKG_VERSION"),
+        positions.len(),
+        edges.len()
+    );
+    for (i, p) in positions.iter().enumerate() {
+        let k = kinds.get(i).copied().unwrap_or(0);
+        let _ = writeln!(s, "{} {} {} {k}", p[0], p[1], p[2]);
+    }
+    for e in edges {
+        let _ = writeln!(s, "{} {}", e[0], e[1]);
+    }
+    write_atomic(path, s.as_bytes())
+}
+
 /// Writes a control cage as USDA (see [`usda`]) atomically. The cage must have faces.
 pub fn write_usda_file(
     path: &Path,

@@ -34,8 +34,23 @@ struct Summary {
     k2_quantiles: [f64; 5],
     /// Normalized units → original units: multiply lengths by this.
     scale_to_original: f64,
+    /// Sharp features of a mesh target (none for a point cloud).
+    features: Option<FeatureSummary>,
     /// Seconds per phase.
     timings: Timings,
+}
+
+/// Counts of [`subfit::target::detect_features`].
+#[derive(Serialize)]
+struct FeatureSummary {
+    angle_deg: f64,
+    sharp_edges: usize,
+    sharp_edges_before_cleaning: usize,
+    curves: usize,
+    closed_curves: usize,
+    corners: usize,
+    darts: usize,
+    seconds: f64,
 }
 
 #[derive(Serialize)]
@@ -82,13 +97,19 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         (Some(k), None) => Neighborhood::Knn(k as usize),
         (None, None) => TargetOptions::default().neighborhood,
     };
-    if let Some(out) = &a.output {
+    for out in a.output.iter().chain(&a.features) {
         if subfit::io::Format::from_path(out) != Some(subfit::io::Format::Ply) {
             bail!(
-                "{}: the analysis output is a PLY file (.ply)",
+                "{}: the analysis outputs are PLY files (.ply)",
                 out.display()
             );
         }
+    }
+    if !(a.feature_angle.is_finite() && a.feature_angle > 0.0 && a.feature_angle < 180.0) {
+        bail!(
+            "--feature-angle must be in (0, 180) degrees, got {}",
+            a.feature_angle
+        );
     }
     let options = TargetOptions {
         neighborhood,
@@ -106,6 +127,22 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     let (mut mesh, _) = crate::progress::load(&a.target)?;
     crate::commands::reorient_target(&mut mesh, &a.target);
     let read = t_read.elapsed().as_secs_f64();
+    let features = (!mesh.faces.is_empty()).then(|| {
+        let t = std::time::Instant::now();
+        let o = subfit::target::FeatureOptions {
+            angle_deg: a.feature_angle,
+            ..Default::default()
+        };
+        let f = subfit::target::detect_features(&mesh.positions, &mesh.faces, &o);
+        (f, t.elapsed().as_secs_f64())
+    });
+    if let (Some(out), None) = (&a.features, &features) {
+        bail!(
+            "{}: feature detection needs a mesh target (faces); {} is a point cloud",
+            out.display(),
+            a.target.display()
+        );
+    }
 
     let bar = crate::progress::bar(1, "analysing");
     let on_progress = |p: Progress| {
@@ -148,6 +185,16 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         k1_quantiles: quantiles(&attrs.k1),
         k2_quantiles: quantiles(&attrs.k2),
         scale_to_original: target.normalization().length_to_original(1.0),
+        features: features.as_ref().map(|(f, seconds)| FeatureSummary {
+            angle_deg: a.feature_angle,
+            sharp_edges: f.edges.len(),
+            sharp_edges_before_cleaning: f.raw_edges,
+            curves: f.curves.len(),
+            closed_curves: f.curves.iter().filter(|c| c.closed).count(),
+            corners: f.corners.len(),
+            darts: f.darts.len(),
+            seconds: *seconds,
+        }),
         timings: Timings {
             read,
             validate: t.validate.as_secs_f64(),
@@ -164,10 +211,16 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     if let Some(out) = &a.output {
         write_points(out, &attrs)?;
     }
+    if let (Some(out), Some((f, _))) = (&a.features, &features) {
+        write_features(out, &mesh.positions, f)?;
+    }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print_text(&summary, a.output.as_deref());
+        if let Some(out) = &a.features {
+            println!("wrote         {}", out.display());
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -195,6 +248,40 @@ fn write_points(out: &std::path::Path, at: &subfit::target::PointAttributes) -> 
     };
     crate::interrupt::watch_dir(out);
     subfit::io::write_ply_with_properties(out, &cloud, &props, &opts)?;
+    Ok(())
+}
+
+/// The feature vertices (compacted) with their kinds and the feature edges.
+fn write_features(
+    out: &std::path::Path,
+    positions: &[[f64; 3]],
+    f: &subfit::target::Features,
+) -> anyhow::Result<()> {
+    let mut id = std::collections::HashMap::new();
+    let mut pts = Vec::new();
+    let mut kinds = Vec::new();
+    let mut edges = Vec::with_capacity(f.edges.len());
+    let kind = |v: u32| {
+        if f.corners.binary_search(&v).is_ok() {
+            1
+        } else if f.darts.binary_search(&v).is_ok() {
+            2
+        } else {
+            0
+        }
+    };
+    for e in &f.edges {
+        let [a, b] = e.map(|v| {
+            *id.entry(v).or_insert_with(|| {
+                pts.push(positions[v as usize]);
+                kinds.push(kind(v));
+                (pts.len() - 1) as u32
+            })
+        });
+        edges.push([a, b]);
+    }
+    crate::interrupt::watch_dir(out);
+    subfit::io::write_ply_edges(out, &pts, &kinds, &edges)?;
     Ok(())
 }
 
@@ -240,6 +327,12 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
         "units         1 normalized unit = {:.6} original units",
         s.scale_to_original
     );
+    if let Some(f) = &s.features {
+        println!(
+            "features      {} sharp edges (≥ {}°; {} before cleaning) in {} curves ({} closed), {} corners, {} darts",
+            f.sharp_edges, f.angle_deg, f.sharp_edges_before_cleaning, f.curves, f.closed_curves, f.corners, f.darts
+        );
+    }
     let t = &s.timings;
     println!(
         "time (s)      read {:.3}, validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh index {:.3}; analysis total {:.3}",
