@@ -1,5 +1,6 @@
 //! Exact evaluation and closest-point throughput on ~1k-face control meshes (Loop and
-//! Catmull-Clark tori with extraordinary vertices), random parameters and queries.
+//! Catmull-Clark tori with extraordinary vertices; a mixed quad/triangle torus under
+//! Catmull-Clark and under the quad/triangle scheme), random parameters and queries.
 //!
 //! Run: `cargo bench -p subfit-subdiv --bench eval`.
 
@@ -32,7 +33,29 @@ fn meshes() -> Vec<(&'static str, Scheme, Vec<[f64; 3]>, Polygons)> {
         }
         i += 2;
     }
+    // Every 7th quad of the Catmull-Clark torus cut into two triangles.
+    let mut mixed = Polygons::new();
+    for (k, q) in cc.faces.iter().enumerate() {
+        if k % 7 == 0 {
+            mixed.push(&[q[0], q[1], q[2]]);
+            mixed.push(&[q[0], q[2], q[3]]);
+        } else {
+            mixed.push(q);
+        }
+    }
     vec![
+        (
+            "catmull-clark mixed torus (every 7th quad cut)",
+            Scheme::CatmullClark,
+            cc.positions.clone(),
+            mixed.clone(),
+        ),
+        (
+            "quad-tri mixed torus (every 7th quad cut)",
+            Scheme::QuadTriangle,
+            cc.positions.clone(),
+            mixed,
+        ),
         (
             "catmull-clark torus 1000 quads",
             Scheme::CatmullClark,
