@@ -40,6 +40,7 @@ pub mod neighbors;
 mod normalize;
 mod options;
 pub mod orient;
+mod outliers;
 pub mod project;
 pub mod quadric;
 mod regularize;

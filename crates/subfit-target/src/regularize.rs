@@ -61,6 +61,12 @@ const TURN_COS: f64 = 0.866;
 const MAX_ITERATIONS: usize = 200;
 /// Converged when no active normal turns by more than this (cos ≈ 0.5°) in a step.
 const CONVERGED_COS: f64 = 0.999_96;
+/// Budget of the iteration: it stops once it has evaluated the field at this many × `#P`
+/// points (plus [`BUDGET_BASE`]), whatever the iteration count, so that a scan where most
+/// points look suspicious (heavy noise) costs a bounded number of passes over the cloud.
+const BUDGET_PER_POINT: usize = 12;
+/// Evaluations always allowed (small clouds).
+const BUDGET_BASE: usize = 200_000;
 /// Shortest step tried before the iteration stops.
 const MIN_STEP: f64 = 1.0 / 64.0;
 
@@ -256,7 +262,9 @@ fn iterate(
     let mut charges = vec![0.0; n];
     let mut backup: Vec<[f64; 3]> = Vec::with_capacity(act.len());
     let mut step = 1.0;
-    while out.iterations < MAX_ITERATIONS {
+    let budget = BUDGET_PER_POINT * n + BUDGET_BASE;
+    let mut spent = set.len();
+    while out.iterations < MAX_ITERATIONS && spent < budget {
         ctx.cancel.check()?;
         out.iterations += 1;
         for (e, &i) in set.iter().enumerate() {
@@ -291,6 +299,7 @@ fn iterate(
                 normals[i as usize] = normalize(add(old, scale(sub(*d, old), step))).unwrap_or(old);
             }
             tree.refresh(normals, inp.area);
+            spent += set.len() + act.len();
             let ev2 = evaluate(ctx, tree, normals, &set)?;
             let f2 = objective(ctx, normals, &ev2, &set);
             if f2 >= f {
@@ -325,6 +334,7 @@ fn iterate(
         if act.len() != before {
             set = with_neighbours(active, inp);
             pos = positions(&set, n);
+            spent += set.len();
             ev = evaluate(ctx, tree, normals, &set)?;
             f = objective(ctx, normals, &ev, &set);
         } else if settled {

@@ -67,6 +67,7 @@ fn phase_name(p: Phase) -> &'static str {
         Phase::Normalize => "normalizing",
         Phase::Merge => "merging duplicates",
         Phase::Index => "building kd-tree",
+        Phase::Outliers => "detecting outliers",
         Phase::Estimate => "fitting normals and curvatures",
         Phase::Orient => "orienting normals",
         Phase::MeshIndex => "building triangle BVH",
