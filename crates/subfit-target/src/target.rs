@@ -97,8 +97,9 @@ impl Target {
     }
 
     /// Builds a target: validate, normalize into the unit cube, merge exact duplicates, build the
-    /// kd-tree, fit a PCA frame and a quadric per point, orient normals, and for meshes build
-    /// the triangle BVH. Faces (any polygon size, fan-triangulated) are used for area-weighted
+    /// kd-tree, drop outliers of point clouds and estimate the noise level
+    /// ([`TargetOptions::remove_outliers`], [`TargetOptions::adapt_to_noise`]), fit a PCA frame
+    /// and a quadric per point, orient normals, and for meshes build the triangle BVH. Faces (any polygon size, fan-triangulated) are used for area-weighted
     /// normals and exact closest points; colours are ignored.
     ///
     /// Errors: NaN/Inf coordinates or normals (with the input index), fewer than
@@ -108,8 +109,9 @@ impl Target {
     /// normals are the plane's (oriented `+z`, or `+x`/`+y` for a vertical plane) and its
     /// curvatures 0.
     ///
-    /// Cost: O(P log P) plus O(P·k) for the fits, parallel; the orientation is serial
-    /// O(P·k_o log P). Progress goes to `progress`, never to stdout/stderr.
+    /// Cost: O(P log P) plus O(P·k) for the outlier scan and the fits, parallel; the
+    /// orientation O(P·k_o log P), its field refinement capped at a number of point evaluations
+    /// linear in P. Progress goes to `progress`, never to stdout/stderr.
     pub fn build(
         mesh: &PolyMesh,
         options: &TargetOptions,
@@ -422,7 +424,8 @@ impl Target {
         &self.removed_inputs
     }
 
-    /// For each input point, the index of its distinct point (`#input` entries).
+    /// For each input point, the index of its distinct point (`#input` entries); for a point
+    /// dropped as an outlier, the nearest kept point.
     pub fn input_to_point(&self) -> &[u32] {
         &self.input_to_point
     }
