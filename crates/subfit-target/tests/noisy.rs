@@ -123,3 +123,21 @@ fn outlier_removal_can_be_turned_off() {
     assert_eq!(t.len(), cloud.points.len());
     assert!(t.stats().noise_level > 0.0);
 }
+
+#[test]
+fn noisy_sphere_without_wider_neighbourhoods_still_orients_within_the_field_budget() {
+    // k stays 24: most normals look suspicious to the field check, whose iteration is then
+    // bounded by its budget of point evaluations (not timed here).
+    let clean = points(&SPHERE, 20_000, 8);
+    let cloud = noisy::add_noise(&clean, 0.003, 0.03, 9);
+    let o = TargetOptions {
+        adapt_to_noise: false,
+        ..options()
+    };
+    let t = Target::from_points(&cloud.points, None, &o).unwrap();
+    let s = t.stats();
+    assert_eq!(s.neighborhood_k, 24);
+    assert!(s.field_iterations <= 200, "{s:?}");
+    let f = outward(&t, |_| [0.0; 3]);
+    assert!(f >= 0.99, "{:.4} outward", f);
+}
