@@ -318,6 +318,13 @@ fn analyze_writes_normals_curvatures_and_directions() {
     let s: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
     assert_eq!(s["points"], 4000);
     assert_eq!(s["normal_origin"], "estimated");
+    // A clean sampling: no outliers, a noise level far below the spacing.
+    assert_eq!(s["outliers_removed"], 0, "{s}");
+    let noise = s["noise_level"].as_f64().unwrap();
+    assert!(
+        noise >= 0.0 && noise < 0.1 * s["point_spacing"].as_f64().unwrap(),
+        "{s}"
+    );
     // The ellipsoid is convex: with outward normals both curvatures are negative (Cheng 2007
     // §II-D3: the centre of curvature lies on the side opposite the normal) at almost all points.
     assert!(s["k1_quantiles"][3].as_f64().unwrap() < 0.0, "{s}");

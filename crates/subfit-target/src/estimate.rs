@@ -46,6 +46,9 @@ pub(crate) struct EstimateParams {
     pub ambiguity_ratio: f64,
     pub graph_k: usize,
     pub degree: u8,
+    /// Try the nearest [`SMALL_K`] where the full neighbourhood is not surface-like (off for
+    /// noisy scans).
+    pub small_fallback: bool,
 }
 
 /// Minimum number of neighbours used in any fit.
@@ -72,6 +75,7 @@ pub(crate) fn estimate_point(
         ambiguity_ratio,
         graph_k: _,
         degree,
+        small_fallback,
     } = *params;
     let p = points[i];
     let nb: Vec<Neighbor> = match hood {
@@ -93,7 +97,8 @@ pub(crate) fn estimate_point(
     // Adaptive scale: where the full neighbourhood is not surface-like (ambiguous, or large
     // surface variation λ0/Σλ, e.g. it crosses a thin part), try the nearest SMALL_K. Only for
     // `Knn`: a `Radius` neighbourhood is an explicit choice of scale (e.g. to average noise).
-    if prescribed.is_none() && matches!(hood, Neighborhood::Knn(_)) && m > SMALL_K {
+    if small_fallback && prescribed.is_none() && matches!(hood, Neighborhood::Knn(_)) && m > SMALL_K
+    {
         let full_var = variation(&lam);
         if lam[0] >= ambiguity_ratio * lam[1] || full_var > MAX_VARIATION {
             let (_, lam2, vecs2) = pca(&rel_all[..SMALL_K]);

@@ -1,7 +1,8 @@
 //! The shape being fitted (DESIGN.md §2 `subfit-target`, §3.2).
 //!
 //! A [`Target`] is a point cloud or mesh scaled uniformly into the unit cube (Cheng 2004 §3
-//! step 1), with exact duplicates merged, a kd-tree ([`neighbors`]), a unit normal and a local
+//! step 1), with exact duplicates merged, outliers of point clouds dropped and the noise level
+//! estimated ([`TargetOptions::remove_outliers`]), a kd-tree ([`neighbors`]), a unit normal and a local
 //! quadric per point ([`estimate`], [`quadric`]; Cheng 2004 §4.1, Cheng 2007 §II-C), normals
 //! oriented by minimum-spanning-tree propagation ([`orient`]; Hoppe et al. 1992), foot-point
 //! queries with the signed distance, frame and curvature radii of the SD term ([`project`];
@@ -41,6 +42,7 @@ pub mod neighbors;
 mod normalize;
 mod options;
 pub mod orient;
+mod outliers;
 pub mod project;
 pub mod quadric;
 mod regularize;

@@ -44,6 +44,20 @@ pub struct TargetOptions {
     pub imls_radius: Option<f64>,
     /// Build the triangle BVH for exact closest points when the input has faces. Default true.
     pub mesh_closest_point: bool,
+    /// Drop outliers of point clouds before estimation: points whose 16th neighbour is more
+    /// than 4× the median distance away, or whose distance to the plane of their neighbours is
+    /// more than 3× the largest of the neighbours' spread, the noise level and a quarter of that
+    /// median distance (see `outliers` in the crate source). Inputs with faces keep every vertex.
+    /// Removed points are counted in [`TargetStats::outliers_removed`]; their input indices map
+    /// to the nearest kept point. Default true.
+    pub remove_outliers: bool,
+    /// Widen a `Knn(k)` neighbourhood on noisy scans: when the estimated noise level
+    /// ([`TargetStats::noise_level`]) exceeds 0.1 × the point spacing
+    /// ([`TargetStats::point_spacing`]), `k` is raised (up to 96) so that the neighbourhood
+    /// radius is about 8 noise levels, and the smaller neighbourhood otherwise tried where the
+    /// full one is not surface-like is not (in noise it fits the noise); clean scans keep `k`.
+    /// The `k` used is [`TargetStats::neighborhood_k`]. Default true.
+    pub adapt_to_noise: bool,
     /// Cancellation token, polled by every long step of construction (per chunk of the
     /// per-point fits, per pass of the orientation and its winding-number and field checks);
     /// once cancelled, construction returns [`crate::TargetError::Interrupted`] within a few
@@ -62,6 +76,8 @@ impl Default for TargetOptions {
             ambiguity_ratio: 0.5,
             imls_radius: None,
             mesh_closest_point: true,
+            remove_outliers: true,
+            adapt_to_noise: true,
             cancel: Cancel::default(),
         }
     }
@@ -92,6 +108,8 @@ pub enum Phase {
     Merge,
     /// kd-tree construction.
     Index,
+    /// Outlier detection and noise estimation (and the kd-tree rebuilt without the outliers).
+    Outliers,
     /// Per-point PCA frame and quadric fit (normals, curvatures).
     Estimate,
     /// Normal orientation.
@@ -127,10 +145,19 @@ pub struct TargetTimings {
     pub merge: Duration,
     /// [`Phase::Index`].
     pub index: Duration,
+    /// [`Phase::Outliers`].
+    pub outliers: Duration,
     /// [`Phase::Estimate`].
     pub estimate: Duration,
-    /// [`Phase::Orient`].
+    /// [`Phase::Orient`] (all of it: the steps below and the query layout).
     pub orient: Duration,
+    /// Orientation: spanning tree, propagation and consensus.
+    pub orient_propagate: Duration,
+    /// Orientation: the global winding-number check.
+    pub orient_winding: Duration,
+    /// Orientation: the winding-field refinement (capped, see
+    /// [`TargetStats::field_iterations`]).
+    pub orient_field: Duration,
     /// [`Phase::MeshIndex`].
     pub mesh_index: Duration,
     /// Whole construction.
@@ -146,6 +173,19 @@ pub struct TargetStats {
     pub points: usize,
     /// Input points merged into an identical earlier point.
     pub merged_duplicates: usize,
+    /// Outliers dropped (distinct points; see [`TargetOptions::remove_outliers`]).
+    pub outliers_removed: usize,
+    /// Estimated noise level: `1.4826 ×` the median distance of a point to the least-squares
+    /// plane of its 16 nearest neighbours (itself left out), over the kept points (normalized
+    /// units). About the standard deviation of the noise along the normal on noisy scans; the
+    /// curvature sag of a neighbourhood on clean ones.
+    pub noise_level: f64,
+    /// Median distance of a point to its 16th nearest neighbour (normalized units), the scale
+    /// the outlier tests and [`Self::noise_level`] are compared with.
+    pub point_spacing: f64,
+    /// `k` of the `Knn` neighbourhood used for the fits (after [`TargetOptions::adapt_to_noise`];
+    /// 0 for a `Radius` neighbourhood).
+    pub neighborhood_k: usize,
     /// Triangles in the mesh BVH (0 for point clouds).
     pub triangles: usize,
     /// Where the normals came from.
@@ -169,7 +209,8 @@ pub struct TargetStats {
     /// or normal more than 60° from `−∇w`; see the `regularize` step of [`crate::orient`]).
     /// 0: the field refinement was skipped.
     pub field_suspicious: usize,
-    /// Iterations of the field refinement (0 when skipped).
+    /// Iterations of the field refinement (0 when skipped; capped, and bounded by a budget of
+    /// point evaluations proportional to `#P`).
     pub field_iterations: usize,
     /// Sign changes made by the field refinement (included in the net `flipped_normals`).
     pub field_flips: usize,

@@ -33,6 +33,8 @@
 //! sort), the winding check O(P log P) per pass, the field refinement O(C log P) for its check
 //! of `C` points and O(A log P) per iteration on `A` active points, the rest O(E).
 
+use std::time::{Duration, Instant};
+
 use rayon::prelude::*;
 use subfit_mesh::{Cancel, Cancelled};
 
@@ -61,6 +63,12 @@ pub struct Orientation {
     /// Per point: whether the field refinement replaced the normal's direction (`#P`; the
     /// caller refits what depends on it). Empty when nothing was replaced.
     pub redirected: Vec<bool>,
+    /// Wall time of the spanning tree, propagation and consensus (steps 1–3).
+    pub propagate_time: Duration,
+    /// Wall time of the winding-number check (step 4).
+    pub winding_time: Duration,
+    /// Wall time of the field refinement (step 5).
+    pub field_time: Duration,
 }
 
 /// The k-nearest-neighbour graph: row `i` is `targets[i * stride .. (i + 1) * stride]`, padded
@@ -165,6 +173,7 @@ pub fn orient_normals(
         trusted: &trusted,
         cancel,
     };
+    let clock = Instant::now();
     let tree = spanning_tree(&pts, &nrm, graph, &input)?;
     let mut closed = vec![false; n];
     let components = propagate(&pts, &mut nrm, &tree, &input, &mut closed);
@@ -192,6 +201,8 @@ pub fn orient_normals(
         })
         .unzip();
     cancel.check()?;
+    let propagate_time = clock.elapsed();
+    let clock = Instant::now();
     let mut dipoles = DipoleTree::new(&pts, &nrm, &wn_area);
     let winding_flips = winding::refine(
         &mut nrm,
@@ -206,6 +217,8 @@ pub fn orient_normals(
         &mut dipoles,
         cancel,
     )?;
+    let winding_time = clock.elapsed();
+    let clock = Instant::now();
     let spacing: Vec<f64> = exclude.par_iter().map(|&e| e / EXCLUDE_WIDEN).collect();
     let scale: Vec<f64> = area.par_iter().map(|&a| a.max(0.0).sqrt()).collect();
     let field_eligible: Vec<bool> = eligible
@@ -227,6 +240,7 @@ pub fn orient_normals(
         &mut dipoles,
         cancel,
     )?;
+    let field_time = clock.elapsed();
     let redirected = if field.redirected > 0 {
         rank.iter()
             .map(|&r| redirected_sorted[r as usize])
@@ -252,6 +266,9 @@ pub fn orient_normals(
         field_iterations: field.iterations,
         field_flips: field.flips,
         redirected,
+        propagate_time,
+        winding_time,
+        field_time,
     })
 }
 

@@ -50,6 +50,8 @@ pub struct Target {
     layout: QueryLayout,
     bvh: Option<TriangleBvh>,
     input_to_point: Vec<u32>,
+    /// Input indices of the points dropped as outliers, ascending.
+    removed_inputs: Vec<u32>,
     /// Per point: the larger of the distance to the nearest other point and
     /// `2 FOOT_SHORTCUT ×` the neighbourhood radius (foot points within half of it are accepted).
     nn_dist: Vec<f64>,
@@ -95,8 +97,9 @@ impl Target {
     }
 
     /// Builds a target: validate, normalize into the unit cube, merge exact duplicates, build the
-    /// kd-tree, fit a PCA frame and a quadric per point, orient normals, and for meshes build
-    /// the triangle BVH. Faces (any polygon size, fan-triangulated) are used for area-weighted
+    /// kd-tree, drop outliers of point clouds and estimate the noise level
+    /// ([`TargetOptions::remove_outliers`], [`TargetOptions::adapt_to_noise`]), fit a PCA frame
+    /// and a quadric per point, orient normals, and for meshes build the triangle BVH. Faces (any polygon size, fan-triangulated) are used for area-weighted
     /// normals and exact closest points; colours are ignored.
     ///
     /// Errors: NaN/Inf coordinates or normals (with the input index), fewer than
@@ -106,8 +109,9 @@ impl Target {
     /// normals are the plane's (oriented `+z`, or `+x`/`+y` for a vertical plane) and its
     /// curvatures 0.
     ///
-    /// Cost: O(P log P) plus O(P·k) for the fits, parallel; the orientation is serial
-    /// O(P·k_o log P). Progress goes to `progress`, never to stdout/stderr.
+    /// Cost: O(P log P) plus O(P·k) for the outlier scan and the fits, parallel; the
+    /// orientation O(P·k_o log P), its field refinement capped at a number of point evaluations
+    /// linear in P. Progress goes to `progress`, never to stdout/stderr.
     pub fn build(
         mesh: &PolyMesh,
         options: &TargetOptions,
@@ -157,7 +161,7 @@ impl Target {
         cancel.check()?;
         let t = Instant::now();
         report(Phase::Merge, 0, n_in);
-        let (points, input_to_point) = merge_duplicates(&normalized);
+        let (mut points, mut input_to_point) = merge_duplicates(&normalized);
         stats.points = points.len();
         stats.merged_duplicates = n_in - points.len();
         if points.len() < MIN_POINTS {
@@ -176,12 +180,37 @@ impl Target {
         cancel.check()?;
         let t = Instant::now();
         report(Phase::Index, 0, points.len());
-        let index = PointIndex::new(&points).ok_or(TargetError::TooFewPoints {
-            found: points.len(),
+        let too_few = |found: usize| TargetError::TooFewPoints {
+            found,
             required: MIN_POINTS,
-        })?;
+        };
+        let mut index = PointIndex::new(&points).ok_or(too_few(points.len()))?;
         stats.timings.index = t.elapsed();
         report(Phase::Index, points.len(), points.len());
+
+        // Outliers and noise level (point clouds only: a mesh's vertices are its faces').
+        cancel.check()?;
+        let t = Instant::now();
+        report(Phase::Outliers, 0, points.len());
+        let remove = options.remove_outliers && mesh.faces.is_empty();
+        let scan = crate::outliers::detect(&points, &index, remove, cancel)?;
+        let mut removed_inputs = Vec::new();
+        stats.noise_level = scan.noise;
+        stats.point_spacing = scan.spacing;
+        if scan.count > 0 && points.len() - scan.count >= MIN_POINTS {
+            removed_inputs = (0..n_in as u32)
+                .filter(|&i| scan.outlier[input_to_point[i as usize] as usize])
+                .collect();
+            let (kept, mut map) = drop_outliers(&points, &scan.outlier);
+            index = PointIndex::new(&kept).ok_or(too_few(kept.len()))?;
+            remap_outliers(&points, &index, &mut map, &mut input_to_point);
+            points = kept;
+            stats.outliers_removed = scan.count;
+            stats.points = points.len();
+            check_not_collinear(&points)?;
+        }
+        stats.timings.outliers = t.elapsed();
+        report(Phase::Outliers, points.len(), points.len());
 
         // Prescribed normals (input or faces), per distinct point.
         let (prescribed, origin) = prescribed_normals(mesh, options, &points, &input_to_point);
@@ -191,11 +220,25 @@ impl Target {
         let np = points.len();
         report(Phase::Estimate, 0, np);
         let tick = |done: usize| report(Phase::Estimate, done, np);
+        let hood = match options.neighborhood {
+            Neighborhood::Knn(k) if options.adapt_to_noise => Neighborhood::Knn(
+                crate::outliers::noisy_knn(stats.noise_level, stats.point_spacing, k),
+            ),
+            h => h,
+        };
+        let widened = match (hood, options.neighborhood) {
+            (Neighborhood::Knn(k), Neighborhood::Knn(k0)) => {
+                stats.neighborhood_k = k;
+                k > k0
+            }
+            _ => false,
+        };
         let params = EstimateParams {
-            hood: options.neighborhood,
+            hood,
             ambiguity_ratio: options.ambiguity_ratio,
             graph_k: options.orientation_k,
             degree: options.jet_degree,
+            small_fallback: !widened,
         };
         cancel.check()?;
         let (estimates, graph) =
@@ -273,6 +316,9 @@ impl Target {
             stats.field_iterations = o.field_iterations;
             stats.field_flips = o.field_flips;
             stats.field_redirected = o.redirected.iter().filter(|&&r| r).count();
+            stats.timings.orient_propagate = o.propagate_time;
+            stats.timings.orient_winding = o.winding_time;
+            stats.timings.orient_field = o.field_time;
         }
         cancel.check()?;
         let radius: Vec<f64> = estimates.iter().map(|e| e.radius).collect();
@@ -324,6 +370,7 @@ impl Target {
             layout,
             bvh,
             input_to_point,
+            removed_inputs,
             nn_dist,
             imls_radius,
             stats,
@@ -370,7 +417,15 @@ impl Target {
         &self.quadrics
     }
 
-    /// For each input point, the index of its distinct point (`#input` entries).
+    /// Input indices of the points dropped as outliers (see
+    /// [`TargetOptions::remove_outliers`]), ascending; [`Self::input_to_point`] maps them to the
+    /// nearest kept point.
+    pub fn removed_outliers(&self) -> &[u32] {
+        &self.removed_inputs
+    }
+
+    /// For each input point, the index of its distinct point (`#input` entries); for a point
+    /// dropped as an outlier, the nearest kept point.
     pub fn input_to_point(&self) -> &[u32] {
         &self.input_to_point
     }
@@ -467,6 +522,39 @@ fn refit_redirected(
             },
         );
     cancel.check()
+}
+
+/// Removes the points marked `outlier` (`#P`). Returns the kept points (in order) and the map
+/// old point → new point (`u32::MAX` for a removed one). O(P).
+fn drop_outliers(points: &[[f64; 3]], outlier: &[bool]) -> (Vec<[f64; 3]>, Vec<u32>) {
+    let mut map = vec![u32::MAX; points.len()];
+    let mut kept = Vec::with_capacity(points.len());
+    for (i, (p, &o)) in points.iter().zip(outlier).enumerate() {
+        if !o {
+            map[i] = kept.len() as u32;
+            kept.push(*p);
+        }
+    }
+    (kept, map)
+}
+
+/// Rewrites `input_to_point` through `map` (from [`drop_outliers`]), pointing each input point
+/// whose point was removed at the kept point nearest to it (`index` over the kept points,
+/// `old_points` the points before removal). Parallel, O(#input + #removed · log P).
+fn remap_outliers(
+    old_points: &[[f64; 3]],
+    index: &PointIndex,
+    map: &mut [u32],
+    input_to_point: &mut [u32],
+) {
+    map.par_iter_mut().enumerate().for_each(|(i, m)| {
+        if *m == u32::MAX {
+            *m = index.nearest(&old_points[i]).index;
+        }
+    });
+    input_to_point
+        .par_iter_mut()
+        .for_each(|j| *j = map[*j as usize]);
 }
 
 /// The first `k` entries of each row of a graph with rows of `stride` entries (`k ≤ stride`);

@@ -288,9 +288,12 @@ fn noisy(
     let (lo, hi) = subfit_mesh::bounding_box(&p).unwrap();
     let diag = norm(sub(hi, lo));
     let noisy = jitter(&p, 0.002 * diag, seed + 100);
+    // Outlier removal off: the comparison is point by point with the truth, and it drops the
+    // far tail of the noise (~0.4 % of these points; tests/noisy.rs checks it).
     let opts = TargetOptions {
         neighborhood: hood,
         jet_degree: degree,
+        remove_outliers: false,
         ..TargetOptions::default()
     };
     check_estimates(name, shape, &noisy, &truth, &opts, 0.2).curv_ok

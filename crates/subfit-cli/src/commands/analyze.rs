@@ -19,6 +19,16 @@ struct Summary {
     input_points: usize,
     points: usize,
     merged_duplicates: usize,
+    /// Points dropped as outliers (point clouds only).
+    outliers_removed: usize,
+    /// Estimated noise level, normalized units (see `TargetStats::noise_level`).
+    noise_level: f64,
+    /// Median distance to the 16th nearest neighbour, normalized units.
+    point_spacing: f64,
+    /// Neighbours per fit (`Knn`; widened on noisy scans), 0 for a radius neighbourhood.
+    neighborhood_k: usize,
+    /// Iterations of the orientation's winding-field refinement (0: skipped).
+    field_iterations: usize,
     triangles: usize,
     normal_origin: String,
     flipped_normals: usize,
@@ -60,8 +70,12 @@ struct Timings {
     normalize: f64,
     merge: f64,
     index: f64,
+    outliers: f64,
     estimate: f64,
     orient: f64,
+    orient_propagate: f64,
+    orient_winding: f64,
+    orient_field: f64,
     mesh_index: f64,
     total: f64,
 }
@@ -82,6 +96,7 @@ fn phase_name(p: Phase) -> &'static str {
         Phase::Normalize => "normalizing",
         Phase::Merge => "merging duplicates",
         Phase::Index => "building kd-tree",
+        Phase::Outliers => "detecting outliers",
         Phase::Estimate => "fitting normals and curvatures",
         Phase::Orient => "orienting normals",
         Phase::MeshIndex => "building triangle BVH",
@@ -165,6 +180,11 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         input_points: s.input_points,
         points: s.points,
         merged_duplicates: s.merged_duplicates,
+        outliers_removed: s.outliers_removed,
+        noise_level: s.noise_level,
+        point_spacing: s.point_spacing,
+        neighborhood_k: s.neighborhood_k,
+        field_iterations: s.field_iterations,
         triangles: s.triangles,
         normal_origin: format!("{:?}", s.normal_origin).to_lowercase(),
         flipped_normals: s.flipped_normals,
@@ -201,8 +221,12 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
             normalize: t.normalize.as_secs_f64(),
             merge: t.merge.as_secs_f64(),
             index: t.index.as_secs_f64(),
+            outliers: t.outliers.as_secs_f64(),
             estimate: t.estimate.as_secs_f64(),
             orient: t.orient.as_secs_f64(),
+            orient_propagate: t.orient_propagate.as_secs_f64(),
+            orient_winding: t.orient_winding.as_secs_f64(),
+            orient_field: t.orient_field.as_secs_f64(),
             mesh_index: t.mesh_index.as_secs_f64(),
             total: t.total.as_secs_f64(),
         },
@@ -298,6 +322,14 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
             String::new()
         }
     );
+    println!("outliers      {} removed", s.outliers_removed);
+    println!(
+        "noise         {:.3e} normalized units ({:.3} x the point spacing {:.3e}); fits use k = {}",
+        s.noise_level,
+        s.noise_level / s.point_spacing.max(f64::MIN_POSITIVE),
+        s.point_spacing,
+        s.neighborhood_k
+    );
     println!(
         "normals       {}; {} flipped by orientation, {} ambiguous, {} degenerate fits, {} orientation component(s)",
         s.normal_origin, s.flipped_normals, s.ambiguous_normals, s.degenerate_fits, s.orientation_components
@@ -335,8 +367,9 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
     }
     let t = &s.timings;
     println!(
-        "time (s)      read {:.3}, validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, estimate {:.3}, orient {:.3}, mesh index {:.3}; analysis total {:.3}",
-        t.read, t.validate, t.normalize, t.merge, t.index, t.estimate, t.orient, t.mesh_index, t.total
+        "time (s)      read {:.3}, validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, outliers {:.3}, estimate {:.3}, orient {:.3} (propagate {:.3}, winding {:.3}, field {:.3} in {} iterations), mesh index {:.3}; analysis total {:.3}",
+        t.read, t.validate, t.normalize, t.merge, t.index, t.outliers, t.estimate, t.orient,
+        t.orient_propagate, t.orient_winding, t.orient_field, s.field_iterations, t.mesh_index, t.total
     );
     if let Some(o) = out {
         println!("wrote         {}", o.display());
