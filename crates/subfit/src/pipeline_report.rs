@@ -411,8 +411,20 @@ pub struct UsdDifference {
 pub struct Report {
     /// The target's name (its file).
     pub target: String,
-    /// Distinct target points.
+    /// Distinct target points (after outliers are dropped).
     pub target_points: usize,
+    /// Points of a point-cloud target dropped as outliers (see `subfit_target::outliers`).
+    #[serde(default)]
+    pub target_outliers_removed: usize,
+    /// The target's estimated noise level (1.4826 × the median distance of a point to the
+    /// plane of its 16 nearest neighbours, normalized units: about the noise's standard
+    /// deviation on a noisy scan, the curvature sag of a neighbourhood on a clean one).
+    #[serde(default)]
+    pub target_noise_level: f64,
+    /// The target's median distance of a point to its 16th nearest neighbour (normalized
+    /// units).
+    #[serde(default)]
+    pub target_point_spacing: f64,
     /// The target mesh's topology (`None` for a point cloud).
     pub target_topology: Option<Topology>,
     /// Faces of the target re-oriented to agree with their neighbours, if any.

@@ -287,6 +287,16 @@ pub fn fit_scan(
         e => Error::input(&name, e),
     })?;
     let preprocess = target.stats().timings.total.as_secs_f64();
+    let outliers = target.stats().outliers_removed;
+    if outliers > 0 {
+        warn(
+            format!(
+                "dropped {outliers} of {} points of {name} as outliers (not fitted, not measured)",
+                target.stats().input_points
+            ),
+            &mut progress,
+        );
+    }
 
     step(Step::Init, &mut progress);
     let t_init = Instant::now();
@@ -512,6 +522,9 @@ pub fn fit_scan(
     let report = Report {
         target: name,
         target_points: target.len(),
+        target_outliers_removed: target.stats().outliers_removed,
+        target_noise_level: target.stats().noise_level,
+        target_point_spacing: target.stats().point_spacing,
         target_topology,
         reoriented,
         normalized_unit_in_original_units: unit,
