@@ -22,24 +22,11 @@ impl NoisyCloud {
     }
 }
 
-/// Axis-aligned bounding box of `pts`.
-pub fn bounds(pts: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in pts {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
-
 /// Adds Gaussian noise of standard deviation `noise × diagonal` to each coordinate of `clean`
 /// and appends `round(outlier_fraction × #clean)` points uniform in the (clean) bounding box.
 pub fn add_noise(clean: &[[f64; 3]], noise: f64, outlier_fraction: f64, seed: u64) -> NoisyCloud {
     let mut rng = StdRng::seed_from_u64(seed);
-    let (lo, hi) = bounds(clean);
+    let (lo, hi) = subfit_mesh::bounding_box(clean).expect("a clean cloud has points");
     let diag = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
     let normal = Normal::new(0.0, noise * diag).expect("finite noise");
     let mut points: Vec<[f64; 3]> = clean
