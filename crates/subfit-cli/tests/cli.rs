@@ -588,36 +588,27 @@ fn compare_measures_two_sided_distances_between_concentric_cubes() {
 #[test]
 fn analyze_writes_the_sharp_features_of_a_mesh() {
     let d = tempfile::tempdir().unwrap();
-    // A unit cube, each face a fan of 4 triangles around its centre: 12 crease edges, 8
-    // corners (the fan edges are flat).
-    let corners = [
-        "0 0 0", "1 0 0", "1 1 0", "0 1 0", "0 0 1", "1 0 1", "1 1 1", "0 1 1",
-    ];
-    let quads = [
-        [1, 4, 3, 2],
-        [5, 6, 7, 8],
-        [1, 2, 6, 5],
-        [2, 3, 7, 6],
-        [3, 4, 8, 7],
-        [4, 1, 5, 8],
-    ];
-    let mut obj: String = corners.iter().map(|c| format!("v {c}\n")).collect();
-    for (k, q) in quads.iter().enumerate() {
-        let p = |i: usize| -> Vec<f64> {
-            corners[q[i] - 1]
-                .split(' ')
-                .map(|x| x.parse().unwrap())
-                .collect()
-        };
-        let c: Vec<f64> = (0..3)
-            .map(|j| (0..4).map(|i| p(i)[j]).sum::<f64>() / 4.0)
-            .collect();
-        obj += &format!("v {} {} {}\n", c[0], c[1], c[2]);
+    // The project's cube with each face a fan of 4 triangles around its centre (analysis needs
+    // 10+ points): 12 crease edges, 8 corners (the fan edges are flat).
+    let mut cube_mesh = subfit::mesh::shapes::cube_mesh(0.5);
+    let quads: Vec<Vec<u32>> = cube_mesh.faces.iter().map(<[u32]>::to_vec).collect();
+    let mut fans = subfit::mesh::Polygons::new();
+    for q in &quads {
+        let c = cube_mesh.positions.len() as u32;
+        let centre = [0, 1, 2].map(|k| {
+            q.iter()
+                .map(|&v| cube_mesh.positions[v as usize][k])
+                .sum::<f64>()
+                / 4.0
+        });
+        cube_mesh.positions.push(centre);
         for i in 0..4 {
-            obj += &format!("f {} {} {}\n", q[i], q[(i + 1) % 4], 9 + k);
+            fans.push(&[q[i], q[(i + 1) % 4], c]);
         }
     }
-    let cube = write(d.path(), "cube.obj", obj.as_bytes());
+    cube_mesh.faces = fans;
+    let cube = d.path().join("cube.obj");
+    subfit::io::write_file(&cube, &cube_mesh, &Default::default()).unwrap();
     let out = d.path().join("features.ply");
     let r = subfit(&[
         "analyze",
