@@ -199,6 +199,11 @@ pub struct FitArgs {
     /// of the data and the data within it of the limit surface.
     #[arg(long)]
     pub one_sided: bool,
+    /// Weight of the data → surface part of the objective (dimensionless, relative to the
+    /// surface → data mean): every data point pulls its nearest limit sample, so boundaries
+    /// reach the data's edge and nothing is left uncovered. 0 fits one-sided, as the papers.
+    #[arg(long, default_value_t = 1.0)]
+    pub coverage: f64,
     /// The control-point budget: the initial cage and every refinement stay within it (exit
     /// code 2 when the target's topology needs more).
     #[arg(long, default_value_t = 5_000, value_parser = clap::value_parser!(u32).range(4..=10_000_000))]

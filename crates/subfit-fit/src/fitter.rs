@@ -115,7 +115,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
     /// Cost: dominated by the sampling operator and the pattern, O(m·s²) with `m` samples and
     /// `s` ≈ 12–15 control points per sample.
     pub fn with_term(
-        term: T,
+        mut term: T,
         faces: &Polygons,
         num_vertices: usize,
         options: &FitOptions,
@@ -134,6 +134,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             &options.subdivision(),
             options.sample_level,
         )?;
+        term.prepare(&op);
         let lap = Laplacian::umbrella(faces, num_vertices);
         let block = if term.isotropic() { 1 } else { 3 };
         let pattern = Pattern::new(&op.position, &lap, block);
@@ -309,9 +310,10 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         let t1 = Instant::now();
         let projected = self.term.project(Some(&a.samples), &samples);
         let t2 = Instant::now();
-        let (sum, max) = sum_max_d2(&self.term, &samples, &projected);
+        // Active samples get no coverage (see `DataTerm::project`): objective = errors.
+        let (_, sum, max) = sums_d2(&self.term, &samples, &projected);
         let (fs, fm) = a.fixed.as_ref().map_or((0.0, 0.0), |f| (f.sum, f.max));
-        let stats = self.stats(control, sum + fs, max.max(fm));
+        let stats = self.stats(control, sum + fs, sum + fs, max.max(fm));
         t.sample += t1 - t0;
         t.project += t2 - t1;
         t.evaluate += t2.elapsed();
@@ -330,7 +332,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         }
         let xs = sample_rows(&self.op.position, &a.fixed_samples, control);
         let projected = self.term.project(Some(&a.fixed_samples), &xs);
-        let (sum, max) = sum_max_d2(&self.term, &xs, &projected);
+        let (_, sum, max) = sums_d2(&self.term, &xs, &projected);
         if let Some(a) = &mut self.active {
             a.fixed = Some(FixedErrors {
                 control: control.to_vec(),
@@ -348,8 +350,8 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         // Samples move little between calls: the term may warm-start from its last answers.
         let projected = self.term.project(None, &samples);
         let t2 = Instant::now();
-        let (sum, max) = sum_max_d2(&self.term, &samples, &projected);
-        let stats = self.stats(control, sum, max);
+        let (objective, sum, max) = sums_d2(&self.term, &samples, &projected);
+        let stats = self.stats(control, objective, sum, max);
         t.sample += t1 - t0;
         t.project += t2 - t1;
         t.evaluate += t2.elapsed();
@@ -360,9 +362,9 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         }
     }
 
-    /// Error statistics over all `m` samples from the sum and maximum of their squared
-    /// distances, and the smoothing energy of `control`.
-    fn stats(&self, control: &[[f64; 3]], sum: f64, max: f64) -> ErrorStats {
+    /// Error statistics over all `m` samples from the sum of their objective shares, the sum
+    /// and maximum of their squared distances, and the smoothing energy of `control`.
+    fn stats(&self, control: &[[f64; 3]], objective: f64, sum: f64, max: f64) -> ErrorStats {
         let m = self.num_samples().max(1) as f64;
         let n = control.len().max(1) as f64;
         let e_rms = (sum / m).sqrt();
@@ -377,7 +379,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             e_rms,
             e_max_diag: e_max / self.bbox_diagonal,
             e_rms_diag: e_rms / self.bbox_diagonal,
-            objective: sum / m + smooth,
+            objective: objective / m + smooth,
         }
     }
 
@@ -738,17 +740,19 @@ impl Damping {
     }
 }
 
-/// `(Σ_k e_k², max_k e_k²)` of the samples `s` with their projections `projected`: squared
-/// errors in parallel, summed serially in sample order (deterministic for any thread count).
-fn sum_max_d2<T: DataTerm>(term: &T, s: &[[f64; 3]], projected: &[T::Sample]) -> (f64, f64) {
-    let d2: Vec<f64> = s
+/// `(Σ_k objective share, Σ_k e_k², max_k e_k²)` of the samples `s` with their projections
+/// `projected` ([`DataTerm::objective_error`], [`DataTerm::squared_error`]): in parallel,
+/// summed serially in sample order (deterministic for any thread count).
+fn sums_d2<T: DataTerm>(term: &T, s: &[[f64; 3]], projected: &[T::Sample]) -> (f64, f64, f64) {
+    let d2: Vec<(f64, f64)> = s
         .par_iter()
         .zip(projected.par_iter())
-        .map(|(&s, f)| term.squared_error(f, s))
+        .map(|(&s, f)| (term.objective_error(f, s), term.squared_error(f, s)))
         .collect();
-    let sum: f64 = d2.iter().sum();
-    let max = d2.iter().fold(0.0f64, |a, &b| a.max(b));
-    (sum, max)
+    let objective: f64 = d2.iter().map(|d| d.0).sum();
+    let sum: f64 = d2.iter().map(|d| d.1).sum();
+    let max = d2.iter().fold(0.0f64, |a, &b| a.max(b.1));
+    (objective, sum, max)
 }
 
 fn check_finite(

@@ -24,14 +24,21 @@
 //! Where the foot points come from ([`FootPointSource`]): a point cloud has only its local
 //! quadrics ([`Target::foot_points`]); a mesh target also has its triangles, and then the exact
 //! closest point on them is the better foot point ([`Target::mesh_foot_point`]).
+//!
+//! With a [`Coverage`] (weight [`FitOptions::coverage`] > 0) the term also pulls the surface
+//! over data it leaves uncovered: each projection of all samples assigns every data point to
+//! its nearest sample and adds its quadratic to that sample's model and objective share
+//! ([`crate::coverage`]). The measured error ([`DataTerm::squared_error`], and everything
+//! from [`DataTerm::project_fresh`]) stays the surface → data distance.
 
 use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
 use subfit_target::{FootPoint, Target};
 
+use crate::coverage::{CoverSum, Coverage};
 use crate::options::FitOptions;
-use crate::term::{mul, DataTerm, Mat3, IDENTITY};
+use crate::term::{add_mat, mul, DataTerm, Mat3, IDENTITY};
 
 /// The error term (distance measure) used to build the quadratic model (Cheng 2007 §II-D).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -82,6 +89,31 @@ pub struct FootPointTerm<'t> {
     source: FootPointSource,
     /// Nearest data point of every sample row at its last projection (`u32::MAX`: none).
     hints: Mutex<Vec<u32>>,
+    /// The data → surface part of the objective, if any.
+    coverage: Option<Coverage>,
+}
+
+/// What [`FootPointTerm`] keeps per sample: the foot point and, on projections of all samples
+/// with coverage, the data points assigned to the sample. Dereferences to the foot point.
+#[derive(Clone, Debug)]
+pub struct FootSample {
+    /// The foot point of the sample on the target.
+    pub foot: FootPoint,
+    /// The data points whose nearest sample this is (see [`crate::coverage`]).
+    pub cover: Option<Box<CoverSum>>,
+}
+
+impl std::ops::Deref for FootSample {
+    type Target = FootPoint;
+    fn deref(&self) -> &FootPoint {
+        &self.foot
+    }
+}
+
+fn plain(feet: Vec<FootPoint>) -> Vec<FootSample> {
+    feet.into_iter()
+        .map(|foot| FootSample { foot, cover: None })
+        .collect()
 }
 
 impl<'t> FootPointTerm<'t> {
@@ -92,12 +124,31 @@ impl<'t> FootPointTerm<'t> {
             method,
             source,
             hints: Mutex::new(Vec::new()),
+            coverage: None,
         }
     }
 
-    /// The term `options` name ([`FitOptions::method`], [`FitOptions::foot_points`]).
+    /// The term `options` name ([`FitOptions::method`], [`FitOptions::foot_points`], and
+    /// [`FitOptions::coverage`] > 0 adds the data → surface part).
     pub fn from_options(target: &'t Target, options: &FitOptions) -> Self {
-        Self::new(target, options.method, options.foot_points)
+        let term = Self::new(target, options.method, options.foot_points);
+        if options.coverage > 0.0 {
+            term.with_coverage(options.coverage)
+        } else {
+            term
+        }
+    }
+
+    /// Adds the data → surface part with weight `weight` (> 0; see [`crate::coverage`]).
+    /// Cost: O(#points + #triangles).
+    pub fn with_coverage(mut self, weight: f64) -> Self {
+        self.coverage = Some(Coverage::new(self.target, weight));
+        self
+    }
+
+    /// The data → surface part, if any.
+    pub fn coverage(&self) -> Option<&Coverage> {
+        self.coverage.as_ref()
     }
 
     /// The target.
@@ -138,18 +189,33 @@ impl<'t> FootPointTerm<'t> {
 }
 
 impl DataTerm for FootPointTerm<'_> {
-    type Sample = FootPoint;
+    type Sample = FootSample;
 
-    /// PD: `Q = I`.
+    /// PD without coverage: `Q = I` (coverage adds point-to-plane matrices).
     fn isotropic(&self) -> bool {
-        self.method == Method::Pdm
+        self.method == Method::Pdm && self.coverage.is_none()
     }
 
-    fn project(&self, rows: Option<&[u32]>, xs: &[[f64; 3]]) -> Vec<FootPoint> {
+    fn prepare(&mut self, op: &subfit_subdiv::SamplingOperator) {
+        if let Some(c) = self.coverage.as_mut() {
+            c.prepare(op);
+        }
+    }
+
+    fn project(&self, rows: Option<&[u32]>, xs: &[[f64; 3]]) -> Vec<FootSample> {
         // A poisoned lock only loses the hints.
         let mut hints = self.hints.lock().unwrap_or_else(PoisonError::into_inner);
         let Some(rows) = rows else {
-            return self.foot_points_hinted(xs, &mut hints);
+            let feet = self.foot_points_hinted(xs, &mut hints);
+            drop(hints);
+            let Some(c) = &self.coverage else {
+                return plain(feet);
+            };
+            return feet
+                .into_iter()
+                .zip(c.assign(xs))
+                .map(|(foot, cover)| FootSample { foot, cover })
+                .collect();
         };
         let need = rows.iter().max().map_or(0, |&k| k as usize + 1);
         if hints.len() < need {
@@ -160,29 +226,44 @@ impl DataTerm for FootPointTerm<'_> {
         for (&k, &h) in rows.iter().zip(&sub) {
             hints[k as usize] = h;
         }
-        feet
+        plain(feet)
     }
 
-    fn project_fresh(&self, xs: &[[f64; 3]]) -> Vec<FootPoint> {
-        self.foot_points(xs)
+    fn project_fresh(&self, xs: &[[f64; 3]]) -> Vec<FootSample> {
+        plain(self.foot_points(xs))
     }
 
     /// `‖x − V‖²`.
     #[inline]
-    fn squared_error(&self, f: &FootPoint, x: [f64; 3]) -> f64 {
+    fn squared_error(&self, f: &FootSample, x: [f64; 3]) -> f64 {
         (0..3).map(|a| (x[a] - f.point[a]).powi(2)).sum::<f64>()
     }
 
-    /// [`error_matrix`] and `Q (x − V)` (PD: `x − V`).
+    /// `‖x − V‖²` plus the assigned data points' share.
     #[inline]
-    fn model(&self, f: &FootPoint, x: [f64; 3]) -> (Mat3, [f64; 3]) {
+    fn objective_error(&self, f: &FootSample, x: [f64; 3]) -> f64 {
+        let own = self.squared_error(f, x);
+        f.cover.as_ref().map_or(own, |c| own + c.energy(x))
+    }
+
+    /// [`error_matrix`] and `Q (x − V)` (PD: `x − V`), plus the assigned data points' model.
+    #[inline]
+    fn model(&self, f: &FootSample, x: [f64; 3]) -> (Mat3, [f64; 3]) {
         let e = std::array::from_fn(|a| x[a] - f.point[a]);
-        if self.method == Method::Pdm {
-            return (IDENTITY, e);
+        let (q, r) = if self.method == Method::Pdm {
+            (IDENTITY, e)
+        } else {
+            let q = error_matrix(self.method, f);
+            let r = mul(&q, e);
+            (q, r)
+        };
+        match &f.cover {
+            None => (q, r),
+            Some(c) => {
+                let (qc, rc) = c.model(x);
+                (add_mat(&q, &qc), std::array::from_fn(|a| r[a] + rc[a]))
+            }
         }
-        let q = error_matrix(self.method, f);
-        let r = mul(&q, e);
-        (q, r)
     }
 
     fn bbox_diagonal(&self) -> f64 {

@@ -46,6 +46,7 @@
 
 mod active;
 mod assemble;
+mod coverage;
 mod error;
 mod fitter;
 mod foot_point_term;
@@ -61,9 +62,10 @@ mod solve;
 mod stages;
 mod term;
 
+pub use coverage::{CoverSum, Coverage};
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
-pub use foot_point_term::{FootPointSource, FootPointTerm};
+pub use foot_point_term::{FootPointSource, FootPointTerm, FootSample};
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use pcg::PcgStats;
 pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};

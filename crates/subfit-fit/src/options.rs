@@ -164,6 +164,12 @@ pub struct FitOptions {
     /// Where foot points come from: the target's triangles when it has them (default), or
     /// always the local quadrics.
     pub foot_points: FootPointSource,
+    /// Weight `w` of the data → surface part of the objective ([`crate::Coverage`]: every data
+    /// point pulls its nearest sample, point-to-plane inside, point-to-point at boundaries),
+    /// relative to the surface → data mean: `F = mean_k e_k² + w · mean_j e_j² + …`.
+    /// Dimensionless, ≥ 0. Default 0 (off: the papers' one-sided objective, as in the
+    /// convergence studies); `subfit::fit_scan` turns it on (1).
+    pub coverage: f64,
     /// Cancellation token, polled at the start of every iteration and of every LM / Armijo
     /// trial; once cancelled, [`crate::Fitter::run`] (and [`crate::fit`], [`crate::fit_stages`])
     /// return [`crate::FitError::Interrupted`]. Default: a fresh token, never cancelled.
@@ -195,6 +201,7 @@ impl Default for FitOptions {
             pcg_tolerance: 1e-2,
             pcg_max_iterations: 500,
             foot_points: FootPointSource::Auto,
+            coverage: 0.0,
             cancel: Cancel::default(),
         }
     }
@@ -248,7 +255,8 @@ impl FitOptions {
 
     /// Checks value ranges; returns the offending field's name and value.
     pub(crate) fn validate(&self) -> Result<(), (&'static str, f64)> {
-        let checks: [(&'static str, f64, bool); 9] = [
+        let checks: [(&'static str, f64, bool); 10] = [
+            ("coverage", self.coverage, self.coverage >= 0.0),
             ("lambda", self.lambda, self.lambda >= 0.0),
             (
                 "tolerance_rms",

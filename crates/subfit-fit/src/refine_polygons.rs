@@ -23,8 +23,10 @@
 //! # Positions
 //! Points come from one uniform refinement step of the whole cage by the scheme
 //! ([`subfit_subdiv::refine`], with the cage's creases): a new edge point takes the scheme's edge
-//! point, a new face point the face's centroid (Catmull-Clark's face point), and an old point
-//! all of whose faces are split fully takes the scheme's vertex point; other old points stay.
+//! point, a new face point the face's centroid (Catmull-Clark's face point), an old point
+//! all of whose faces are split fully takes the scheme's vertex point, and so does a boundary
+//! point whose two boundary edges are split (the boundary curve depends on the boundary polygon
+//! alone, so it stays where it was); other old points stay.
 //! Where the split is uniform and matches the scheme's own split (Catmull-Clark splits a
 //! triangle into 3 quads, which is why [`TriangleSplit::for_scheme`] picks that), the limit
 //! surface does not change at all; elsewhere it changes little.
@@ -187,7 +189,7 @@ pub fn refine_polygons(
         }
     }
     for v in 0..nv {
-        if all_red[v] && used[v] {
+        if all_red[v] && used[v] || boundary_both_split(&topo, tags, &split, v as u32) {
             positions[v] = child[v];
         }
     }
@@ -243,6 +245,31 @@ pub fn refine_polygons(
         parents,
         edge_points,
     })
+}
+
+/// Whether `v` is a boundary point of two boundary edges, both split, with no crease or
+/// corner tag on it or its edges: its scheme's boundary vertex point (1/8, 3/4, 1/8 of the
+/// boundary polygon) then keeps the boundary curve where the split is uniform, whatever its
+/// interior faces do (the curve depends on the boundary polygon alone).
+fn boundary_both_split(topo: &Topology, tags: &Tags, split: &[bool], v: u32) -> bool {
+    if !topo.is_boundary_vertex(v) || tags.is_corner(v) {
+        return false;
+    }
+    let edges = topo.vertex_edges(v);
+    let mut boundary = 0;
+    for &e in edges {
+        let [a, b] = topo.edge_vertices(e);
+        if tags.crease(a, b) > 0.0 {
+            return false;
+        }
+        if topo.is_boundary_edge(e) {
+            if !split[e as usize] {
+                return false;
+            }
+            boundary += 1;
+        }
+    }
+    boundary == 2 && edges.len() > 2
 }
 
 /// Red faces (marked, or closed by a full split) and split edges, by propagation until no

@@ -114,8 +114,9 @@ fn key(a: u32, b: u32) -> (u32, u32) {
 ///
 /// New control points sit at Loop's edge points of the current cage (3/8, 3/8, 1/8, 1/8;
 /// midpoints on boundary edges); an interior old control point whose faces are all split moves
-/// to Loop's vertex point, so that the limit surface is unchanged where the refinement is
-/// uniform; other old points stay. Old points keep their ids, new ones are appended. Winding
+/// to Loop's vertex point, and a boundary point whose two boundary edges are split to Loop's
+/// boundary vertex point (1/8, 3/4, 1/8), so that the limit surface and its boundary curve are
+/// unchanged where the refinement is uniform; other old points stay. Old points keep their ids, new ones are appended. Winding
 /// is preserved. Returns `None` when the cage is not all triangles.
 pub fn refine_red_green(mesh: &PolyMesh, marked: &[bool]) -> Option<(PolyMesh, RefineStats)> {
     refine_red_green_with_parents(mesh, marked).map(|(m, s, _)| (m, s))
@@ -191,9 +192,42 @@ pub fn refine_red_green_with_parents(
         }
     }
     let mut positions = mesh.positions.clone();
+    // Boundary neighbours and incident faces, for the boundary rule below.
+    let mut boundary_ring: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    let mut incident = vec![0u32; nv];
+    for t in &tris {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            incident[a as usize] += 1;
+            if opposite[&key(a, b)].len() == 1 {
+                boundary_ring[a as usize].push(b);
+                boundary_ring[b as usize].push(a);
+            }
+        }
+    }
     for v in 0..nv {
         let n = ring[v].len();
-        if !all_red[v] || on_boundary[v] || n < 3 {
+        if on_boundary[v] {
+            // Loop's boundary vertex point (1/8, 3/4, 1/8) when both boundary edges are split:
+            // the boundary curve (a cubic B-spline of the boundary polygon) is then unchanged
+            // there. Left in place, the refined polygon's curve would jump out toward the
+            // control polygon. A vertex of one face (a corner under the edge-and-corner rule)
+            // or of more than two boundary edges stays.
+            let br = &boundary_ring[v];
+            if br.len() == 2
+                && incident[v] > 1
+                && br.iter().all(|&w| split.contains_key(&key(v as u32, w)))
+            {
+                let (p, a, b) = (
+                    mesh.positions[v],
+                    mesh.positions[br[0] as usize],
+                    mesh.positions[br[1] as usize],
+                );
+                positions[v] = std::array::from_fn(|k| 0.75 * p[k] + 0.125 * (a[k] + b[k]));
+            }
+            continue;
+        }
+        if !all_red[v] || n < 3 {
             continue;
         }
         let beta = loop_beta(n);

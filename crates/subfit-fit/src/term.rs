@@ -59,7 +59,21 @@ pub trait DataTerm: Send + Sync {
     /// (normalized units²).
     fn squared_error(&self, s: &Self::Sample, x: [f64; 3]) -> f64;
 
-    /// The quadratic model of [`Self::squared_error`] around `x` with the state `s`: `Q` (3×3
+    /// The share of the sample in the objective at `x` with the state `s`: the squared error
+    /// plus whatever else the term adds to it (e.g. the data → surface part of
+    /// [`crate::FootPointTerm`] with coverage). The model of [`Self::model`] is this one's.
+    /// Default: [`Self::squared_error`].
+    fn objective_error(&self, s: &Self::Sample, x: [f64; 3]) -> f64 {
+        self.squared_error(s, x)
+    }
+
+    /// Called once by the fitter with its sampling operator, before any projection (e.g. to
+    /// learn the sample tessellation). Default: nothing.
+    fn prepare(&mut self, op: &subfit_subdiv::SamplingOperator) {
+        let _ = op;
+    }
+
+    /// The quadratic model of [`Self::objective_error`] around `x` with the state `s`: `Q` (3×3
     /// symmetric PSD) and the weighted residual `r = Q (x − V)`, so that the model's gradient
     /// in `x` is `2r`. An isotropic term returns the identity and `x − V`.
     fn model(&self, s: &Self::Sample, x: [f64; 3]) -> (Mat3, [f64; 3]);
@@ -85,6 +99,12 @@ pub trait DataTerm: Send + Sync {
 pub fn quadratic(q: &Mat3, e: [f64; 3]) -> f64 {
     let qe = mul(q, e);
     e[0] * qe[0] + e[1] * qe[1] + e[2] * qe[2]
+}
+
+/// `a + b`. Cost: O(1).
+#[inline]
+pub fn add_mat(a: &Mat3, b: &Mat3) -> Mat3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| a[i][j] + b[i][j]))
 }
 
 /// `Q e`. Cost: O(1).

@@ -58,6 +58,7 @@ fn options(
     max_iterations: i64,
     stage_iterations: i64,
     one_sided: bool,
+    coverage: f64,
     refine: bool,
     edge_flips: bool,
     max_depth: i64,
@@ -65,6 +66,11 @@ fn options(
     local_rings: Option<i64>,
     error_scale: Option<f64>,
 ) -> PyResult<FitScanOptions> {
+    if !(coverage >= 0.0 && coverage.is_finite()) {
+        return Err(value_error(format!(
+            "coverage must be a finite number >= 0, got {coverage}"
+        )));
+    }
     let method = match method.to_ascii_lowercase().as_str() {
         "pdm" => Method::Pdm,
         "tdm" => Method::Tdm,
@@ -98,6 +104,7 @@ fn options(
             sample_level: range("sample_level", sample_level, 0, 6)?,
             method,
             step,
+            coverage,
             ..FitOptions::default()
         },
         stages: StageOptions {
@@ -167,7 +174,8 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     points, faces=None, normals=None, *, scheme="loop", method="sdm", step="lm",
     tolerance=5e-4, max_error=None, max_control_points=5000, control_points=None,
     as_points=false, init=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
-    max_iterations=100, stage_iterations=6, one_sided=false, refine=true, edge_flips=true,
+    max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
+    edge_flips=true,
     max_depth=4, local=false, local_rings=None, error_scale=None, name=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -191,6 +199,7 @@ pub fn fit(
     max_iterations: i64,
     stage_iterations: i64,
     one_sided: bool,
+    coverage: f64,
     refine: bool,
     edge_flips: bool,
     max_depth: i64,
@@ -215,6 +224,7 @@ pub fn fit(
         max_iterations,
         stage_iterations,
         one_sided,
+        coverage,
         refine,
         edge_flips,
         max_depth,

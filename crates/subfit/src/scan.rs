@@ -89,7 +89,9 @@ pub struct FitScanOptions {
     /// given, makes the inferred scheme Catmull-Clark; it cannot be combined with Loop.
     /// It replaces [`InitOptions::quad_dominant`] in [`Self::init_options`].
     pub quad_dominant: Option<bool>,
-    /// Per-iteration options (method, step control, sample level, solver). Its scheme, tags,
+    /// Per-iteration options (method, step control, sample level, solver; by default with the
+    /// data → surface part on, [`FitOptions::coverage`] = 1, so the fit aims at the two-sided
+    /// tolerance it is judged by). Its scheme, tags,
     /// `λ`, tolerances and iteration caps are set by the pipeline.
     pub fit: FitOptions,
     /// The stages: `λ` schedule, tolerances (two-sided by default), budgets, refinement.
@@ -115,7 +117,10 @@ impl Default for FitScanOptions {
             as_points: false,
             scheme: None,
             quad_dominant: None,
-            fit: FitOptions::default(),
+            fit: FitOptions {
+                coverage: 1.0,
+                ..FitOptions::default()
+            },
             stages: StageOptions::default(),
             target: TargetOptions::default(),
             init_options: InitOptions::default(),

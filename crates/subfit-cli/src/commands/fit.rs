@@ -68,6 +68,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             sample_level: a.sample_level as usize,
             method,
             step,
+            coverage: a.coverage,
             ..FitOptions::default()
         },
         stages: StageOptions {

@@ -192,6 +192,7 @@ def fit(
         ``init`` (a :class:`Surface`, :class:`Fit` or ``(vertices, faces)`` initial cage),
         ``lambda_start`` (1e-3, ``--lambda``), ``lambda_end``, ``sample_level`` (3),
         ``max_iterations`` (100), ``stage_iterations`` (6), ``one_sided`` (False),
+        ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),
         ``refine`` (True; ``--no-refine``), ``edge_flips`` (True; ``--no-flips``),
         ``max_depth`` (4), ``local`` (False), ``local_rings`` (2), ``error_scale``, ``name``
         (used in messages).

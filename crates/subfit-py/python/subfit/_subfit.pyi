@@ -43,6 +43,7 @@ def fit(
     max_iterations: int = 100,
     stage_iterations: int = 6,
     one_sided: bool = False,
+    coverage: float = 1.0,
     refine: bool = True,
     edge_flips: bool = True,
     max_depth: int = 4,

@@ -1,0 +1,311 @@
+//! The data → surface part of the objective ("coverage"; DESIGN.md decision 11, issue 14's
+//! boundary-aware fitting, Lavoué et al. 2005 §4.2 and §5.2 on boundaries that must reach the
+//! data's edge).
+//!
+//! Cheng et al.'s terms (2007 §II-D) are one-sided: every sample of the limit surface is pulled
+//! onto the data, but nothing pulls the surface over data it does not cover. An open surface's
+//! limit boundary is a B-spline of the control boundary and lies inside it, so its rim shrinks
+//! away from the data's edge with zero one-sided error (a 96-vertex neck rim 16% of the diagonal
+//! from the limit surface; holes that close up; sharp tips cut off). This module adds the other
+//! direction, in the form of the same per-sample quadratic model the fitter already solves:
+//!
+//! ```text
+//! F = (1/m) Σ_k e_k(S_k)²  +  (w/N) Σ_j (S_k(j) − p_j)ᵀ Q_j (S_k(j) − p_j)
+//! ```
+//!
+//! for the `N` data points `p_j`, each with its nearest sample `S_k(j)` (a kd-tree over the
+//! samples, rebuilt at every projection, so the assignment follows the surface). `Q_j` is the
+//! point-to-plane matrix `n_j n_jᵀ` of the data normal (interior data: the sample may slide
+//! along the data, as with Cheng's TD), and the identity (point-to-point) where the surface
+//! ends — the nearest sample is on the tessellation's boundary — or the data does — `p_j` is a
+//! boundary vertex of a mesh target: there the gap is tangential and must be closed along the
+//! surface. A pair is left out when the sample's normal (from the sample tessellation)
+//! faces away from the data normal (the other sheet of a thin part; the orientation of the
+//! whole cage is taken from the majority of pairs, so either winding works).
+//!
+//! Per sample the assigned data points sum to one quadratic `eᵀ Q e − 2 eᵀ b + c` in
+//! `e = S_k − x₀` (`x₀` the sample at the projection), added to the sample's own model. The
+//! weight `w` is [`crate::FitOptions::coverage`] (1: both directions count alike; 0: off, the
+//! papers' one-sided objective). It applies to projections of all samples; the samples of an
+//! active set (local stages) get none, since the nearest sample of a data point is only known
+//! over all of them.
+//!
+//! Cost per projection: a kd-tree over the `m` samples (O(m log m), parallel above 50k), one
+//! nearest query per data point (about 1 µs each), the sample normals (O(#tessellation
+//! faces)), and a serial accumulation (O(N)).
+
+use rayon::prelude::*;
+use subfit_mesh::vec3::{cross, dot, normalize, sub};
+use subfit_mesh::Polygons;
+use subfit_subdiv::SamplingOperator;
+use subfit_target::{PointIndex, Target};
+
+use crate::term::Mat3;
+
+/// The data points a surface must cover, with the rule for each (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Coverage {
+    points: Vec<[f64; 3]>,
+    /// Unit data normals (zero: unknown, point-to-point).
+    normals: Vec<[f64; 3]>,
+    /// Data point on the boundary of a mesh target (point-to-point).
+    boundary: Vec<bool>,
+    weight: f64,
+    /// The fitter's sample tessellation (faces over sample rows), set by [`Self::prepare`].
+    faces: Polygons,
+    /// Sample rows on the tessellation's boundary.
+    sample_boundary: Vec<bool>,
+}
+
+/// The data points assigned to one sample, summed into one quadratic in `e = x − x₀`:
+/// `eᵀ q e − 2 eᵀ b + c` (normalized units², already weighted).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoverSum {
+    /// The sample position at the assignment.
+    x0: [f64; 3],
+    q: Mat3,
+    b: [f64; 3],
+    c: f64,
+    /// Data points assigned.
+    count: u32,
+}
+
+impl CoverSum {
+    fn new(x0: [f64; 3]) -> Self {
+        Self {
+            x0,
+            q: [[0.0; 3]; 3],
+            b: [0.0; 3],
+            c: 0.0,
+            count: 0,
+        }
+    }
+
+    /// Adds `w (x − p)ᵀ Q (x − p)` with `Q = I` (`n = None`) or `n nᵀ`.
+    fn add(&mut self, p: [f64; 3], n: Option<[f64; 3]>, w: f64) {
+        let d = sub(p, self.x0);
+        match n {
+            None => {
+                for a in 0..3 {
+                    self.q[a][a] += w;
+                    self.b[a] += w * d[a];
+                }
+                self.c += w * dot(d, d);
+            }
+            Some(n) => {
+                let dn = dot(d, n);
+                for a in 0..3 {
+                    for c in 0..3 {
+                        self.q[a][c] += w * n[a] * n[c];
+                    }
+                    self.b[a] += w * n[a] * dn;
+                }
+                self.c += w * dn * dn;
+            }
+        }
+        self.count += 1;
+    }
+
+    /// The summed squared distances at `x`. Cost O(1).
+    pub fn energy(&self, x: [f64; 3]) -> f64 {
+        let e = sub(x, self.x0);
+        let qe = crate::term::mul(&self.q, e);
+        (dot(e, qe) - 2.0 * dot(e, self.b) + self.c).max(0.0)
+    }
+
+    /// The model at `x`: `Q` and half the gradient, `Q e − b`. Cost O(1).
+    pub fn model(&self, x: [f64; 3]) -> (Mat3, [f64; 3]) {
+        let e = sub(x, self.x0);
+        let qe = crate::term::mul(&self.q, e);
+        (self.q, std::array::from_fn(|a| qe[a] - self.b[a]))
+    }
+
+    /// Data points assigned to the sample.
+    pub fn count(&self) -> u32 {
+        self.count
+    }
+}
+
+impl Coverage {
+    /// The coverage of `target`'s points with weight `weight` (> 0): the target's normals, and
+    /// for a mesh target the vertices on its boundary edges (edges of one triangle).
+    /// Cost: O(#points + #triangles).
+    pub fn new(target: &Target, weight: f64) -> Self {
+        let points = target.points().to_vec();
+        let normals = target
+            .normals()
+            .iter()
+            .map(|&n| normalize(n).unwrap_or([0.0; 3]))
+            .collect();
+        let mut boundary = vec![false; points.len()];
+        if let Some(bvh) = target.mesh() {
+            for v in boundary_vertices(bvh.triangles()) {
+                if let Some(b) = boundary.get_mut(v as usize) {
+                    *b = true;
+                }
+            }
+        }
+        Self {
+            points,
+            normals,
+            boundary,
+            weight,
+            faces: Polygons::default(),
+            sample_boundary: Vec::new(),
+        }
+    }
+
+    /// The weight `w`.
+    pub fn weight(&self) -> f64 {
+        self.weight
+    }
+
+    /// Data points on the target's boundary.
+    pub fn num_boundary_points(&self) -> usize {
+        self.boundary.iter().filter(|&&b| b).count()
+    }
+
+    /// Takes the tessellation of the fitter's samples (for their normals and boundary).
+    /// Cost: O(#tessellation faces).
+    pub fn prepare(&mut self, op: &SamplingOperator) {
+        self.faces = op.faces.clone();
+        let tris: Vec<[u32; 3]> = op.faces.triangulate_fan();
+        let mut sb = vec![false; op.num_vertices];
+        for v in boundary_vertices(&tris) {
+            sb[v as usize] = true;
+        }
+        self.sample_boundary = sb;
+    }
+
+    /// The data points' quadratics summed per sample for the samples `xs` (all rows of the
+    /// prepared tessellation, in order). `None` where no data point is assigned; all `None`
+    /// when `xs` does not match the tessellation. Weighted so that the objective's mean over
+    /// the `m = xs.len()` samples gives `(w/N) Σ_j`.
+    pub fn assign(&self, xs: &[[f64; 3]]) -> Vec<Option<Box<CoverSum>>> {
+        let m = xs.len();
+        let mut out: Vec<Option<Box<CoverSum>>> = Vec::new();
+        out.resize_with(m, || None);
+        if m == 0 || self.points.is_empty() || self.sample_boundary.len() != m {
+            return out;
+        }
+        let Some(index) = PointIndex::new(xs) else {
+            return out;
+        };
+        let sample_normals = vertex_normals(&self.faces, xs);
+        // Nearest sample and the normals' agreement of every data point.
+        let pairs: Vec<(u32, f64)> = self
+            .points
+            .par_iter()
+            .zip(self.normals.par_iter())
+            .map(|(p, n)| {
+                let k = index.nearest(p).index;
+                (k, dot(sample_normals[k as usize], *n))
+            })
+            .collect();
+        let orient: f64 = pairs.iter().map(|&(_, c)| c.signum()).sum();
+        let s = if orient < 0.0 { -1.0 } else { 1.0 };
+        let w = self.weight * m as f64 / self.points.len() as f64;
+        for (j, &(k, cos)) in pairs.iter().enumerate() {
+            let n = self.normals[j];
+            let known = n != [0.0; 3] && sample_normals[k as usize] != [0.0; 3];
+            if known && s * cos <= 0.0 {
+                continue;
+            }
+            let point_to_point = !known || self.boundary[j] || self.sample_boundary[k as usize];
+            let sum =
+                out[k as usize].get_or_insert_with(|| Box::new(CoverSum::new(xs[k as usize])));
+            sum.add(self.points[j], (!point_to_point).then_some(n), w);
+        }
+        out
+    }
+}
+
+/// Vertices on edges used by exactly one triangle. Cost O(T log T).
+fn boundary_vertices(tris: &[[u32; 3]]) -> Vec<u32> {
+    let mut edges: Vec<(u32, u32)> = tris
+        .iter()
+        .flat_map(|t| (0..3).map(move |i| (t[i].min(t[(i + 1) % 3]), t[i].max(t[(i + 1) % 3]))))
+        .collect();
+    edges.par_sort_unstable();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            out.push(edges[i].0);
+            out.push(edges[i].1);
+        }
+        i = j;
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Unit vertex normals of the polygon mesh `faces` over `xs` (Newell normals of the faces,
+/// area-weighted, summed at their vertices; zero where they cancel). Cost O(#corners).
+fn vertex_normals(faces: &Polygons, xs: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let mut acc = vec![[0.0; 3]; xs.len()];
+    for f in faces.iter() {
+        let mut n = [0.0; 3];
+        for i in 0..f.len() {
+            let (a, b) = (xs[f[i] as usize], xs[f[(i + 1) % f.len()] as usize]);
+            let c = cross(a, b);
+            for k in 0..3 {
+                n[k] += c[k];
+            }
+        }
+        for &v in f {
+            for k in 0..3 {
+                acc[v as usize][k] += n[k];
+            }
+        }
+    }
+    acc.into_iter()
+        .map(|n| normalize(n).unwrap_or([0.0; 3]))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cover_sum_is_the_sum_of_its_parts() {
+        let x0 = [0.1, -0.2, 0.3];
+        let mut s = CoverSum::new(x0);
+        let pts = [[0.0, 0.0, 0.0], [1.0, 0.5, -0.5], [0.3, 0.3, 0.9]];
+        let n = normalize([1.0, 2.0, -0.5]).unwrap();
+        s.add(pts[0], None, 2.0);
+        s.add(pts[1], Some(n), 0.5);
+        s.add(pts[2], None, 1.0);
+        let x = [0.4, 0.1, -0.7];
+        let direct = 2.0 * subfit_mesh::vec3::dist2(x, pts[0])
+            + 0.5 * dot(sub(x, pts[1]), n).powi(2)
+            + subfit_mesh::vec3::dist2(x, pts[2]);
+        assert!((s.energy(x) - direct).abs() < 1e-12 * direct);
+        // Half the gradient, by central differences.
+        let (_, r) = s.model(x);
+        for a in 0..3 {
+            let h = 1e-6;
+            let (mut xp, mut xm) = (x, x);
+            xp[a] += h;
+            xm[a] -= h;
+            let fd = (s.energy(xp) - s.energy(xm)) / (4.0 * h);
+            assert!((fd - r[a]).abs() < 1e-6, "{a}: {fd} vs {}", r[a]);
+        }
+        assert_eq!(s.count(), 3);
+    }
+
+    #[test]
+    fn boundary_vertices_of_a_strip() {
+        // Two triangles sharing edge (1, 2): every vertex is on the boundary; a closed
+        // tetrahedron has none.
+        assert_eq!(boundary_vertices(&[[0, 1, 2], [2, 1, 3]]), vec![0, 1, 2, 3]);
+        let tet = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+        assert!(boundary_vertices(&tet).is_empty());
+    }
+}
