@@ -200,8 +200,9 @@ pub struct FitArgs {
     #[arg(long)]
     pub one_sided: bool,
     /// Weight of the data → surface part of the objective (dimensionless, relative to the
-    /// surface → data mean): every data point pulls its nearest limit sample, so boundaries
-    /// reach the data's edge and nothing is left uncovered. 0 fits one-sided, as the papers.
+    /// surface → data mean): data points at the data's or the limit surface's boundary pull
+    /// their nearest limit sample, so open rims reach the data's edge. 0 fits one-sided, as
+    /// the papers.
     #[arg(long, default_value_t = 1.0)]
     pub coverage: f64,
     /// The control-point budget: the initial cage and every refinement stay within it (exit

@@ -14,14 +14,18 @@
 //! ```
 //!
 //! for the `N` data points `p_j`, each with its nearest sample `S_k(j)` (a kd-tree over the
-//! samples, rebuilt at every projection, so the assignment follows the surface). `Q_j` is the
-//! point-to-plane matrix `n_j n_jᵀ` of the data normal (interior data: the sample may slide
-//! along the data, as with Cheng's TD), and the identity (point-to-point) where the surface
-//! ends — the nearest sample is on the tessellation's boundary — or the data does — `p_j` is a
-//! boundary vertex of a mesh target: there the gap is tangential and must be closed along the
-//! surface. A pair is left out when the sample's normal (from the sample tessellation)
-//! faces away from the data normal (the other sheet of a thin part; the orientation of the
-//! whole cage is taken from the majority of pairs, so either winding works).
+//! samples, rebuilt at every projection, so the assignment follows the surface). A pair counts
+//! where the surface ends — the nearest sample is on the tessellation's boundary — or the data
+//! does — `p_j` is a boundary vertex of a mesh target — with `Q_j = I` (point-to-point): there
+//! the gap is tangential and must be closed along the surface. Interior pairs (point-to-plane,
+//! `Q_j = n_j n_jᵀ`) count only where the data is uncovered — the data point farther than two
+//! mean sample spacings from its nearest sample, full weight from four (a thin tip or a deep
+//! fold the cage cuts off); covered data is the surface → data term's, so a target the surface
+//! already covers is fitted as by the papers' objective ([`Coverage::with_interior`] turns
+//! them off). A pair is also left out when the sample's normal (from
+//! the sample tessellation) faces away from the data normal (the other sheet of a thin part;
+//! the orientation of the whole cage is taken from the majority of pairs, so either winding
+//! works).
 //!
 //! Per sample the assigned data points sum to one quadratic `eᵀ Q e − 2 eᵀ b + c` in
 //! `e = S_k − x₀` (`x₀` the sample at the projection), added to the sample's own model. The
@@ -51,6 +55,8 @@ pub struct Coverage {
     /// Data point on the boundary of a mesh target (point-to-point).
     boundary: Vec<bool>,
     weight: f64,
+    /// Whether interior pairs (point-to-plane) count too; see [`Self::with_interior`].
+    interior: bool,
     /// The fitter's sample tessellation (faces over sample rows), set by [`Self::prepare`].
     faces: Polygons,
     /// Sample rows on the tessellation's boundary.
@@ -128,31 +134,59 @@ impl CoverSum {
 
 impl Coverage {
     /// The coverage of `target`'s points with weight `weight` (> 0): the target's normals, and
-    /// for a mesh target the vertices on its boundary edges (edges of one triangle).
+    /// for a mesh target only the vertices its triangles use, those on boundary edges (edges
+    /// of one triangle) marked.
     /// Cost: O(#points + #triangles).
     pub fn new(target: &Target, weight: f64) -> Self {
-        let points = target.points().to_vec();
-        let normals = target
-            .normals()
-            .iter()
-            .map(|&n| normalize(n).unwrap_or([0.0; 3]))
-            .collect();
-        let mut boundary = vec![false; points.len()];
+        let all = target.points();
+        // A mesh target's vertices that no triangle uses (left inside a hole that was cut,
+        // say) are not data the surface must cover.
+        let used: Vec<bool> = match target.mesh() {
+            Some(bvh) => {
+                let mut used = vec![false; all.len()];
+                for &v in bvh.triangles().iter().flatten() {
+                    if let Some(u) = used.get_mut(v as usize) {
+                        *u = true;
+                    }
+                }
+                used
+            }
+            None => vec![true; all.len()],
+        };
+        let mut on_rim = vec![false; all.len()];
         if let Some(bvh) = target.mesh() {
             for v in boundary_vertices(bvh.triangles()) {
-                if let Some(b) = boundary.get_mut(v as usize) {
+                if let Some(b) = on_rim.get_mut(v as usize) {
                     *b = true;
                 }
             }
         }
+        let keep = |i: &usize| used[*i];
+        let points = (0..all.len()).filter(keep).map(|i| all[i]).collect();
+        let normals = (0..all.len())
+            .filter(keep)
+            .map(|i| normalize(target.normals()[i]).unwrap_or([0.0; 3]))
+            .collect();
+        let boundary = (0..all.len()).filter(keep).map(|i| on_rim[i]).collect();
         Self {
             points,
             normals,
             boundary,
             weight,
+            interior: true,
             faces: Polygons::default(),
             sample_boundary: Vec::new(),
         }
+    }
+
+    /// Whether interior pairs (point-to-plane, the data point and its sample both away from a
+    /// boundary) count where the data is uncovered (default true; see the module docs).
+    /// Counted everywhere, they traded surface → data error for data → surface error at sharp
+    /// edges (rocker arm at 950 control points: two-sided RMS 3.5e-4, against 2.9e-4 without);
+    /// left out, a camel's head kept tips 3% of the diagonal uncovered.
+    pub fn with_interior(mut self, interior: bool) -> Self {
+        self.interior = interior;
+        self
     }
 
     /// The weight `w`.
@@ -193,30 +227,66 @@ impl Coverage {
         };
         let sample_normals = vertex_normals(&self.faces, xs);
         // Nearest sample and the normals' agreement of every data point.
-        let pairs: Vec<(u32, f64)> = self
+        let pairs: Vec<(u32, f64, f64)> = self
             .points
             .par_iter()
             .zip(self.normals.par_iter())
             .map(|(p, n)| {
-                let k = index.nearest(p).index;
-                (k, dot(sample_normals[k as usize], *n))
+                let nb = index.nearest(p);
+                (
+                    nb.index,
+                    dot(sample_normals[nb.index as usize], *n),
+                    nb.distance,
+                )
             })
             .collect();
-        let orient: f64 = pairs.iter().map(|&(_, c)| c.signum()).sum();
+        let spacing = mean_edge_length(&self.faces, xs);
+        let orient: f64 = pairs.iter().map(|&(_, c, _)| c.signum()).sum();
         let s = if orient < 0.0 { -1.0 } else { 1.0 };
         let w = self.weight * m as f64 / self.points.len() as f64;
-        for (j, &(k, cos)) in pairs.iter().enumerate() {
+        for (j, &(k, cos, dist)) in pairs.iter().enumerate() {
             let n = self.normals[j];
             let known = n != [0.0; 3] && sample_normals[k as usize] != [0.0; 3];
             if known && s * cos <= 0.0 {
                 continue;
             }
             let point_to_point = !known || self.boundary[j] || self.sample_boundary[k as usize];
+            // An interior pair counts only where the data is uncovered: from 0 at two sample
+            // spacings (a covered point is within about one of its nearest sample) to full
+            // weight at four.
+            let gate = if point_to_point {
+                1.0
+            } else if self.interior && spacing > 0.0 {
+                (dist / (2.0 * spacing) - 1.0).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            if gate <= 0.0 {
+                continue;
+            }
             let sum =
                 out[k as usize].get_or_insert_with(|| Box::new(CoverSum::new(xs[k as usize])));
-            sum.add(self.points[j], (!point_to_point).then_some(n), w);
+            sum.add(self.points[j], (!point_to_point).then_some(n), w * gate);
         }
         out
+    }
+}
+
+/// The mean edge length of the polygons `faces` over `xs` (each edge counted once per face
+/// side). Cost O(#corners).
+fn mean_edge_length(faces: &Polygons, xs: &[[f64; 3]]) -> f64 {
+    let (mut sum, mut count) = (0.0, 0usize);
+    for f in faces.iter() {
+        for i in 0..f.len() {
+            let (a, b) = (xs[f[i] as usize], xs[f[(i + 1) % f.len()] as usize]);
+            sum += subfit_mesh::vec3::dist2(a, b).sqrt();
+            count += 1;
+        }
+    }
+    if count == 0 {
+        0.0
+    } else {
+        sum / count as f64
     }
 }
 

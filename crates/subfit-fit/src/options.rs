@@ -164,8 +164,9 @@ pub struct FitOptions {
     /// Where foot points come from: the target's triangles when it has them (default), or
     /// always the local quadrics.
     pub foot_points: FootPointSource,
-    /// Weight `w` of the data → surface part of the objective ([`crate::Coverage`]: every data
-    /// point pulls its nearest sample, point-to-plane inside, point-to-point at boundaries),
+    /// Weight `w` of the data → surface part of the objective ([`crate::Coverage`]: data points
+    /// at the data's or the surface's boundary pull their nearest sample, so open rims reach
+    /// the data's edge),
     /// relative to the surface → data mean: `F = mean_k e_k² + w · mean_j e_j² + …`.
     /// Dimensionless, ≥ 0. Default 0 (off: the papers' one-sided objective, as in the
     /// convergence studies); `subfit::fit_scan` turns it on (1).

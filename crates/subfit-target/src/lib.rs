@@ -31,6 +31,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod blend;
+pub mod boundary_corners;
 pub mod closest;
 mod error;
 pub mod estimate;
@@ -49,6 +50,7 @@ mod regularize;
 mod target;
 mod winding;
 
+pub use boundary_corners::{boundary_corners, BoundaryCorners};
 pub use closest::{MeshClosestPoint, TriangleBvh};
 pub use error::TargetError;
 pub use estimate::Neighborhood;

@@ -407,7 +407,10 @@ pub fn fit_scan(
                 );
             }
             let summary = init_summary(&r, n, &m);
-            (m, Tags::new(), summary)
+            // Sharp turns of an open target's boundary become corner tags of the cage.
+            let (mut m, mut tags) = (m, Tags::new());
+            crate::corners::tag_boundary_corners(&target, &mut m, &mut tags);
+            (m, tags, summary)
         }
     };
     let init_time = t_init.elapsed().as_secs_f64();
