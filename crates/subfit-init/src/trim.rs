@@ -487,3 +487,84 @@ fn extract(mesh: &PolyMesh, keep: &[bool]) -> PolyMesh {
     }
     PolyMesh::new(positions, faces)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use subfit_mesh::shapes::octahedron_mesh;
+
+    #[test]
+    fn fans_are_maximal_runs_and_wrap_around_interior_vertices() {
+        let keep = [true, false, true, true, false, true];
+        // Interior vertex: faces 5 and 0 are one run across the end of the list.
+        assert_eq!(
+            fans(&[0, 1, 2, 3, 4, 5], &keep, true),
+            vec![vec![2, 3], vec![5, 0]]
+        );
+        // Boundary vertex: the list does not wrap.
+        assert_eq!(
+            fans(&[0, 1, 2, 3, 4, 5], &keep, false),
+            vec![vec![0], vec![2, 3], vec![5]]
+        );
+        assert_eq!(fans(&[0, 2, 3], &keep, true), vec![vec![0, 2, 3]]);
+        assert!(fans(&[1, 4], &keep, true).is_empty());
+    }
+
+    /// Two opposite faces of an octahedron touch at one vertex only (a bow-tie); cleaning keeps
+    /// one of them, and the result is a manifold.
+    #[test]
+    fn bow_ties_keep_one_fan() {
+        let m = octahedron_mesh(1.0, 1.0, 1.0);
+        let he = HalfEdgeMesh::from_mesh(&m).unwrap();
+        let v = VertexId(0);
+        let around: Vec<usize> = he.vertex_faces(v).map(|f| f.idx()).collect();
+        assert_eq!(around.len(), 4);
+        let mut keep = vec![false; m.num_faces()];
+        keep[around[0]] = true;
+        keep[around[2]] = true;
+        assert_eq!(remove_minor_fans(&he, &mut keep), 1);
+        assert_eq!(keep.iter().filter(|&&k| k).count(), 1);
+        let out = extract(&m, &keep);
+        assert!(HalfEdgeMesh::from_mesh(&out).is_ok());
+    }
+
+    /// A strip one face wide is eaten from its ends; a face with two kept neighbours stays.
+    #[test]
+    fn ears_are_removed() {
+        let m = octahedron_mesh(1.0, 1.0, 1.0);
+        let he = HalfEdgeMesh::from_mesh(&m).unwrap();
+        let mut keep = vec![true; m.num_faces()];
+        assert_eq!(remove_ears(&he, &mut keep), 0);
+        let mut keep = vec![false; m.num_faces()];
+        keep[0] = true;
+        let g = he.face_neighbors(FaceId(0)).flatten().next().unwrap().idx();
+        keep[g] = true;
+        assert_eq!(remove_ears(&he, &mut keep), 2);
+        assert!(keep.iter().all(|&k| !k));
+    }
+
+    #[test]
+    fn invalid_options_are_errors() {
+        for o in [
+            TrimOptions {
+                support_spacings: 0.0,
+                ..TrimOptions::default()
+            },
+            TrimOptions {
+                support_band_fraction: f64::INFINITY,
+                ..TrimOptions::default()
+            },
+            TrimOptions {
+                max_hole_diameter: -1.0,
+                ..TrimOptions::default()
+            },
+            TrimOptions {
+                min_component_fraction: 2.0,
+                ..TrimOptions::default()
+            },
+        ] {
+            assert!(matches!(validate(&o), Err(TrimError::InvalidOption(_))));
+        }
+        assert!(validate(&TrimOptions::default()).is_ok());
+    }
+}

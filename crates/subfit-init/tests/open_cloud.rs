@@ -283,6 +283,42 @@ fn closed_clouds_stay_closed() {
     }
 }
 
+/// A sphere cloud with a cap cut away gives a disk; with a gap of about two point spacings (a
+/// sampling gap, not a boundary) it stays closed: the unsupported faces over the gap form a
+/// small region, which is kept.
+#[test]
+fn a_cut_sphere_is_open_and_a_small_gap_is_not_a_hole() {
+    let sphere = Shape::Ellipsoid {
+        a: 1.0,
+        b: 1.0,
+        c: 1.0,
+    };
+    let cloud = sphere.sample(8000, 0.0, 8);
+    let cut: Vec<[f64; 3]> = cloud
+        .positions
+        .iter()
+        .copied()
+        .filter(|p| p[2] < 0.8)
+        .collect();
+    check_open("cut sphere", &cut, 0, 1);
+    // 8000 points on the unit sphere: about 0.04 apart, 16th neighbour at about 0.09.
+    let gap: Vec<[f64; 3]> = cloud
+        .positions
+        .iter()
+        .copied()
+        .filter(|p| p[0] * p[0] + p[1] * p[1] > 0.2f64.powi(2) || p[2] < 0.0)
+        .collect();
+    let t = target(&gap);
+    let (cage, rep) = initial_control_mesh(&t, None, N, &InitOptions::default()).unwrap();
+    let trim = rep.trim.clone().unwrap();
+    assert!(!rep.cloud_open(), "{trim:?}");
+    assert!(
+        trim.unsupported_faces > 0 && trim.holes_kept >= 1,
+        "{trim:?}"
+    );
+    assert_eq!(topology(&cage), (0, 0, 1));
+}
+
 /// With trimming disabled an open cloud gives the closed contour, as before.
 #[test]
 fn trimming_can_be_disabled() {
