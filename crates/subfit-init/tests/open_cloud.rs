@@ -224,6 +224,13 @@ fn check_open(name: &str, points: &[[f64; 3]], genus: u32, loops: usize) -> (Pol
     (cage, rep)
 }
 
+/// Largest distance from the points `ps` to the nearest point of `index`.
+fn farthest_from_index(index: &subfit_target::PointIndex, ps: &[[f64; 3]]) -> f64 {
+    ps.iter()
+        .map(|p| index.nearest(p).distance)
+        .fold(0.0, f64::max)
+}
+
 #[test]
 fn a_hemisphere_cloud_gives_a_disk() {
     check_open("hemisphere", &hemisphere(6000, 1), 0, 1);
@@ -372,6 +379,21 @@ fn real_single_view_scan_is_open_and_closed_model_is_closed() {
     assert!(
         far < 3.0 * spacing,
         "bun000: cage vertex {far} vs spacing {spacing}"
+    );
+
+    // No data is left behind by the trimming (a dropped piece of the scan would be): every
+    // point is within two cells of a vertex of the trimmed contour.
+    let (closed, c) = subfit_init::contour(&t, &subfit_init::ContourOptions::default()).unwrap();
+    let band = c.band_cells as f64 * c.cell_size * (1u64 << c.band_level) as f64;
+    let (open, _) =
+        subfit_init::trim_unsupported(&t, &closed, band, &subfit_init::TrimOptions::default())
+            .unwrap();
+    let index = subfit_target::PointIndex::new(&open.positions).unwrap();
+    let uncovered = farthest_from_index(&index, t.points());
+    assert!(
+        uncovered < 2.0 * c.cell_size,
+        "bun000: a data point {uncovered} from the trimmed contour (cell {})",
+        c.cell_size
     );
 
     let bunny = read("bunny.off");
