@@ -48,6 +48,12 @@
 //!    because a single-view scan can hold real disconnected pieces (the bunny scan `bun000`
 //!    has a strip of about 1 % of its points whose surface is about 1 % of the main one's:
 //!    dropping it left data 0.15 unit cube from the cage).
+//! 5. The boundary loops are smoothed ([`TrimOptions::boundary_smoothing`] passes of moving each
+//!    boundary vertex halfway to the midpoint of its loop neighbours, unless a face would turn
+//!    by more than 60°): the cut follows the marching tetrahedra's faces and zig-zags by about a
+//!    cell, and the simplification, which keeps boundaries in shape, then spends its vertices on
+//!    the zig-zag (on `bun000` at 301 control points: 221 boundary vertices unsmoothed, 132
+//!    after 10 passes, 116 after 60).
 //!
 //! When nothing is removed the contour is returned unchanged (a closed cloud stays exactly as
 //! before). Cost: one nearest query per contour vertex and one `k`-nearest query per distinct
@@ -83,6 +89,9 @@ pub struct TrimOptions {
     /// point counted for the component of its nearest kept vertex) are dropped; the component
     /// carrying the most is always kept. Default 0.002. Valid `[0, 1]`.
     pub min_component_data: f64,
+    /// Passes of smoothing of the boundary loops of the result (cleaning step 5). Default 10;
+    /// 0 keeps the marching tetrahedra's zig-zag.
+    pub boundary_smoothing: usize,
 }
 
 impl Default for TrimOptions {
@@ -94,6 +103,7 @@ impl Default for TrimOptions {
             min_hole_faces: 24,
             max_hole_diameter: 2.0,
             min_component_data: 0.002,
+            boundary_smoothing: 10,
         }
     }
 }
@@ -182,8 +192,9 @@ pub fn trim_unsupported(
     if kept == 0 {
         return unchanged(report);
     }
-    let out = extract(contour, &keep);
+    let mut out = extract(contour, &keep);
     let out_he = HalfEdgeMesh::from_mesh(&out).map_err(TrimError::NotManifold)?;
+    smooth_boundary(&mut out, &out_he, options.boundary_smoothing);
     report.faces_trimmed = contour.num_faces() - out.num_faces();
     report.open = report.faces_trimmed > 0;
     report.boundary_loops = out_he.boundary_loops().len();
@@ -497,6 +508,47 @@ fn drop_small_components(
     small.iter().filter(|&&s| s).count()
 }
 
+/// Cleaning step 5: `passes` passes of moving every boundary vertex halfway to the midpoint of
+/// its two loop neighbours (a discrete curve-shortening flow), a move being skipped when it
+/// would turn one of the vertex's faces by more than 60°. Cost `O(passes · #H)`.
+fn smooth_boundary(mesh: &mut PolyMesh, he: &HalfEdgeMesh, passes: usize) {
+    use subfit_mesh::vec3::{add, cross, dot, norm, scale, sub};
+    let loops = he.boundary_loops();
+    let normal = |pos: &[[f64; 3]], f: FaceId| {
+        let v = he.face_vertices(f);
+        let [a, b, c] = [0, 1, 2].map(|k| pos[v[k].idx()]);
+        cross(sub(b, a), sub(c, a))
+    };
+    let cos60 = 0.5;
+    for _ in 0..passes {
+        for lp in &loops {
+            let n = lp.len();
+            if n < 4 {
+                continue;
+            }
+            let old: Vec<[f64; 3]> = lp.iter().map(|v| mesh.positions[v.idx()]).collect();
+            for i in 0..n {
+                let v = lp[i];
+                let mid = scale(add(old[(i + n - 1) % n], old[(i + 1) % n]), 0.5);
+                let target = scale(add(old[i], mid), 0.5);
+                let before: Vec<[f64; 3]> = he
+                    .vertex_faces(v)
+                    .map(|f| normal(&mesh.positions, f))
+                    .collect();
+                let keep = mesh.positions[v.idx()];
+                mesh.positions[v.idx()] = target;
+                let ok = he.vertex_faces(v).zip(&before).all(|(f, nb)| {
+                    let na = normal(&mesh.positions, f);
+                    dot(na, *nb) > cos60 * norm(na) * norm(*nb)
+                });
+                if !ok {
+                    mesh.positions[v.idx()] = keep;
+                }
+            }
+        }
+    }
+}
+
 /// The kept faces of `mesh`, with their vertices re-indexed in order of first use.
 fn extract(mesh: &PolyMesh, keep: &[bool]) -> PolyMesh {
     let mut map = vec![u32::MAX; mesh.num_vertices()];
@@ -574,6 +626,57 @@ mod tests {
         keep[g] = true;
         assert_eq!(remove_ears(&he, &mut keep), 2);
         assert!(keep.iter().all(|&k| !k));
+    }
+
+    /// On a flat grid the boundary smoothing keeps every vertex in the plane, leaves the
+    /// interior alone, flips no face, and straightens a zig-zag boundary.
+    #[test]
+    fn boundary_smoothing_straightens_zig_zags_in_the_plane() {
+        let n = 8;
+        let mut pos = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                // The bottom row zig-zags.
+                let y = if j == 0 && i % 2 == 1 { 0.3 } else { j as f64 };
+                pos.push([i as f64, y, 0.0]);
+            }
+        }
+        let id = |i: usize, j: usize| (i + n * j) as u32;
+        let mut tris = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let before = PolyMesh::new(pos, Polygons::from_triangles(&tris));
+        let he = HalfEdgeMesh::from_mesh(&before).unwrap();
+        let mut m = before.clone();
+        smooth_boundary(&mut m, &he, 10);
+        // Second differences along the bottom row, away from the (rounded) corners.
+        let zig = |m: &PolyMesh| {
+            let y = |i: usize| m.positions[i][1];
+            (2..n - 2)
+                .map(|i| (y(i - 1) - 2.0 * y(i) + y(i + 1)).abs())
+                .fold(0.0, f64::max)
+        };
+        assert!(
+            zig(&m) < 0.3 * zig(&before),
+            "{} vs {}",
+            zig(&m),
+            zig(&before)
+        );
+        for (v, (p, q)) in m.positions.iter().zip(&before.positions).enumerate() {
+            assert_eq!(p[2], 0.0);
+            if !he.is_boundary_vertex(VertexId(v as u32)) {
+                assert_eq!(p, q);
+            }
+        }
+        for t in &tris {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            let z = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(z > 0.0, "{t:?} flipped");
+        }
     }
 
     #[test]
