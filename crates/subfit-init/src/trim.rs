@@ -55,6 +55,13 @@
 //!    the zig-zag (on `bun000` at 301 control points: 221 boundary vertices unsmoothed, 132
 //!    after 10 passes, 116 after 60).
 //!
+//! **Genus.** A part of a surface has at most its genus, so trimming never adds a handle; it
+//! does not cut the handles the contour already has either. The IMLS contour of a cloud with
+//! holes can bridge them with spurious handles (measured with the vertices alone: the bunny
+//! `stanford-bunny.obj`, genus 3 where the data has 0; `beetle.off`, genus 2, though all 11 of
+//! its boundary loops are found). When [`crate::InitOptions::expected_genus`] is set and missed,
+//! [`crate::initial_control_mesh`] falls back to the closed carved wrap.
+//!
 //! When nothing is removed the contour is returned unchanged (a closed cloud stays exactly as
 //! before). Cost: one nearest query per contour vertex and one `k`-nearest query per distinct
 //! nearest data point (parallel, in `subfit-target`), `O(#F)` per cleaning pass, and one nearest
