@@ -4,7 +4,9 @@
 //! condition of Dey et al. 1999), like the method of reference 13 in Cheng et al. 2007 §I; point
 //! clouds are contoured first ([`crate::contour()`](mod@crate::contour): IMLS of Xie et al. 2023 on an adaptive octree, marching
 //! tetrahedra) and then simplified, as Cheng et al. 2004 §4.3 (marching cubes on an octree, then
-//! simplification).
+//! simplification). Between the two, the contour of an open cloud is cut where no data supports
+//! it ([`crate::trim`](mod@crate::trim)), so that the cage has the open target's boundary loops
+//! (DESIGN.md §3.6; the open surfaces of Lavoué et al. 2007 §4).
 
 use std::time::{Duration, Instant};
 
@@ -15,6 +17,7 @@ use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
 use crate::quads::{pair_triangles, PairOptions, PairReport};
 use crate::simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
+use crate::trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};
 
 /// Options of [`initial_control_mesh`].
 #[derive(Clone, Debug, PartialEq)]
@@ -23,6 +26,9 @@ pub struct InitOptions {
     pub simplify: SimplifyOptions,
     /// Contouring options (point clouds only).
     pub contour: ContourOptions,
+    /// Trimming the contour where no data supports it (point clouds only; see
+    /// [`crate::trim`](mod@crate::trim)): an open cloud gives an open cage. Default: enabled.
+    pub trim: TrimOptions,
     /// Genus the caller expects for a point cloud (compared in the report). When the IMLS
     /// contour has another genus, the space-carving fallback ([`crate::carve()`], which ignores
     /// the normals) is tried and used if it matches. Default `None`: the contour's genus is
@@ -58,6 +64,7 @@ impl Default for InitOptions {
         Self {
             simplify: SimplifyOptions::default(),
             contour: ContourOptions::default(),
+            trim: TrimOptions::default(),
             expected_genus: None,
             require_genus: false,
             contour_vertices_per_control: 8.0,
@@ -129,7 +136,8 @@ pub struct InitReport {
     pub genus_before: u32,
     /// Genus of the result.
     pub genus_after: u32,
-    /// Boundary loops before and after simplification.
+    /// Boundary loops before and after simplification (for a point cloud, "before" is the
+    /// trimmed contour's: the loops found in the cloud).
     pub boundary_loops: (usize, usize),
     /// Connected components of the result.
     pub components: usize,
@@ -141,6 +149,16 @@ pub struct InitReport {
     pub simplify: SimplifyReport,
     /// Contouring details (point clouds only).
     pub contour: Option<ContourReport>,
+    /// Point clouds: the trimming of the contour where no data supports it
+    /// ([`crate::trim`](mod@crate::trim)); `trim.open` tells whether the cloud was found open,
+    /// `trim.faces_trimmed` how many contour faces were cut, `trim.boundary_loops` how many
+    /// boundary loops the trimmed contour has. `None` for mesh targets.
+    pub trim: Option<TrimReport>,
+    /// Point clouds: the boundary loops of the trimmed contour as closed polylines (normalized
+    /// units, last point not repeated, faces on the left; see
+    /// [`crate::trim::boundary_polylines`]), for fitting boundary curves. Empty for a closed
+    /// cloud and for mesh targets.
+    pub boundary_curves: Vec<Vec<[f64; 3]>>,
     /// Point clouds: the carving radius (normalized units) when the IMLS contour missed
     /// [`InitOptions::expected_genus`] and the space-carving fallback ([`crate::carve()`]) was
     /// used; `None` otherwise.
@@ -149,6 +167,14 @@ pub struct InitReport {
     pub pairing: Option<PairReport>,
     /// Step times.
     pub timings: InitTimings,
+}
+
+impl InitReport {
+    /// Whether the target is a point cloud whose contour was trimmed, i.e. found open (see
+    /// [`crate::trim`](mod@crate::trim)). `false` for mesh targets and closed clouds.
+    pub fn cloud_open(&self) -> bool {
+        self.trim.as_ref().is_some_and(|t| t.open)
+    }
 }
 
 /// Why [`initial_control_mesh`] failed.
@@ -188,6 +214,9 @@ pub enum InitError {
     /// The point cloud cannot be contoured.
     #[error("contouring failed: {0}")]
     Contour(ContourError),
+    /// The contour cannot be trimmed (an invalid [`InitOptions::trim`]).
+    #[error("trimming the contour failed: {0}")]
+    Trim(#[from] TrimError),
     /// The result is not manifold (an internal error).
     #[error("internal error: the initial mesh is not manifold: {0}")]
     Topology(#[from] TopologyError),
@@ -233,12 +262,17 @@ impl From<Cancelled> for InitError {
 ///
 /// * `mesh = Some(m)` with faces: `m` (in the target's **original** coordinates, e.g. the mesh the
 ///   target was built from) is mapped into normalized units and simplified.
-/// * otherwise the target's points (with their oriented normals) are contoured, then simplified.
-///   When [`InitOptions::expected_genus`] is set and the contour misses it, the normal-free
-///   space-carving wrap ([`crate::carve()`]) is tried instead (`report.carve_radius`).
+/// * otherwise the target's points (with their oriented normals) are contoured, the contour's
+///   faces that no data supports are trimmed away ([`crate::trim`](mod@crate::trim): an open
+///   cloud such as a single-view scan gives an open surface, `report.trim`,
+///   `report.boundary_curves`; a closed cloud's contour is kept as is), then simplified, which
+///   keeps the boundary loops. When [`InitOptions::expected_genus`] is set and the trimmed
+///   contour misses it, the normal-free space-carving wrap ([`crate::carve()`], closed, not
+///   trimmed) is tried instead (`report.carve_radius`).
 ///
 /// The result is in the target's normalized units, manifold, consistently oriented (outward for
-/// contours; as the input for meshes), closed when the target is; it may keep more than
+/// contours; as the input for meshes), closed when the target is (for a point cloud: when every
+/// contour face is supported by data); it may keep more than
 /// `n_vertices` vertices when no legal collapse remains (see `report.simplify.reached_target`).
 ///
 /// Errors: [`InitError::TooFewVertices`] (`n_vertices < 4`), [`InitError::InvalidMesh`] /
@@ -270,19 +304,8 @@ pub fn initial_control_mesh(
         _ => {
             report.source = InitSource::Contour;
             let t = Instant::now();
-            let (m, c) = contour_for(target, n_vertices, options)?;
-            let (m, c) = match options.expected_genus {
-                Some(g) if c.genus != g => match carve_for(target, &c, g, &options.cancel)? {
-                    Some((cm, cc, r)) => {
-                        report.carve_radius = Some(r);
-                        (cm, cc)
-                    }
-                    None => (m, c),
-                },
-                _ => (m, c),
-            };
+            let m = cloud_surface(target, n_vertices, options, &mut report)?;
             report.timings.contour = t.elapsed();
-            report.contour = Some(c);
             m
         }
     };
@@ -360,6 +383,37 @@ fn normalized_mesh(target: &Target, m: &PolyMesh) -> Result<PolyMesh, InitError>
         positions,
         subfit_mesh::Polygons::from_triangles(&tris),
     ))
+}
+
+/// The surface of a point cloud: the contour ([`contour_for`]) trimmed where no data supports it
+/// ([`trim_unsupported`]); when [`InitOptions::expected_genus`] is set and the trimmed contour
+/// misses it, the space-carving wrap ([`carve_for`]) if that has the genus. A carved wrap lies
+/// about the carving radius off the data on every side, so it is not trimmed (the support test
+/// would remove it all). Fills `report.contour`, `report.trim`, `report.carve_radius` and
+/// `report.boundary_curves`.
+fn cloud_surface(
+    target: &Target,
+    n_vertices: usize,
+    options: &InitOptions,
+    report: &mut InitReport,
+) -> Result<PolyMesh, InitError> {
+    let (m, c) = contour_for(target, n_vertices, options)?;
+    options.cancel.check()?;
+    let band_width = c.band_cells as f64 * c.cell_size * (1u64 << c.band_level) as f64;
+    let (m, tr) = trim_unsupported(target, &m, band_width, &options.trim)?;
+    if let Some(g) = options.expected_genus.filter(|&g| g != tr.genus) {
+        if let Some((cm, cc, r)) = carve_for(target, &c, g, &options.cancel)? {
+            report.carve_radius = Some(r);
+            report.contour = Some(cc);
+            return Ok(cm);
+        }
+    }
+    if tr.open {
+        report.boundary_curves = boundary_polylines(&m)?;
+    }
+    report.trim = Some(tr);
+    report.contour = Some(c);
+    Ok(m)
 }
 
 /// The contour of the target's points, re-contoured once at a finer resolution when it has fewer

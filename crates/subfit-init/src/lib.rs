@@ -10,6 +10,8 @@
 //!   leaves, which always yields a closed, manifold, consistently oriented, crack-free surface.
 //! * [`carve`](mod@carve): a normal-free wrap of a point cloud (space carving with a ball), the
 //!   fallback when the IMLS contour misses an expected genus (e.g. badly oriented normals).
+//! * [`trim`](mod@trim): the faces of a contour that no data supports are cut away, so an open
+//!   cloud (a single-view scan) gives an open surface with its boundary loops.
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
 //!   contoured then simplified; the genus is checked against the target's and reported.
 //! * [`quads`](mod@quads): [`pair_triangles`] turns a triangle cage into a quad-dominant one,
@@ -27,6 +29,7 @@ mod march;
 mod octree;
 pub mod quads;
 pub mod simplify;
+pub mod trim;
 
 pub use carve::carve;
 pub use contour::{contour, ContourError, ContourOptions, ContourReport, MAX_RESOLUTION};
@@ -36,3 +39,4 @@ pub use init::{
 };
 pub use quads::{coherency_score, pair_triangles, PairOptions, PairReport};
 pub use simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
+pub use trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};

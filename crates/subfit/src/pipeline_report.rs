@@ -126,8 +126,17 @@ pub struct InitSummary {
     pub genus: u32,
     /// Whether they match.
     pub genus_matches: bool,
-    /// Boundary loops of the target and of the cage.
+    /// Boundary loops of the target and of the cage. For a point cloud the target's are those of
+    /// its trimmed contour (`subfit_init::trim`: the loops found in the cloud).
     pub boundary_loops: BoundaryLoops,
+    /// Point clouds: whether the cloud was found open (contour faces without data nearby were
+    /// trimmed, `subfit_init::trim`). `false` for meshes and given cages.
+    #[serde(default)]
+    pub cloud_open: bool,
+    /// Point clouds: contour faces trimmed as unsupported by data (0 for a closed cloud, a mesh
+    /// or a given cage).
+    #[serde(default)]
+    pub contour_faces_trimmed: usize,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
 }

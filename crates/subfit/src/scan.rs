@@ -363,6 +363,8 @@ pub fn fit_scan(
                     target: target_topology.map_or(topo.boundary_loops, |t| t.boundary_loops),
                     cage: topo.boundary_loops,
                 },
+                cloud_open: false,
+                contour_faces_trimmed: 0,
                 timings_s: InitTimings {
                     pair: t_pair.elapsed().as_secs_f64(),
                     total: t_pair.elapsed().as_secs_f64(),
@@ -763,6 +765,8 @@ fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
             target: r.boundary_loops.0,
             cage: r.boundary_loops.1,
         },
+        cloud_open: r.cloud_open(),
+        contour_faces_trimmed: r.trim.as_ref().map_or(0, |t| t.faces_trimmed),
         timings_s: InitTimings {
             contour: r.timings.contour.as_secs_f64(),
             simplify: r.timings.simplify.as_secs_f64(),

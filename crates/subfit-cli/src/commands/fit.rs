@@ -164,14 +164,22 @@ pub fn run_with_progress(
 /// The initial cage in one line: control points, faces, quads and triangles.
 pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
     format!(
-        "initial cage ({}): {} control points, {} faces: {} quads, {} triangles ({:.0}% quads{})",
+        "initial cage ({}): {} control points, {} faces: {} quads, {} triangles ({:.0}% quads{}){}",
         i.source,
         i.control_points,
         i.faces,
         i.quads,
         i.triangles,
         100.0 * i.quad_fraction,
-        if i.paired { ", triangles paired" } else { "" }
+        if i.paired { ", triangles paired" } else { "" },
+        if i.cloud_open {
+            format!(
+                "; open cloud: {} contour faces trimmed, {} boundary loop(s)",
+                i.contour_faces_trimmed, i.boundary_loops.cage
+            )
+        } else {
+            String::new()
+        }
     )
 }
 

@@ -209,6 +209,13 @@ fn print_summary(
             r.simplify.vertices_before, r.simplify.faces_before
         ),
     }
+    if let Some(t) = r.trim.as_ref().filter(|t| t.open) {
+        println!(
+            "open cloud: {} of {} contour faces trimmed (no data within the support distance, median {:.4} unit cube), \
+             {} boundary loop(s), genus {}",
+            t.faces_trimmed, t.faces_before, t.support_distance, t.boundary_loops, t.genus
+        );
+    }
     let versus = if r.source == InitSource::Contour && input.is_none() && a.genus.is_none() {
         "target genus unknown (a point cloud: pass --genus G to check it)".to_owned()
     } else {
