@@ -26,17 +26,21 @@
 //! `Q`, leaving `r` (so the gradient) alone: a constant stand-in for SD's `[α]₊ T Tᵀ` curvature
 //! terms, which damps tangential drift. Measured on the 14-vertex ellipsoid cage of Cheng 2007
 //! Example 10 (12k points, λ = 0, level 3, LM; `tests/imls.rs`), IMLS `E_rms` per iteration:
-//! β = 0 reaches 0.0027 at iteration 3 and 0.00139 at 4 (the floor: the IMLS zero set's own
-//! deviation); β = 0.01 descends faster at first (0.0036, then 0.0018 at 3) but crawls to the
-//! floor (0.00139 at 10); β = 0.1 is at 0.0032 after 10. The term adds stiffness, not
-//! information, so the default is 0.
+//! β = 0 reaches 0.0059 at iteration 2 and 0.00144 at 3 (the floor, 0.00140, is the IMLS zero
+//! set's own deviation); β = 0.01 descends faster at first (0.0154, 0.0024, 0.0017 at 3) but
+//! crawls to the floor (0.00141 at 10); β = 0.1 is still above 0.003 after 10. The term adds
+//! stiffness, not information, so the default is 0.
 //!
 //! **Support radius.** `h` comes from [`FitOptions::imls_radius`], else
-//! [`ImlsTerm::auto_radius`]: twice the target's point spacing (the distance to the 16th
-//! nearest neighbour, so about 30–60 points inside the kernel on a clean scan), at least
-//! 4 × its noise level (the kernel must average the noise out) and at least the target's own
-//! IMLS radius ([`Target::imls_radius`]). Xie et al. set `h₀` by hand (0.0005 for the bunny
-//! and Lucy, 0.05 for the noisy koala, §5.1).
+//! [`ImlsTerm::auto_radius`]: half the target's point spacing (the median distance to the 16th
+//! nearest neighbour, so about 4 points inside the kernel, 2 nearest-neighbour spacings) and at
+//! least 4 × its noise level (on a noisy scan the kernel must average the noise out). Xie et al.
+//! set `h₀` by hand (0.0005 for the bunny and Lucy, 0.05 for the noisy koala, §5.1). Measured on
+//! the bunny's points (spacing 0.0188, `subfit fit --as-points --method imls`, fixed control
+//! points), two-sided E_rms by `h`: at 4,667 points 0.005 → 1.31e-3, 0.008 → 9.3e-4, 0.012 →
+//! 1.12e-3, 0.02 → 1.48e-3, 0.043 → 2.31e-3 (a wide kernel rounds the ears and the surface fits
+//! the rounded shape); at 314 points 0.008 → 3.14e-3, 0.02 → 3.69e-3, 0.043 → 3.49e-3 (too few
+//! control points for `h` to matter much).
 //!
 //! **Empty neighbourhoods.** A sample farther than `h` from every data point (a cage far from
 //! the data) grows the radius: `2h`, then `4h`; beyond that `f` is the signed distance to the
@@ -117,14 +121,13 @@ impl<'t> ImlsTerm<'t> {
         self
     }
 
-    /// The automatic support radius of `target` (normalized units): the largest of twice the
-    /// point spacing ([`subfit_target::TargetStats::point_spacing`]), four noise levels
-    /// ([`subfit_target::TargetStats::noise_level`]) and [`Target::imls_radius`]. Cost: O(1).
+    /// The automatic support radius of `target` (normalized units): half the point spacing
+    /// ([`subfit_target::TargetStats::point_spacing`]), at least four noise levels
+    /// ([`subfit_target::TargetStats::noise_level`]); [`Target::imls_radius`] when both are
+    /// unknown (0). Cost: O(1).
     pub fn auto_radius(target: &Target) -> f64 {
         let s = target.stats();
-        let h = (2.0 * s.point_spacing)
-            .max(4.0 * s.noise_level)
-            .max(target.imls_radius());
+        let h = (0.5 * s.point_spacing).max(4.0 * s.noise_level);
         if h.is_finite() && h > 0.0 {
             h
         } else {

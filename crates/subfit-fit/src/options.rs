@@ -166,8 +166,8 @@ pub struct FitOptions {
     pub foot_points: FootPointSource,
     /// [`Method::Imls`]: the kernel support radius `h` (normalized units, the unit cube the
     /// target is scaled into — the units of Xie et al. 2023 §5.1's `h₀`). Default `None`:
-    /// chosen from the target ([`crate::ImlsTerm::auto_radius`]: 2 × the point spacing, at
-    /// least 4 × the noise level and the target's own IMLS radius). Valid: finite, `> 0`.
+    /// chosen from the target ([`crate::ImlsTerm::auto_radius`]: half the point spacing, at
+    /// least 4 × the noise level). Valid: finite, `> 0`.
     pub imls_radius: Option<f64>,
     /// [`Method::Imls`]: weight `β ≥ 0` of the tangential term added to the Gauss-Newton
     /// matrix, `Q = ∇f ∇fᵀ + β (‖∇f‖² I − ∇f ∇fᵀ)` (a constant stand-in for SD's curvature
@@ -177,9 +177,11 @@ pub struct FitOptions {
     /// Weight `α` of the as-rigid-as-possible regularizer on the control mesh (Sorkine & Alexa
     /// 2007; Xie et al. 2023 eq. 5; [`crate::Arap`]), added to the objective as
     /// `α/n · E_arap` beside the data term's mean and the umbrella smoothing `λ/n ‖L P‖²`
-    /// (both are kept: set `λ = 0` for ARAP alone). Its rest shape is the cage the fitter
-    /// starts from. Dimensionless. Default 0 (off); the paper uses 0.01 on clean scans, 0.1
-    /// on noisy ones.
+    /// (both are kept: set `λ = 0` for ARAP alone). Its rest shape is the cage a
+    /// [`crate::Fitter`] first runs from — in [`crate::fit_stages`] the initial cage until a
+    /// refinement or flip changes the topology, then the changed cage. Dimensionless. Default 0
+    /// (off); the paper uses 0.01 on clean scans, 0.1 on noisy ones (its data term is a sum
+    /// over about as many samples as control points, so the same `α` means the same balance).
     pub arap: f64,
     /// Cancellation token, polled at the start of every iteration and of every LM / Armijo
     /// trial; once cancelled, [`crate::Fitter::run`] (and [`crate::fit`], [`crate::fit_stages`])

@@ -68,6 +68,8 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             sample_level: a.sample_level as usize,
             method,
             step,
+            imls_radius: a.imls_radius,
+            arap: a.arap,
             ..FitOptions::default()
         },
         stages: StageOptions {
@@ -200,6 +202,7 @@ fn method_of(m: MethodArg) -> Method {
         MethodArg::Pdm => Method::Pdm,
         MethodArg::Tdm => Method::Tdm,
         MethodArg::Sdm => Method::Sdm,
+        MethodArg::Imls => Method::Imls,
     }
 }
 
