@@ -167,9 +167,20 @@ pub struct FitArgs {
     /// clamp(1.5·√points, 200, 2000)].
     #[arg(long, value_parser = clap::value_parser!(u32).range(4..=1_000_000))]
     pub control_points: Option<u32>,
-    /// Error term: point (PDM), tangent (TDM) or squared distance (SDM), Cheng et al. 2007.
+    /// Error term: point (PDM), tangent (TDM) or squared distance (SDM), Cheng et al. 2007; or
+    /// the IMLS distance of Xie et al. 2023 (IMLS).
     #[arg(long, value_enum, default_value_t = MethodArg::Sdm)]
     pub method: MethodArg,
+    /// `--method imls`: support radius h of the IMLS kernel, in unit-cube units (the target is
+    /// scaled so its longest side is 1; Xie et al.'s h₀) [default: half the point spacing
+    /// (distance to the 16th nearest neighbour), at least 4 × the noise level].
+    #[arg(long)]
+    pub imls_radius: Option<f64>,
+    /// Weight α of the as-rigid-as-possible regularizer on the control mesh, rest shape the
+    /// initial cage (Xie et al. 2023 eq. 5; 0.01 for clean scans, 0.1 for noisy ones in the
+    /// paper); added to the --lambda smoothing (give --lambda 0 for ARAP alone). 0: off.
+    #[arg(long, default_value_t = 0.0)]
+    pub arap: f64,
     /// Step control: none, Levenberg-Marquardt, or Armijo backtracking.
     #[arg(long, value_enum, default_value_t = StepArg::Lm)]
     pub step: StepArg,
@@ -263,6 +274,8 @@ pub enum MethodArg {
     Tdm,
     /// Squared distance minimization.
     Sdm,
+    /// The IMLS distance (Xie et al. 2023).
+    Imls,
 }
 
 /// A step control named on the command line.

@@ -13,6 +13,8 @@ use subfit_subdiv::{sampling_operator, SamplingOperator};
 use subfit_target::Target;
 
 use crate::active::{sample_rows, ActiveSet, FixedErrors};
+use crate::any_term::AnyTerm;
+use crate::arap::ArapState;
 use crate::assemble::{FillScratch, Pattern};
 use crate::error::{FitError, FitPhase};
 use crate::foot_point_term::FootPointTerm;
@@ -60,6 +62,8 @@ pub struct Fitter<'t, T: DataTerm = FootPointTerm<'t>> {
     active: Option<ActiveSet>,
     /// Partial sums of the fill, reused.
     scratch: FillScratch,
+    /// The ARAP regularizer when [`FitOptions::arap`] `> 0` (rest shape: the first run's cage).
+    arap: Option<ArapState>,
     /// The target (or whatever the term borrows) outlives the fitter.
     _data: PhantomData<&'t ()>,
 }
@@ -158,6 +162,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             lap,
             active: None,
             scratch: FillScratch::default(),
+            arap: (options.arap > 0.0).then(|| ArapState::Pending(faces.clone())),
             _data: PhantomData,
         })
     }
@@ -379,7 +384,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             e_rms,
             e_max_diag: e_max / self.bbox_diagonal,
             e_rms_diag: e_rms / self.bbox_diagonal,
-            objective: objective / m + smooth,
+            objective: objective / m + smooth + self.arap_objective(control),
         }
     }
 
@@ -410,6 +415,9 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             });
         }
         let opts = self.options.clone();
+        if let Some(a) = &mut self.arap {
+            a.ensure(control);
+        }
         self.ensure_fixed(control);
         let mut cur = self.state(control, &mut PhaseTimings::default());
         check_finite(cur.stats.objective, 0, FitPhase::Evaluate, "objective")?;
@@ -638,7 +646,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 .map(|(&s, f)| term.model(f, s).1)
                 .collect()
         };
-        let (g, pattern, values) = match &mut self.active {
+        let (mut g, pattern, values, points) = match &mut self.active {
             None => {
                 let g = self.pattern.fill_with_gradient(
                     &self.op.position,
@@ -650,7 +658,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                     &mut self.values,
                     &mut self.scratch,
                 );
-                (g, &self.pattern, &self.values)
+                (g, &self.pattern, &mut self.values, None)
             }
             Some(a) => {
                 // The smoothing gradient needs the fixed points too: the fill's own is taken
@@ -667,11 +675,25 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                     &mut self.scratch,
                 );
                 a.add_smoothing_gradient(&self.lap, control, w_s, &mut g);
-                (g, &a.pattern, &a.values)
+                (g, &a.pattern, &mut a.values, Some(&a.points[..]))
             }
         };
+        if let Some(arap) = self.arap.as_ref().and_then(ArapState::ready) {
+            let w = 2.0 * self.options.arap / n;
+            if let Err((i, j)) = arap.add_to_system(control, w, pattern, values, &mut g, points) {
+                panic!("ARAP pair ({i}, {j}) is missing from the pattern of H");
+            }
+        }
         self.hdiag = pattern.diag_slots().iter().map(|&s| values[s]).collect();
         g
+    }
+
+    /// `α/n · E_arap(control)` once the regularizer is built, else 0.
+    fn arap_objective(&self, control: &[[f64; 3]]) -> f64 {
+        match self.arap.as_ref().and_then(ArapState::ready) {
+            Some(a) => self.options.arap / control.len().max(1) as f64 * a.energy(control),
+            None => 0.0,
+        }
     }
 
     /// Solves `(H + shift·I) δ = −g`.
@@ -789,8 +811,8 @@ pub fn fit(
     control_mesh: &PolyMesh,
     options: &FitOptions,
 ) -> Result<FitResult, FitError> {
-    let mut fitter = Fitter::new(
-        target,
+    let mut fitter = Fitter::with_term(
+        AnyTerm::from_options(target, options),
         &control_mesh.faces,
         control_mesh.num_vertices(),
         options,

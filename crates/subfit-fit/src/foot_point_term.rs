@@ -51,6 +51,11 @@ pub enum Method {
     /// step. The default.
     #[default]
     Sdm,
+    /// The IMLS distance of Xie et al. 2023 (eq. 2–4): not a foot-point term — the fitter
+    /// takes [`crate::ImlsTerm`] for it (through [`crate::AnyTerm`]). A [`FootPointTerm`] given
+    /// it measures foot-point distances (how the pipeline compares fits of every method) and
+    /// models them as TD, the foot-point analogue of IMLS's `∇f ∇fᵀ`.
+    Imls,
 }
 
 /// The source of foot points.
@@ -67,7 +72,7 @@ pub enum FootPointSource {
 pub fn error_matrix(method: Method, foot: &FootPoint) -> Mat3 {
     match method {
         Method::Pdm => IDENTITY,
-        Method::Tdm => outer(foot.normal, foot.normal, 1.0),
+        Method::Tdm | Method::Imls => outer(foot.normal, foot.normal, 1.0),
         Method::Sdm => {
             let mut q = outer(foot.normal, foot.normal, 1.0);
             add_outer(&mut q, foot.t1, sanitize(foot.alpha1));

@@ -6,7 +6,11 @@
 //! Cholesky solve, and control the step by Levenberg–Marquardt or Armijo (§III-C).
 //!
 //! * [`DataTerm`]: what is fitted — per sample, the true squared error and its quadratic model
-//!   (`Q_k`, `Q_k (S_k − V_k)`); [`FootPointTerm`] is Cheng's PD/TD/SD on a target;
+//!   (`Q_k`, `Q_k (S_k − V_k)`); [`FootPointTerm`] is Cheng's PD/TD/SD on a target,
+//!   [`ImlsTerm`] Xie et al. 2023's IMLS distance (§4.1, eq. 2–4; [`Method::Imls`]), and
+//!   [`AnyTerm`] whichever [`FitOptions::method`] names;
+//! * [`Arap`]: the as-rigid-as-possible regularizer on the control mesh (Sorkine & Alexa
+//!   2007; Xie et al. 2023 eq. 5), [`FitOptions::arap`], folded into the same sparse system;
 //! * [`Fitter`] / [`fit`]: the loop with step control (sampling operator, the pattern of the
 //!   normal matrix and its symbolic Cholesky analysis kept between iterations and calls; PCG
 //!   for large systems, [`LinearSolver`]); [`FitReport`] logs every iteration;
@@ -45,12 +49,15 @@
 //! ```
 
 mod active;
+mod any_term;
+mod arap;
 mod assemble;
 mod coverage;
 mod error;
 mod fitter;
 mod foot_point_term;
 mod grouped_fill;
+mod imls_term;
 mod options;
 mod ordering;
 mod pcg;
@@ -62,10 +69,13 @@ mod solve;
 mod stages;
 mod term;
 
+pub use any_term::{AnySample, AnyTerm};
+pub use arap::Arap;
 pub use coverage::{CoverSum, Coverage};
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
 pub use foot_point_term::{FootPointSource, FootPointTerm, FootSample};
+pub use imls_term::{ImlsSample, ImlsTerm};
 pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
 pub use pcg::PcgStats;
 pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};

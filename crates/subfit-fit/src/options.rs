@@ -171,6 +171,25 @@ pub struct FitOptions {
     /// Dimensionless, ≥ 0. Default 0 (off: the papers' one-sided objective, as in the
     /// convergence studies); `subfit::fit_scan` turns it on (1).
     pub coverage: f64,
+    /// [`Method::Imls`]: the kernel support radius `h` (normalized units, the unit cube the
+    /// target is scaled into — the units of Xie et al. 2023 §5.1's `h₀`). Default `None`:
+    /// chosen from the target ([`crate::ImlsTerm::auto_radius`]: half the point spacing, at
+    /// least 4 × the noise level). Valid: finite, `> 0`.
+    pub imls_radius: Option<f64>,
+    /// [`Method::Imls`]: weight `β ≥ 0` of the tangential term added to the Gauss-Newton
+    /// matrix, `Q = ∇f ∇fᵀ + β (‖∇f‖² I − ∇f ∇fᵀ)` (a constant stand-in for SD's curvature
+    /// terms; the residual, hence the gradient, is unchanged). Dimensionless. Default 0 (see
+    /// [`crate::ImlsTerm`] for the measurements).
+    pub imls_tangential: f64,
+    /// Weight `α` of the as-rigid-as-possible regularizer on the control mesh (Sorkine & Alexa
+    /// 2007; Xie et al. 2023 eq. 5; [`crate::Arap`]), added to the objective as
+    /// `α/n · E_arap` beside the data term's mean and the umbrella smoothing `λ/n ‖L P‖²`
+    /// (both are kept: set `λ = 0` for ARAP alone). Its rest shape is the cage a
+    /// [`crate::Fitter`] first runs from — in [`crate::fit_stages`] the initial cage until a
+    /// refinement or flip changes the topology, then the changed cage. Dimensionless. Default 0
+    /// (off); the paper uses 0.01 on clean scans, 0.1 on noisy ones (its data term is a sum
+    /// over about as many samples as control points, so the same `α` means the same balance).
+    pub arap: f64,
     /// Cancellation token, polled at the start of every iteration and of every LM / Armijo
     /// trial; once cancelled, [`crate::Fitter::run`] (and [`crate::fit`], [`crate::fit_stages`])
     /// return [`crate::FitError::Interrupted`]. Default: a fresh token, never cancelled.
@@ -203,6 +222,9 @@ impl Default for FitOptions {
             pcg_max_iterations: 500,
             foot_points: FootPointSource::Auto,
             coverage: 0.0,
+            imls_radius: None,
+            imls_tangential: 0.0,
+            arap: 0.0,
             cancel: Cancel::default(),
         }
     }
@@ -256,9 +278,17 @@ impl FitOptions {
 
     /// Checks value ranges; returns the offending field's name and value.
     pub(crate) fn validate(&self) -> Result<(), (&'static str, f64)> {
-        let checks: [(&'static str, f64, bool); 10] = [
+        let h = self.imls_radius.unwrap_or(1.0);
+        let checks: [(&'static str, f64, bool); 13] = [
             ("coverage", self.coverage, self.coverage >= 0.0),
             ("lambda", self.lambda, self.lambda >= 0.0),
+            ("imls_radius", h, h > 0.0),
+            (
+                "imls_tangential",
+                self.imls_tangential,
+                self.imls_tangential >= 0.0,
+            ),
+            ("arap", self.arap, self.arap >= 0.0),
             (
                 "tolerance_rms",
                 self.tolerance_rms,

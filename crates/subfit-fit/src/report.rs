@@ -46,7 +46,8 @@ pub struct ErrorStats {
     pub e_max_diag: f64,
     /// `E_rms` as a fraction of the target's bounding-box diagonal.
     pub e_rms_diag: f64,
-    /// The objective `F = E_rms² + λ/n Σ|W(P_i)|²` (squared normalized units).
+    /// The objective `F = E_rms² + λ/n Σ|W(P_i)|² (+ α/n E_arap with [`crate::FitOptions::arap`])`
+    /// (squared normalized units).
     pub objective: f64,
 }
 

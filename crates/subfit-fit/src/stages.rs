@@ -26,6 +26,7 @@ use subfit_report::{data_samples, DistanceStats, MeshDistance, TwoSided};
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 use subfit_target::Target;
 
+use crate::any_term::AnyTerm;
 use crate::error::FitError;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
@@ -352,13 +353,14 @@ pub enum StageEvent<'a> {
 /// symbolic factorization) and the control face of every face of the sample tessellation.
 /// Rebuilt only when the topology changes (refinement, flips); a `λ` change keeps both.
 struct Topo<'t> {
-    fitter: Fitter<'t>,
+    fitter: Fitter<'t, AnyTerm<'t>>,
     owners: Vec<u32>,
 }
 
 impl<'t> Topo<'t> {
     fn new(target: &'t Target, mesh: &PolyMesh, opts: &FitOptions) -> Result<Self, FitError> {
-        let fitter = Fitter::new(target, &mesh.faces, mesh.num_vertices(), opts)?;
+        let term = AnyTerm::from_options(target, opts);
+        let fitter = Fitter::with_term(term, &mesh.faces, mesh.num_vertices(), opts)?;
         let owners = face_owners(&mesh.faces, fitter.sampling_operator());
         Ok(Self { fitter, owners })
     }

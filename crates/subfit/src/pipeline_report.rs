@@ -215,6 +215,13 @@ pub struct OptionsSummary {
     pub local: bool,
     /// Rings around a local change.
     pub local_rings: usize,
+    /// `--method imls`: the IMLS kernel support radius `h` in use (normalized units); absent
+    /// for the foot-point methods.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub imls_radius: Option<f64>,
+    /// Weight `α` of the ARAP regularizer (0: off).
+    #[serde(default)]
+    pub arap: f64,
 }
 
 /// One stage.

@@ -563,6 +563,9 @@ pub fn fit_scan(
             max_depth: st.max_depth,
             local: st.local,
             local_rings: st.local_rings,
+            imls_radius: (fit.method == subfit_fit::Method::Imls)
+                .then(|| subfit_fit::ImlsTerm::from_options(&target, &fit).radius()),
+            arap: fit.arap,
         },
         control_points: result.mesh.num_vertices(),
         control_faces: result.mesh.faces.len(),
@@ -708,6 +711,24 @@ fn validate(o: &FitScanOptions) -> Result<(), Error> {
                 "{name} must be in (0, 1) (unit-cube units), got {v}"
             ));
         }
+    }
+    if let Some(v) = o.fit.imls_radius {
+        if !(v.is_finite() && v > 0.0 && v < 1.0) {
+            return bad(format!(
+                "--imls-radius must be in (0, 1) (unit-cube units), got {v}"
+            ));
+        }
+        if o.fit.method != subfit_fit::Method::Imls {
+            return bad(
+                "--imls-radius is the IMLS kernel's radius: use it with --method imls".into(),
+            );
+        }
+    }
+    if !(o.fit.arap.is_finite() && o.fit.arap >= 0.0) {
+        return bad(format!(
+            "--arap must be a finite number ≥ 0, got {}",
+            o.fit.arap
+        ));
     }
     if let Some(v) = o.error_scale {
         if !(v.is_finite() && v > 0.0 && v < 1.0) {

@@ -69,6 +69,8 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             method,
             step,
             coverage: a.coverage,
+            imls_radius: a.imls_radius,
+            arap: a.arap,
             ..FitOptions::default()
         },
         stages: StageOptions {
@@ -209,6 +211,7 @@ fn method_of(m: MethodArg) -> Method {
         MethodArg::Pdm => Method::Pdm,
         MethodArg::Tdm => Method::Tdm,
         MethodArg::Sdm => Method::Sdm,
+        MethodArg::Imls => Method::Imls,
     }
 }
 

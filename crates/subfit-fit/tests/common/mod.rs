@@ -78,3 +78,18 @@ pub fn quad_sphere(n: usize) -> PolyMesh {
     }
     PolyMesh::new(pos, faces)
 }
+
+/// A seeded linear congruential generator (Knuth's MMIX constants) for reproducible test
+/// inputs without a dependency.
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next value, uniform in `[0, 1)`.
+    pub fn unit(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
