@@ -92,9 +92,9 @@ impl CoverSum {
         let d = sub(p, self.x0);
         match n {
             None => {
-                for a in 0..3 {
+                for (a, da) in d.iter().enumerate() {
                     self.q[a][a] += w;
-                    self.b[a] += w * d[a];
+                    self.b[a] += w * da;
                 }
                 self.c += w * dot(d, d);
             }

@@ -159,7 +159,7 @@ fn the_model_is_the_gauss_newton_model_of_the_objective_share() {
     for (s, &x) in state.iter().zip(&xs) {
         let (_, r) = term.model(s, x);
         let bare = FootSample {
-            foot: s.foot.clone(),
+            foot: s.foot,
             cover: None,
         };
         let (_, r_foot) = term.model(&bare, x);

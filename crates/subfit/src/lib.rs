@@ -26,7 +26,6 @@
 //! - [`init`]: initial control meshes with the target's topology (QEM simplification, contouring);
 //! - [`report`]: two-sided distances, error colours, the limit tessellation, plots.
 
-mod corners;
 mod error;
 mod html_report;
 mod outputs;

@@ -409,10 +409,7 @@ pub fn fit_scan(
                 );
             }
             let summary = init_summary(&r, n, &m);
-            // Sharp turns of an open target's boundary become corner tags of the cage.
-            let (mut m, mut tags) = (m, Tags::new());
-            crate::corners::tag_boundary_corners(&target, &mut m, &mut tags);
-            (m, tags, summary)
+            (m, Tags::new(), summary)
         }
     };
     let init_time = t_init.elapsed().as_secs_f64();
