@@ -15,9 +15,10 @@
 //!
 //! for the `N` data points `p_j`, each with its nearest sample `S_k(j)` (a kd-tree over the
 //! samples, rebuilt at every projection, so the assignment follows the surface). A pair counts
-//! where the surface ends — the nearest sample is on the tessellation's boundary — or the data
-//! does — `p_j` is a boundary vertex of a mesh target — with `Q_j = I` (point-to-point): there
-//! the gap is tangential and must be closed along the surface. Interior pairs (point-to-plane,
+//! where the surface ends — the nearest sample is on the tessellation's boundary and `p_j`
+//! lies beyond it (data just inside would pull the rim inward and bunch its samples up) — or
+//! the data does — `p_j` is a boundary vertex of a mesh target — with `Q_j = I`
+//! (point-to-point): there the gap is tangential and must be closed along the surface. Interior pairs (point-to-plane,
 //! `Q_j = n_j n_jᵀ`) count only where the data is uncovered — the data point farther than two
 //! mean sample spacings from its nearest sample, full weight from four (a thin tip or a deep
 //! fold the cage cuts off); covered data is the surface → data term's, so a target the surface
@@ -61,6 +62,8 @@ pub struct Coverage {
     faces: Polygons,
     /// Sample rows on the tessellation's boundary.
     sample_boundary: Vec<bool>,
+    /// Tessellation neighbours of the boundary samples (empty elsewhere).
+    rings: Vec<Vec<u32>>,
 }
 
 /// The data points assigned to one sample, summed into one quadratic in `e = x − x₀`:
@@ -176,6 +179,7 @@ impl Coverage {
             interior: true,
             faces: Polygons::default(),
             sample_boundary: Vec::new(),
+            rings: Vec::new(),
         }
     }
 
@@ -208,7 +212,37 @@ impl Coverage {
         for v in boundary_vertices(&tris) {
             sb[v as usize] = true;
         }
+        // The tessellation neighbours of every boundary sample (for its outward direction).
+        let mut rings: Vec<Vec<u32>> = vec![Vec::new(); op.num_vertices];
+        for f in op.faces.iter() {
+            for i in 0..f.len() {
+                let (a, b) = (f[i], f[(i + 1) % f.len()]);
+                for (u, w) in [(a, b), (b, a)] {
+                    if sb[u as usize] && !rings[u as usize].contains(&w) {
+                        rings[u as usize].push(w);
+                    }
+                }
+            }
+        }
         self.sample_boundary = sb;
+        self.rings = rings;
+    }
+
+    /// Whether `p` lies beyond the boundary sample `k` (on the side away from the surface):
+    /// the offset has a positive component along the sample's outward direction, the sample
+    /// minus the mean of its tessellation neighbours.
+    fn beyond(&self, xs: &[[f64; 3]], k: usize, p: [f64; 3]) -> bool {
+        let ring = &self.rings[k];
+        if ring.is_empty() {
+            return true;
+        }
+        let mut c = [0.0; 3];
+        for &w in ring {
+            for a in 0..3 {
+                c[a] += xs[w as usize][a] / ring.len() as f64;
+            }
+        }
+        dot(sub(xs[k], c), sub(p, xs[k])) > 0.0
     }
 
     /// The data points' quadratics summed per sample for the samples `xs` (all rows of the
@@ -250,7 +284,11 @@ impl Coverage {
             if known && s * cos <= 0.0 {
                 continue;
             }
-            let point_to_point = !known || self.boundary[j] || self.sample_boundary[k as usize];
+            // At the surface's rim only data beyond it pulls point-to-point: data just inside
+            // would pull the rim samples inward along the surface and bunch them up.
+            let past_rim =
+                self.sample_boundary[k as usize] && self.beyond(xs, k as usize, self.points[j]);
+            let point_to_point = !known || self.boundary[j] || past_rim;
             // An interior pair counts only where the data is uncovered: from 0 at two sample
             // spacings (a covered point is within about one of its nearest sample) to full
             // weight at four.

@@ -22,7 +22,7 @@ use std::collections::HashSet;
 
 use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_report::data_samples::SampleKind;
-use subfit_report::{data_samples, DistanceStats, MeshDistance, TwoSided};
+use subfit_report::{data_samples, vertex_areas, DistanceStats, MeshDistance, TwoSided};
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 use subfit_target::Target;
 
@@ -162,20 +162,21 @@ impl StageOptions {
             && (self.tolerance_max <= 0.0 || e.e_max <= self.tolerance_max)
     }
 
-    /// Whether a cage measured `e` (surface → data, as the fitter measures it) and `two`
-    /// (both ways) meets the tolerances: both ways when [`Self::two_sided`], else one.
+    /// Whether a cage measured `e` (surface → data, as the fitter measures it: a mean over its
+    /// samples) and `two` (both ways, surface → data weighted by area) meets the tolerances:
+    /// `two` when [`Self::two_sided`], else `e` (Cheng's one-sided test).
     pub fn met(&self, e: &ErrorStats, two: &TwoSided) -> bool {
         if self.two_sided {
-            self.reached(e) && two.within(self.tolerance_rms, self.tolerance_max)
+            two.within(self.tolerance_rms, self.tolerance_max)
         } else {
             self.reached(e)
         }
     }
 
-    /// The judged RMS and maximum: the worse direction when two-sided, else surface → data.
+    /// The judged RMS and maximum: the worse direction of `two` when two-sided, else `e`.
     fn judged(&self, e: &ErrorStats, two: &TwoSided) -> (f64, f64) {
         if self.two_sided {
-            (e.e_rms.max(two.rms()), e.e_max.max(two.max()))
+            (two.rms(), two.max())
         } else {
             (e.e_rms, e.e_max)
         }
@@ -376,7 +377,9 @@ struct Measurement {
 }
 
 /// Measures `positions` both ways: the squared errors of every sample of the fitter's sampling
-/// operator from fresh projections (its data term), and the distance of every data sample to the tessellation of the samples (the
+/// operator from fresh projections (its data term; RMS and mean weighted by the area each
+/// sample stands for in the tessellation, as a measurement uniform by area would see them),
+/// and the distance of every data sample to the tessellation of the samples (the
 /// level-`l` limit points; within its chordal error of the limit surface).
 fn measure(
     topo: &Topo<'_>,
@@ -399,7 +402,10 @@ fn measure(
     let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
     Measurement {
         two_sided: TwoSided {
-            surface_to_data: DistanceStats::of_squared(&err2),
+            surface_to_data: DistanceStats::of_weighted(
+                &err2.iter().map(|x| x.max(0.0).sqrt()).collect::<Vec<_>>(),
+                &vertex_areas(&samples, &op.faces),
+            ),
             data_to_surface: DistanceStats::of(&d),
         },
         surface_faces,

@@ -42,6 +42,30 @@ impl DistanceStats {
         }
     }
 
+    /// Statistics of distances `d` of points that stand for the areas `w` of a surface (e.g.
+    /// [`vertex_areas`] of the tessellation the points are vertices of): RMS and mean weighted
+    /// by area, so a region sampled densely (refined deeper, compressed) counts by its area, as
+    /// in a measurement that samples the surface uniformly by area; the maximum and the count
+    /// are unweighted. Unweighted ([`Self::of`]) when the weights do not match or sum to zero.
+    pub fn of_weighted(d: &[f64], w: &[f64]) -> Self {
+        let total: f64 = w.iter().sum();
+        if w.len() != d.len() || total.is_nan() || total <= 0.0 || !total.is_finite() {
+            return Self::of(d);
+        }
+        let (mut s, mut s2, mut max) = (0.0, 0.0, 0.0f64);
+        for (&x, &a) in d.iter().zip(w) {
+            s += a * x;
+            s2 += a * x * x;
+            max = max.max(x);
+        }
+        Self {
+            samples: d.len(),
+            rms: (s2 / total).sqrt(),
+            mean: s / total,
+            max,
+        }
+    }
+
     /// Statistics from squared distances.
     pub fn of_squared(d2: &[f64]) -> Self {
         let d: Vec<f64> = d2.iter().map(|x| x.max(0.0).sqrt()).collect();
@@ -65,6 +89,27 @@ impl DistanceStats {
             max: self.max * s,
         }
     }
+}
+
+/// The area each vertex of the polygon mesh `faces` over `positions` stands for: a third of
+/// each incident triangle's (polygons fanned from their first corner). Cost O(#corners).
+pub fn vertex_areas(positions: &[[f64; 3]], faces: &subfit_mesh::Polygons) -> Vec<f64> {
+    use subfit_mesh::vec3::{cross, norm, sub};
+    let mut a = vec![0.0; positions.len()];
+    for f in faces.iter() {
+        for i in 1..f.len().saturating_sub(1) {
+            let t = [f[0] as usize, f[i] as usize, f[i + 1] as usize];
+            let area = 0.5
+                * norm(cross(
+                    sub(positions[t[1]], positions[t[0]]),
+                    sub(positions[t[2]], positions[t[0]]),
+                ));
+            for v in t {
+                a[v] += area / 3.0;
+            }
+        }
+    }
+    a
 }
 
 /// Distances both ways between a limit surface and its data.
@@ -114,6 +159,11 @@ mod tests {
         assert_eq!((a.mean, a.max), (3.5, 4.0));
         assert_eq!(DistanceStats::of_squared(&[9.0, 16.0]), a);
         assert_eq!(DistanceStats::of(&[]), DistanceStats::default());
+        // Area weights: a point standing for three times the area counts three times.
+        let w = DistanceStats::of_weighted(&[1.0, 3.0], &[3.0, 1.0]);
+        assert!((w.mean - 1.5).abs() < 1e-15 && (w.rms - 3.0f64.sqrt()).abs() < 1e-15);
+        assert_eq!(w.max, 3.0);
+        assert_eq!(DistanceStats::of_weighted(&[3.0, 4.0], &[1.0]), a);
         let b = DistanceStats::of(&[1.0, 5.0, 0.0]);
         let t = TwoSided {
             surface_to_data: a,

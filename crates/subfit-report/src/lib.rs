@@ -31,7 +31,7 @@ pub mod tessellate;
 
 pub use color::error_color;
 pub use data_samples::{data_samples, DataSamples};
-pub use distance::{DistanceStats, TwoSided};
+pub use distance::{vertex_areas, DistanceStats, TwoSided};
 pub use limit_distance::{LimitDistance, LimitDistanceError, PointToLimit};
 pub use mesh_distance::MeshDistance;
 pub use preview::{

@@ -23,7 +23,9 @@ use subfit_subdiv::Scheme;
 use subfit_target::{Target, TargetOptions};
 
 use crate::error::Error;
-use subfit_report::{data_samples, limit_tessellation, DistanceStats, MeshDistance, TwoSided};
+use subfit_report::{
+    data_samples, limit_tessellation, vertex_areas, DistanceStats, MeshDistance, TwoSided,
+};
 
 use crate::pipeline_report::{
     face_counts, BoundaryLoops, Errors, FinalErrors, InitSummary, InitTimings, IterationSummary,
@@ -485,7 +487,10 @@ pub fn fit_scan(
             .map(|p| p.distance)
             .collect();
     let final_two = TwoSided {
-        surface_to_data: DistanceStats::of(&local),
+        surface_to_data: DistanceStats::of_weighted(
+            &local,
+            &vertex_areas(&tessellation.mesh.positions, &tessellation.mesh.faces),
+        ),
         data_to_surface: DistanceStats::of(&to_surface),
     };
     let usd_difference = if scheme == Scheme::QuadTriangle {
@@ -514,8 +519,8 @@ pub fn fit_scan(
     let two = TwoSidedErrors::new(&final_two, diagonal, unit);
     let reached = options.stages.met(&last, &final_two);
     let reached_one_sided = options.stages.reached(&last);
-    let reached_two_sided = reached_one_sided
-        && final_two.within(options.stages.tolerance_rms, options.stages.tolerance_max);
+    let reached_two_sided =
+        final_two.within(options.stages.tolerance_rms, options.stages.tolerance_max);
     let cage = PolyMesh::new(
         result
             .mesh
