@@ -22,6 +22,7 @@ use crate::options::{FitOptions, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
 use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
+use crate::surface_term::fan_triangles;
 use crate::term::{DataTerm, Mat3};
 
 /// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
@@ -64,6 +65,8 @@ pub struct Fitter<'t, T: DataTerm = FootPointTerm<'t>> {
     scratch: FillScratch,
     /// The ARAP regularizer when [`FitOptions::arap`] `> 0` (rest shape: the first run's cage).
     arap: Option<ArapState>,
+    /// The triangles of the sample tessellation when a [`FitOptions::surface_term`] is set.
+    surface_triangles: Vec<[u32; 3]>,
     /// The target (or whatever the term borrows) outlives the fitter.
     _data: PhantomData<&'t ()>,
 }
@@ -151,7 +154,6 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         Ok(Self {
             term,
             options: options.clone(),
-            op,
             pattern,
             solver,
             values,
@@ -163,6 +165,12 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             active: None,
             scratch: FillScratch::default(),
             arap: (options.arap > 0.0).then(|| ArapState::Pending(faces.clone())),
+            surface_triangles: if options.surface_term.is_some() {
+                fan_triangles(&op.faces)
+            } else {
+                Vec::new()
+            },
+            op,
             _data: PhantomData,
         })
     }
@@ -318,7 +326,8 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         // Active samples get no coverage (see `DataTerm::project`): objective = errors.
         let (_, sum, max) = sums_d2(&self.term, &samples, &projected);
         let (fs, fm) = a.fixed.as_ref().map_or((0.0, 0.0), |f| (f.sum, f.max));
-        let stats = self.stats(control, sum + fs, sum + fs, max.max(fm));
+        let surface = self.surface_value(control, None);
+        let stats = self.stats(control, sum + fs + surface, sum + fs, max.max(fm));
         t.sample += t1 - t0;
         t.project += t2 - t1;
         t.evaluate += t2.elapsed();
@@ -356,7 +365,8 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         let projected = self.term.project(None, &samples);
         let t2 = Instant::now();
         let (objective, sum, max) = sums_d2(&self.term, &samples, &projected);
-        let stats = self.stats(control, objective, sum, max);
+        let surface = self.surface_value(control, Some(&samples));
+        let stats = self.stats(control, objective + surface, sum, max);
         t.sample += t1 - t0;
         t.project += t2 - t1;
         t.evaluate += t2.elapsed();
@@ -365,6 +375,23 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             projected,
             stats,
         }
+    }
+
+    /// `m · w · value` of the [`FitOptions::surface_term`] at `control` (all samples, taken
+    /// from `samples` when given), so that [`Self::stats`]' division by `m` leaves `w · value`;
+    /// 0 without one.
+    fn surface_value(&self, control: &[[f64; 3]], samples: Option<&[[f64; 3]]>) -> f64 {
+        let Some(st) = &self.options.surface_term else {
+            return 0.0;
+        };
+        let m = self.num_samples().max(1) as f64;
+        let value = match samples {
+            Some(s) => st.term.value(s, &self.surface_triangles),
+            None => st
+                .term
+                .value(&self.op.position.apply(control), &self.surface_triangles),
+        };
+        m * st.weight * value
     }
 
     /// Error statistics over all `m` samples from the sum of their objective shares, the sum
@@ -416,7 +443,16 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         }
         let opts = self.options.clone();
         if let Some(a) = &mut self.arap {
-            a.ensure(control);
+            match &opts.arap_rest {
+                Some(rest) if rest.len() == n => a.ensure(rest),
+                Some(rest) => {
+                    return Err(FitError::BadInput(format!(
+                        "the ARAP rest shape has {} points, the mesh has {n} control points",
+                        rest.len()
+                    )))
+                }
+                None => a.ensure(control),
+            };
         }
         self.ensure_fixed(control);
         let mut cur = self.state(control, &mut PhaseTimings::default());
@@ -646,6 +682,24 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 .map(|(&s, f)| term.model(f, s).1)
                 .collect()
         };
+        let mut r = r;
+        if let Some(st) = &self.options.surface_term {
+            // Half the gradient of w·value, scaled by m as the fill divides r by m.
+            let all = match &self.active {
+                None => None,
+                Some(_) => Some(self.op.position.apply(control)),
+            };
+            let samples = all.as_deref().unwrap_or(&cur.samples);
+            let (_, grad) = st.term.value_and_gradient(samples, &self.surface_triangles);
+            let c = 0.5 * m * st.weight;
+            let rows: Option<&[u32]> = self.active.as_ref().map(|a| &a.samples[..]);
+            for (i, rk) in r.iter_mut().enumerate() {
+                let k = rows.map_or(i, |rows| rows[i] as usize);
+                for a in 0..3 {
+                    rk[a] += c * grad[k][a];
+                }
+            }
+        }
         let (mut g, pattern, values, points) = match &mut self.active {
             None => {
                 let g = self.pattern.fill_with_gradient(

@@ -67,6 +67,7 @@ mod report;
 mod smooth;
 mod solve;
 mod stages;
+mod surface_term;
 mod term;
 
 pub use any_term::{AnySample, AnyTerm};
@@ -84,6 +85,7 @@ pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
     fit_stages, StageEvent, StageOptions, StageReport, StageStop, StagesReport, StagesResult,
 };
+pub use surface_term::{fan_triangles, SurfaceTerm, WeightedSurfaceTerm};
 pub use term::{DataTerm, Mat3};
 
 /// The fitter's building blocks, reachable only for this crate's integration tests (`tests/`)

@@ -1,9 +1,12 @@
 //! Options of the fitting loop (Cheng et al. 2007, §II-B, §II-E, §III-C; DESIGN.md §3.4).
 
+use std::sync::Arc;
+
 use subfit_mesh::{Cancel, Tags};
 use subfit_subdiv::{BoundaryRule, Options, Scheme};
 
 use crate::foot_point_term::FootPointSource;
+use crate::surface_term::WeightedSurfaceTerm;
 
 pub use crate::foot_point_term::Method;
 pub use crate::ordering::FillOrdering;
@@ -190,6 +193,15 @@ pub struct FitOptions {
     /// (off); the paper uses 0.01 on clean scans, 0.1 on noisy ones (its data term is a sum
     /// over about as many samples as control points, so the same `α` means the same balance).
     pub arap: f64,
+    /// The ARAP rest shape (normalized units, one position per control point). Default `None`:
+    /// the cage the fitter first runs from. A sequence sets the template here, so every frame
+    /// keeps the template's local shape whatever cage it starts from.
+    pub arap_rest: Option<Arc<Vec<[f64; 3]>>>,
+    /// A term on the whole sampled surface with its weight ([`crate::SurfaceTerm`], e.g. the
+    /// soft silhouette loss of [`crate::silhouette`]), added to the objective and, as a
+    /// first-order term, to the gradient. Default `None`. Evaluated on all samples even with an
+    /// active set.
+    pub surface_term: Option<WeightedSurfaceTerm>,
     /// Cancellation token, polled at the start of every iteration and of every LM / Armijo
     /// trial; once cancelled, [`crate::Fitter::run`] (and [`crate::fit`], [`crate::fit_stages`])
     /// return [`crate::FitError::Interrupted`]. Default: a fresh token, never cancelled.
@@ -225,6 +237,8 @@ impl Default for FitOptions {
             imls_radius: None,
             imls_tangential: 0.0,
             arap: 0.0,
+            arap_rest: None,
+            surface_term: None,
             cancel: Cancel::default(),
         }
     }
@@ -279,7 +293,9 @@ impl FitOptions {
     /// Checks value ranges; returns the offending field's name and value.
     pub(crate) fn validate(&self) -> Result<(), (&'static str, f64)> {
         let h = self.imls_radius.unwrap_or(1.0);
-        let checks: [(&'static str, f64, bool); 13] = [
+        let w = self.surface_term.as_ref().map_or(0.0, |t| t.weight);
+        let checks: [(&'static str, f64, bool); 14] = [
+            ("surface_term.weight", w, w >= 0.0),
             ("coverage", self.coverage, self.coverage >= 0.0),
             ("lambda", self.lambda, self.lambda >= 0.0),
             ("imls_radius", h, h > 0.0),

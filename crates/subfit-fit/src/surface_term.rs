@@ -1,0 +1,61 @@
+//! Terms on the whole sampled surface rather than per sample: a value of all the samples at
+//! once and its gradient with respect to each (e.g. the soft silhouette loss of
+//! [`crate::silhouette`], Xie et al. 2023 §4.2). The fitter adds `weight · value(S)` to its
+//! objective and the gradient, pulled back through the sampling operator (`Cᵀ ∇_S`), to the
+//! gradient of its model — a first-order term: it contributes no curvature to the normal
+//! matrix, the LM damping and the data term's Gauss-Newton matrix bound the step, and the gain
+//! ratio judges it on the true objective like every other term.
+
+use std::fmt;
+use std::sync::Arc;
+
+/// A differentiable function of all the samples of the limit surface and the triangles of
+/// their tessellation (the level-`l` faces of the sampling operator, fanned into triangles).
+/// Positions in the target's normalized units.
+pub trait SurfaceTerm: Send + Sync {
+    /// The value at `samples`.
+    fn value(&self, samples: &[[f64; 3]], triangles: &[[u32; 3]]) -> f64;
+
+    /// The value and its gradient with respect to every sample (zero for samples no triangle
+    /// uses).
+    fn value_and_gradient(
+        &self,
+        samples: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> (f64, Vec<[f64; 3]>);
+}
+
+/// A [`SurfaceTerm`] with its weight in the objective, as [`crate::FitOptions::surface_term`]
+/// holds it. Two are equal when they share the term (the same `Arc`) and the weight.
+#[derive(Clone)]
+pub struct WeightedSurfaceTerm {
+    /// The term.
+    pub term: Arc<dyn SurfaceTerm>,
+    /// Its weight `w ≥ 0`: the objective gains `w · value`.
+    pub weight: f64,
+}
+
+impl fmt::Debug for WeightedSurfaceTerm {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("WeightedSurfaceTerm")
+            .field("weight", &self.weight)
+            .finish_non_exhaustive()
+    }
+}
+
+impl PartialEq for WeightedSurfaceTerm {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.term, &other.term) && self.weight == other.weight
+    }
+}
+
+/// The triangles of a polygon tessellation, each polygon fanned from its first corner.
+pub fn fan_triangles(faces: &subfit_mesh::Polygons) -> Vec<[u32; 3]> {
+    let mut t = Vec::with_capacity(2 * faces.len());
+    for f in faces.iter() {
+        for k in 1..f.len().saturating_sub(1) {
+            t.push([f[0], f[k], f[k + 1]]);
+        }
+    }
+    t
+}
