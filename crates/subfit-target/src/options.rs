@@ -58,6 +58,10 @@ pub struct TargetOptions {
     /// full one is not surface-like is not (in noise it fits the noise); clean scans keep `k`.
     /// The `k` used is [`TargetStats::neighborhood_k`]. Default true.
     pub adapt_to_noise: bool,
+    /// The map into normalized units. Default `None`: the input's bounding box scaled into the
+    /// unit cube (Cheng 2004 §3 step 1). A sequence gives every frame the first frame's map, so
+    /// that one cage moves between frames in one set of units.
+    pub normalization: Option<crate::Normalization>,
     /// Cancellation token, polled by every long step of construction (per chunk of the
     /// per-point fits, per pass of the orientation and its winding-number and field checks);
     /// once cancelled, construction returns [`crate::TargetError::Interrupted`] within a few
@@ -78,6 +82,7 @@ impl Default for TargetOptions {
             mesh_closest_point: true,
             remove_outliers: true,
             adapt_to_noise: true,
+            normalization: None,
             cancel: Cancel::default(),
         }
     }

@@ -141,7 +141,10 @@ impl Target {
         let t = Instant::now();
         report(Phase::Normalize, 0, n_in);
         let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
-        let Some(normalization) = Normalization::from_bounds(lo, hi) else {
+        let Some(normalization) = options
+            .normalization
+            .or_else(|| Normalization::from_bounds(lo, hi))
+        else {
             return Err(TargetError::TooFewDistinctPoints {
                 distinct: 1,
                 input: n_in,
@@ -600,6 +603,14 @@ fn validate_options(o: &TargetOptions) -> Result<(), TargetError> {
     if let Some(h) = o.imls_radius {
         if !(h.is_finite() && h > 0.0) {
             return bad("imls_radius", "must be finite and > 0");
+        }
+    }
+    if let Some(n) = o.normalization {
+        if !(n.scale.is_finite() && n.scale > 0.0 && n.min.iter().all(|c| c.is_finite())) {
+            return bad(
+                "normalization",
+                "needs a finite scale > 0 and a finite corner",
+            );
         }
     }
     Ok(())
