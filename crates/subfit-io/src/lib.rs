@@ -406,6 +406,59 @@ pub fn write_usda_file(
     write_atomic(path, &out)
 }
 
+/// Writes an animated control cage as USDA (see [`usda::write_animated`]) atomically:
+/// `frames` holds the points of each frame (`N` frames of `#V by 3`), played at `fps` frames
+/// per second.
+///
+/// Errors ([`ErrorKind::CannotWrite`], [`ErrorKind::IndexOutOfRange`]): no faces, no frames,
+/// frames of different lengths, a face index beyond the points, or `fps` not positive and
+/// finite.
+pub fn write_usda_animated_file(
+    path: &Path,
+    faces: &subfit_mesh::Polygons,
+    frames: &[Vec<[f64; 3]>],
+    tags: &subfit_mesh::Tags,
+    scheme: usda::UsdScheme,
+    boundary: usda::UsdBoundary,
+    fps: f64,
+) -> Result<()> {
+    let bad = |what: String| Err(Error::file(path, ErrorKind::CannotWrite(what)));
+    let Some(first) = frames.first() else {
+        return bad("an animation needs at least one frame".into());
+    };
+    if faces.is_empty() {
+        return bad("a USD mesh needs faces".into());
+    }
+    if let Some((t, p)) = frames
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.len() != first.len())
+    {
+        return bad(format!(
+            "frame {t} has {} points, frame 0 has {}",
+            p.len(),
+            first.len()
+        ));
+    }
+    if !(fps > 0.0 && fps.is_finite()) {
+        return bad(format!("{fps} frames per second"));
+    }
+    if let Some(&m) = faces.indices().iter().max() {
+        if m as usize >= first.len() {
+            return Err(Error::file(
+                path,
+                ErrorKind::IndexOutOfRange {
+                    index: m as i64,
+                    count: first.len() as u64,
+                },
+            ));
+        }
+    }
+    let mut out = Vec::new();
+    usda::write_animated(faces, frames, tags, scheme, boundary, fps, &mut out);
+    write_atomic(path, &out)
+}
+
 /// Writes `bytes` to `path` through a temporary file in the same directory and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let io_err = |e: std::io::Error| Error::file(path, ErrorKind::Io(e));

@@ -7,11 +7,13 @@
 //! manifoldness, orientation, components, Euler characteristic, genus); [`reorient_faces`] repairs
 //! inconsistently oriented faces. [`Cancel`] is the cancellation token that the long phases of
 //! the other crates poll. [`vec3`] holds the small `[f64; 3]` helpers every crate uses; [`bvh`]
-//! the exact closest point on triangles.
+//! the exact closest point on triangles; [`deforming`] generates deforming test sequences with
+//! known correspondence.
 
 pub mod bvh;
 pub mod cancel;
 pub mod components;
+pub mod deforming;
 pub mod diagnose;
 mod edges;
 pub mod halfedge;
