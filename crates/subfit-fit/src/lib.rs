@@ -64,6 +64,7 @@ mod pcg;
 mod refine_polygons;
 mod remesh;
 mod report;
+pub mod silhouette;
 mod smooth;
 mod solve;
 mod stages;
