@@ -246,6 +246,46 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         self.options.lambda = lambda;
     }
 
+    /// Changes the ARAP weight `α` (e.g. annealed from stiff to loose, as non-rigid ICP does);
+    /// the regularizer exists only when the fitter was built with `α > 0`
+    /// ([`FitOptions::arap`]), so a fitter built without it ignores this.
+    pub fn set_arap(&mut self, alpha: f64) {
+        if self.arap.is_some() {
+            self.options.arap = alpha.max(0.0);
+        }
+    }
+
+    /// Both-way distances of `control` (normalized units): the squared errors of every sample
+    /// from fresh projections of the data term (RMS and mean weighted by the area each sample
+    /// stands for in the sample tessellation) and the distance of every point of `data` to
+    /// that tessellation (the level-`l` limit points; within its chordal error of the limit
+    /// surface). Also returns the per-sample squared errors and the data points' closest points,
+    /// for per-face statistics. Cost: one projection of the samples, one BVH over the sample
+    /// tessellation and one query per data point.
+    pub fn measure_two_sided(
+        &self,
+        control: &[[f64; 3]],
+        data: &[[f64; 3]],
+    ) -> (
+        subfit_report::TwoSided,
+        Vec<f64>,
+        Vec<subfit_report::PointToLimit>,
+    ) {
+        use subfit_report::{vertex_areas, DistanceStats, MeshDistance, TwoSided};
+        let samples = self.op.position.apply(control);
+        let err2 = self.squared_errors(&samples);
+        let to_surface = MeshDistance::new(&samples, &self.op.faces).distances(data);
+        let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
+        let two = TwoSided {
+            surface_to_data: DistanceStats::of_weighted(
+                &err2.iter().map(|x| x.max(0.0).sqrt()).collect::<Vec<_>>(),
+                &vertex_areas(&samples, &self.op.faces),
+            ),
+            data_to_surface: DistanceStats::of(&d),
+        };
+        (two, err2, to_surface)
+    }
+
     /// Sets what the next [`Self::run`] does, keeping everything built for the topology:
     /// `λ`, the iteration cap, the stopping tolerances (`E_rms`, `E_max`; 0 = off) and the
     /// stall threshold ([`FitOptions::min_relative_decrease`]).

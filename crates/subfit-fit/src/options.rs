@@ -197,6 +197,7 @@ pub struct FitOptions {
     /// the cage the fitter first runs from. A sequence sets the template here, so every frame
     /// keeps the template's local shape whatever cage it starts from.
     pub arap_rest: Option<Arc<Vec<[f64; 3]>>>,
+
     /// A term on the whole sampled surface with its weight ([`crate::SurfaceTerm`], e.g. the
     /// soft silhouette loss of [`crate::silhouette`]), added to the objective and, as a
     /// first-order term, to the gradient. Default `None`. Evaluated on all samples even with an
@@ -238,6 +239,7 @@ impl Default for FitOptions {
             imls_tangential: 0.0,
             arap: 0.0,
             arap_rest: None,
+
             surface_term: None,
             cancel: Cancel::default(),
         }

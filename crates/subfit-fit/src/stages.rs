@@ -22,7 +22,7 @@ use std::collections::HashSet;
 
 use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_report::data_samples::SampleKind;
-use subfit_report::{data_samples, vertex_areas, DistanceStats, MeshDistance, TwoSided};
+use subfit_report::{data_samples, TwoSided};
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 use subfit_target::Target;
 
@@ -388,10 +388,8 @@ fn measure(
     data: &[[f64; 3]],
 ) -> Measurement {
     let op = topo.fitter.sampling_operator();
-    let samples = op.position.apply(positions);
-    let err2 = topo.fitter.squared_errors(&samples);
+    let (two_sided, err2, to_surface) = topo.fitter.measure_two_sided(positions, data);
     let surface_faces = face_errors(faces, op, &err2);
-    let to_surface = MeshDistance::new(&samples, &op.faces).distances(data);
     let mut data_faces = vec![FaceError::default(); faces.len()];
     for p in &to_surface {
         let e = &mut data_faces[topo.owners[p.face as usize] as usize];
@@ -399,15 +397,8 @@ fn measure(
         e.count += 1;
         e.max = e.max.max(p.distance);
     }
-    let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
     Measurement {
-        two_sided: TwoSided {
-            surface_to_data: DistanceStats::of_weighted(
-                &err2.iter().map(|x| x.max(0.0).sqrt()).collect::<Vec<_>>(),
-                &vertex_areas(&samples, &op.faces),
-            ),
-            data_to_surface: DistanceStats::of(&d),
-        },
+        two_sided,
         surface_faces,
         data_faces,
     }
