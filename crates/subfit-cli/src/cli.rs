@@ -36,6 +36,10 @@ pub enum Command {
     Init(InitArgs),
     /// Two-sided distances (RMS, mean, max / Hausdorff) between two surfaces or point sets.
     Compare(CompareArgs),
+    /// Fit one cage to every frame of a deforming scan (same connectivity and vertex order in
+    /// every frame), with a silhouette term against drift; writes the cages and an animated
+    /// sequence.usda.
+    Sequence(SequenceArgs),
     /// Benchmarks and studies that print figures.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -113,6 +117,58 @@ pub enum BenchCommand {
     /// Fit the models of `$SUBFIT_DATA` end to end and print a table per model (control
     /// points, iterations, E_max, E_rms, time per phase) next to the papers' figures.
     Fit(BenchFitArgs),
+    /// Fit generated deforming sequences (known correspondence: drift measured exactly) with
+    /// and without the silhouette term; print per-frame errors, drift and time.
+    Sequence(BenchSequenceArgs),
+}
+
+/// `subfit bench sequence`.
+#[derive(clap::Args, Debug)]
+pub struct BenchSequenceArgs {
+    /// Frames per sequence.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(2..=1000))]
+    pub frames: u32,
+    /// Vertices per frame (each frame's resolution varies ±30% around it).
+    #[arg(long, default_value_t = 25_000, value_parser = clap::value_parser!(u32).range(500..=5_000_000))]
+    pub vertices: u32,
+    /// Control points of the template.
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(20..=100_000))]
+    pub control_points: u32,
+    /// Silhouette views of the run with the term (the other run has none).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub silhouette_views: u32,
+    /// Which motion: the moderate default, the large tangential one, or both.
+    #[arg(long, value_enum, default_value_t = MotionArg::Both)]
+    pub motion: MotionArg,
+    /// Seed of the frames' tessellations.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// ARAP weight α towards the template [default: `subfit sequence`'s].
+    #[arg(long)]
+    pub arap: Option<f64>,
+    /// ARAP weight at the start of each frame's annealing [default: `subfit sequence`'s].
+    #[arg(long)]
+    pub arap_start: Option<f64>,
+    /// LM iterations per frame at most [default: `subfit sequence`'s].
+    #[arg(long)]
+    pub iterations: Option<u32>,
+    /// Silhouette weight [default: `subfit sequence`'s].
+    #[arg(long)]
+    pub silhouette_weight: Option<f64>,
+    /// Also write each run's outputs (frames, sequence.usda, report.json) under this directory.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+/// The motion of a generated sequence.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum MotionArg {
+    /// Bending, twisting, thickness waves (subfit_mesh::deforming defaults).
+    Moderate,
+    /// The same with a large spin about the axis: points slide far between frames.
+    Large,
+    /// Both.
+    Both,
 }
 
 /// `subfit bench fit`.
@@ -253,6 +309,61 @@ pub struct FitArgs {
     /// Output directory (control.obj, control.usda, limit.ply, error.ply, log.csv,
     /// report.json).
     #[arg(short, long, default_value = "subfit-fit")]
+    pub output: PathBuf,
+}
+
+/// `subfit sequence`.
+#[derive(clap::Args, Debug)]
+pub struct SequenceArgs {
+    /// The frames, in order: meshes or point clouds (any supported format); their
+    /// connectivity may differ between frames.
+    #[arg(required = true)]
+    pub frames: Vec<PathBuf>,
+    /// The template cage, in the first frame's coordinates [default: fit the first frame].
+    #[arg(long)]
+    pub template: Option<PathBuf>,
+    /// Control points of the template fitted to the first frame (also its budget: it is not
+    /// refined beyond them) [default: `subfit fit`'s rule, refined to the tolerance].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(4..=1_000_000), conflicts_with = "template")]
+    pub control_points: Option<u32>,
+    /// Views of the soft silhouette term around each frame (Xie et al. 2023 §4.2); 0 turns it
+    /// off.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub silhouette_views: u32,
+    /// Pixels per side of the silhouette images.
+    #[arg(long, default_value_t = 128)]
+    pub silhouette_resolution: u32,
+    /// Weight of the silhouette loss (mean squared pixel difference) against the data term.
+    #[arg(long, default_value_t = subfit::DEFAULT_SILHOUETTE_WEIGHT)]
+    pub silhouette_weight: f64,
+    /// Data term of every frame: SDM (Cheng et al.) or IMLS (Xie et al.).
+    #[arg(long, value_enum, default_value_t = MethodArg::Sdm)]
+    pub method: MethodArg,
+    /// Weight α of the as-rigid-as-possible term towards the template.
+    #[arg(long, default_value_t = 0.01)]
+    pub arap: f64,
+    /// Umbrella smoothing λ per frame.
+    #[arg(long, default_value_t = 1e-5)]
+    pub lambda: f64,
+    /// LM iterations per frame at most.
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub iterations: u32,
+    /// A frame (and the template fit) stops when both directions' E_rms (unit-cube units of
+    /// the first frame) are at most this.
+    #[arg(long, default_value_t = 5e-4)]
+    pub tolerance: f64,
+    /// Refinement level at which the limit surface is sampled in every frame after the
+    /// template's fit (which samples at level 3).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=6))]
+    pub sample_level: u32,
+    /// Subdivision scheme of the template; `auto` picks Loop for all-triangle cages.
+    #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
+    pub scheme: SchemeArg,
+    /// Frames per second of sequence.usda.
+    #[arg(long, default_value_t = 24.0)]
+    pub fps: f64,
+    /// Output directory (frame_0000.obj …, sequence.usda, report.json).
+    #[arg(short, long, default_value = "subfit-sequence")]
     pub output: PathBuf,
 }
 

@@ -59,3 +59,18 @@ pub fn fan_triangles(faces: &subfit_mesh::Polygons) -> Vec<[u32; 3]> {
     }
     t
 }
+
+impl SurfaceTerm for crate::silhouette::Silhouette {
+    /// The silhouette loss (mean squared pixel difference over all views).
+    fn value(&self, samples: &[[f64; 3]], triangles: &[[u32; 3]]) -> f64 {
+        self.loss(samples, triangles)
+    }
+
+    fn value_and_gradient(
+        &self,
+        samples: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> (f64, Vec<[f64; 3]>) {
+        self.loss_and_gradient(samples, triangles)
+    }
+}

@@ -15,7 +15,11 @@ struct Plane {
 
 impl SurfaceTerm for Plane {
     fn value(&self, samples: &[[f64; 3]], _: &[[u32; 3]]) -> f64 {
-        samples.iter().map(|s| (s[2] - self.z0).powi(2)).sum::<f64>() / samples.len() as f64
+        samples
+            .iter()
+            .map(|s| (s[2] - self.z0).powi(2))
+            .sum::<f64>()
+            / samples.len() as f64
     }
 
     fn value_and_gradient(&self, samples: &[[f64; 3]], t: &[[u32; 3]]) -> (f64, Vec<[f64; 3]>) {

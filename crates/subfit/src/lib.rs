@@ -31,12 +31,18 @@ mod html_report;
 mod outputs;
 pub mod pipeline_report;
 mod scan;
+mod sequence;
 
 pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use outputs::{log_csv, OUTPUTS};
 pub use pipeline_report::Report;
 pub use scan::{fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
+pub use sequence::{
+    fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence,
+    SequenceFrame, SequenceOptions, SequenceOptionsSummary, SequenceReport, SilhouetteOptions,
+    DEFAULT_SILHOUETTE_WEIGHT,
+};
 
 pub use subfit_fit as fit;
 pub use subfit_init as init;

@@ -49,15 +49,8 @@ impl Fitted {
         let check = || self.cancel.check().map_err(|_| Error::Interrupted);
         check()?;
         subfit_io::write_file(&dir.join("control.obj"), &self.cage, &ascii)?;
-        let usd_scheme = match self.scheme {
-            Scheme::Loop => UsdScheme::Loop,
-            Scheme::CatmullClark => UsdScheme::CatmullClark,
-            Scheme::QuadTriangle => UsdScheme::QuadTriangle,
-        };
-        let usd_boundary = match self.fit.boundary {
-            BoundaryRule::EdgeOnly => UsdBoundary::EdgeOnly,
-            BoundaryRule::EdgeAndCorner => UsdBoundary::EdgeAndCorner,
-        };
+        let usd_scheme = usd_scheme(self.scheme);
+        let usd_boundary = usd_boundary(self.fit.boundary);
         check()?;
         subfit_io::write_usda_file(
             &dir.join("control.usda"),
@@ -214,4 +207,21 @@ pub fn log_csv(r: &StagesReport) -> String {
         }
     }
     s
+}
+
+/// The USD `subdivisionScheme` a cage of `scheme` is written with.
+pub(crate) fn usd_scheme(scheme: Scheme) -> UsdScheme {
+    match scheme {
+        Scheme::Loop => UsdScheme::Loop,
+        Scheme::CatmullClark => UsdScheme::CatmullClark,
+        Scheme::QuadTriangle => UsdScheme::QuadTriangle,
+    }
+}
+
+/// The USD `interpolateBoundary` of a boundary rule.
+pub(crate) fn usd_boundary(rule: BoundaryRule) -> UsdBoundary {
+    match rule {
+        BoundaryRule::EdgeOnly => UsdBoundary::EdgeOnly,
+        BoundaryRule::EdgeAndCorner => UsdBoundary::EdgeAndCorner,
+    }
 }

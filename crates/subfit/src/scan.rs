@@ -230,40 +230,9 @@ pub fn fit_scan(
     };
     let t0 = Instant::now();
     step(Step::Read, &mut progress);
-    let (mut mesh, name) = match input {
-        Input::File(path) => {
-            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
-            (m, path.display().to_string())
-        }
-        Input::Mesh { mesh, name } => (mesh, name),
-    };
+    let (mut mesh, name, reoriented) =
+        read_input(input, options.as_points, &mut |m| warn(m, &mut progress))?;
     let read = t0.elapsed().as_secs_f64();
-
-    // Faces that disagree with their neighbours (a messy scan) are turned, with a warning;
-    // only what cannot be repaired is refused (non-manifold edges, non-orientable parts),
-    // unless the faces are not used.
-    let mut reoriented = None;
-    if !mesh.faces.is_empty() {
-        match reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions)) {
-            Ok((faces, r)) if r.needed => {
-                warn(
-                    format!(
-                        "re-oriented {} faces in {} components of {name}",
-                        r.flipped_faces, r.repaired_components
-                    ),
-                    &mut progress,
-                );
-                reoriented = Some(Reorientation {
-                    faces_flipped: r.flipped_faces,
-                    components_changed: r.repaired_components,
-                });
-                mesh.faces = faces;
-            }
-            Ok(_) => {}
-            Err(e) if !options.as_points => return Err(Error::input(&name, e)),
-            Err(_) => {}
-        }
-    }
     options.cancel.check().map_err(|_| Error::Interrupted)?;
 
     // With `as_points` the faces are dropped, but their genus still tells the initial mesh
@@ -654,6 +623,44 @@ pub fn fit_scan(
         data_error: to_surface,
         cancel: options.cancel.clone(),
     })
+}
+
+/// Reads `input` (a file, or takes the mesh given) and turns faces that disagree with their
+/// neighbours (a messy scan), with a warning; only what cannot be repaired is refused
+/// (non-manifold edges, non-orientable parts), unless the faces are not used (`as_points`).
+/// Returns the mesh, its name for messages and what was re-oriented.
+pub(crate) fn read_input(
+    input: Input,
+    as_points: bool,
+    warn: &mut dyn FnMut(String),
+) -> Result<(PolyMesh, String, Option<Reorientation>), Error> {
+    let (mut mesh, name) = match input {
+        Input::File(path) => {
+            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            (m, path.display().to_string())
+        }
+        Input::Mesh { mesh, name } => (mesh, name),
+    };
+    let mut reoriented = None;
+    if !mesh.faces.is_empty() {
+        match reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions)) {
+            Ok((faces, r)) if r.needed => {
+                warn(format!(
+                    "re-oriented {} faces in {} components of {name}",
+                    r.flipped_faces, r.repaired_components
+                ));
+                reoriented = Some(Reorientation {
+                    faces_flipped: r.flipped_faces,
+                    components_changed: r.repaired_components,
+                });
+                mesh.faces = faces;
+            }
+            Ok(_) => {}
+            Err(e) if !as_points => return Err(Error::input(&name, e)),
+            Err(_) => {}
+        }
+    }
+    Ok((mesh, name, reoriented))
 }
 
 /// Both-way distances between the quad/triangle limit of `cage` and the Catmull-Clark limit

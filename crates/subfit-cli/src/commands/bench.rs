@@ -26,6 +26,7 @@ pub fn run(cmd: BenchCommand) -> anyhow::Result<ExitCode> {
     match cmd {
         BenchCommand::Convergence(a) => convergence(a),
         BenchCommand::Fit(a) => crate::commands::bench_fit::run(a),
+        BenchCommand::Sequence(a) => crate::commands::bench_sequence::run(a),
     }
 }
 

@@ -206,7 +206,7 @@ pub fn write_outputs(fitted: &mut Fitted, dir: &std::path::Path) -> anyhow::Resu
     Ok(())
 }
 
-fn method_of(m: MethodArg) -> Method {
+pub(crate) fn method_of(m: MethodArg) -> Method {
     match m {
         MethodArg::Pdm => Method::Pdm,
         MethodArg::Tdm => Method::Tdm,

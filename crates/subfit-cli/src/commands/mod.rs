@@ -3,6 +3,7 @@
 mod analyze;
 mod bench;
 mod bench_fit;
+mod bench_sequence;
 mod compare;
 mod compare_html;
 mod convert;
@@ -11,6 +12,7 @@ mod eval;
 mod fit;
 mod info;
 mod init;
+mod sequence;
 mod subdivide;
 
 use std::path::Path;
@@ -32,6 +34,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         Command::Fit(a) => fit::run(a),
         Command::Init(a) => init::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Sequence(a) => sequence::run(a),
         Command::Bench(b) => bench::run(b),
     }
 }

@@ -1,0 +1,875 @@
+//! One cage fitted to every frame of a deforming scan (Xie et al. 2023 §4.2, §5.2, Fig. 2 and
+//! 10–13): the template is fitted to the first frame (or given), each next frame starts from
+//! the previous frame's cage (warm start) and is fitted with the data term of
+//! [`FitOptions::method`], the umbrella smoothing, the as-rigid-as-possible regularizer whose
+//! rest shape is the **template** (so the cage keeps its local shape and does not swim over
+//! the surface), and optionally the soft silhouette term of [`subfit_fit::silhouette`] (K
+//! orthographic views around the frame, Xie et al.'s remedy for tangential drift). Every
+//! frame's cage has the template's connectivity and vertex order — the point of a sequence —
+//! and is measured both ways like a single fit.
+//!
+//! All frames share one normalization, the first frame's (the unit cube of frame 0), so that
+//! the cage moves in one set of units; every figure is reported in the frame's own units and
+//! as a fraction of the frame's own bounding-box diagonal.
+//!
+//! Frames come from an iterator and leave through a callback ([`fit_sequence`]): a long
+//! sequence streams, only the per-frame reports and the cages' positions are kept.
+//!
+//! **Drift diagnostics** (no ground truth is needed): the limit points of the control vertices
+//! are tracked; per frame the report gives the RMS of their motion since the previous frame
+//! split into its part along the limit normal and its tangential part (the sliding a geometric
+//! fit cannot see), and the RMS relative change of the cage's edge lengths against the
+//! template (how far the cage is from the template's local shape).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde::Serialize;
+use subfit_fit::{AnyTerm, FitOptions, Fitter, Method, WeightedSurfaceTerm};
+use subfit_mesh::vec3::{cross, dist2, dot, sub};
+use subfit_mesh::{Cancel, PolyMesh, Polygons, Tags};
+use subfit_report::data_samples;
+use subfit_subdiv::{sampling_operator, BoundaryRule, Scheme, StencilMatrix};
+use subfit_target::{Normalization, Target, TargetOptions};
+
+use crate::error::Error;
+use crate::pipeline_report::{Reorientation, TwoSidedErrors};
+use crate::scan::read_input;
+use crate::{fit_scan, FitScanOptions, InitialCage, Input};
+
+/// The silhouette term of a sequence (Xie et al. 2023 §4.2; [`subfit_fit::silhouette`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SilhouetteOptions {
+    /// Number of views around the frame's bounding sphere; 0 turns the term off. Default 8.
+    pub views: usize,
+    /// Image resolution (pixels per side). Default 128.
+    pub resolution: usize,
+    /// Weight of the loss (mean squared pixel difference) in the objective, against the data
+    /// term's mean squared distance (normalized units²). Default [`DEFAULT_SILHOUETTE_WEIGHT`].
+    pub weight: f64,
+}
+
+/// The default weight of the silhouette loss (see [`SilhouetteOptions::weight`]).
+pub const DEFAULT_SILHOUETTE_WEIGHT: f64 = 1e-4;
+
+impl Default for SilhouetteOptions {
+    fn default() -> Self {
+        Self {
+            views: 8,
+            resolution: 128,
+            weight: DEFAULT_SILHOUETTE_WEIGHT,
+        }
+    }
+}
+
+/// Options of [`fit_sequence`]. Lengths in the first frame's normalized units (its unit cube).
+#[derive(Clone, Debug)]
+pub struct SequenceOptions {
+    /// The template: [`InitialCage::Auto`] (default) fits the first frame with
+    /// [`Self::template_fit`] ([`fit_scan`]); [`InitialCage::Given`] is a cage in the first
+    /// frame's coordinates, fitted to it like every other frame.
+    pub template: InitialCage,
+    /// Options of the template's fit ([`fit_scan`]; its `init` is replaced by
+    /// [`InitialCage::Auto`], its `cancel` by [`Self::cancel`]). Default: `fit_scan`'s.
+    pub template_fit: FitScanOptions,
+    /// Per-frame fit options: method (SDM or IMLS), sample level, coverage, step control. The
+    /// scheme and tags are the template's, `λ`, `α` and the iteration cap those below.
+    /// Default: [`FitOptions::default`] with coverage 1 (as [`fit_scan`]).
+    pub fit: FitOptions,
+    /// Umbrella smoothing `λ` per frame. Default `1e-5` (the end of the template's schedule).
+    pub lambda: f64,
+    /// ARAP weight `α` towards the template ([`FitOptions::arap`]) at the end of each frame's
+    /// fit. Default 0.01 (Xie et al.).
+    pub arap: f64,
+    /// ARAP weight at the start of each frame's fit: `α` is annealed from this down to
+    /// [`Self::arap`] by factors of 10, the iterations shared among the levels, so the cage
+    /// first follows the frame nearly rigidly piece by piece (closest points pull, ARAP keeps
+    /// the template's local shape: the cage's points go where their material went) and then
+    /// fits the details (the stiffness annealing of non-rigid ICP, Amberg et al. 2007).
+    /// Default 0.01, equal to [`Self::arap`]: no annealing (on the generated sequences of
+    /// `subfit bench sequence` annealing from 10 or 1000 did not lower the drift).
+    pub arap_start: f64,
+
+    /// LM iterations per frame at most. Default 12.
+    pub iterations: usize,
+    /// A frame stops early when both directions' RMS are within this (normalized units).
+    /// Default `5e-4`.
+    pub tolerance_rms: f64,
+    /// The silhouette term. Default on (8 views, 128²).
+    pub silhouette: SilhouetteOptions,
+    /// Data → surface samples of a mesh frame (0: as many as it has points). Default 0.
+    pub data_samples: usize,
+    /// Cancels the run; polled by every long step.
+    pub cancel: Cancel,
+}
+
+impl Default for SequenceOptions {
+    fn default() -> Self {
+        Self {
+            template: InitialCage::Auto,
+            template_fit: FitScanOptions::default(),
+            fit: FitOptions {
+                coverage: 1.0,
+                ..FitOptions::default()
+            },
+            lambda: 1e-5,
+            arap: 0.01,
+            arap_start: 0.01,
+
+            iterations: 12,
+            tolerance_rms: 5e-4,
+            silhouette: SilhouetteOptions::default(),
+            data_samples: 0,
+            cancel: Cancel::default(),
+        }
+    }
+}
+
+/// One frame's figures (`report.json` → `frames[i]`).
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameReport {
+    /// 0-based frame index.
+    pub index: usize,
+    /// The frame's name (its file).
+    pub name: String,
+    /// Points of the frame after duplicates and outliers.
+    pub points: usize,
+    /// Whether the frame had faces (a mesh) or was a point cloud.
+    pub mesh: bool,
+    /// Faces re-oriented on reading, if any.
+    pub reoriented: Option<Reorientation>,
+    /// The frame's bounding-box diagonal (its own units).
+    pub bbox_diagonal: f64,
+    /// Both-way errors of the frame's cage against the frame.
+    pub two_sided: TwoSidedErrors,
+    /// Whether both directions' RMS are within the tolerance.
+    pub tolerance_reached: bool,
+    /// LM iterations (solves) spent on the frame (the template fit's for an automatic template).
+    pub iterations: usize,
+    /// The silhouette loss at the end (mean squared pixel difference), when the term is on.
+    pub silhouette_loss: Option<f64>,
+    /// Drift diagnostics of the tracked limit points (see the module docs).
+    pub drift: DriftDiagnostics,
+    /// Seconds per phase.
+    pub timings_s: FrameTimings,
+}
+
+/// How the tracked limit points moved and the cage deformed (fractions of the frame's
+/// bounding-box diagonal; zero for the first frame).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct DriftDiagnostics {
+    /// RMS motion of the control vertices' limit points since the previous frame.
+    pub motion_rms: f64,
+    /// Its part along the limit normal (RMS).
+    pub normal_motion_rms: f64,
+    /// Its tangential part (RMS): sliding over the surface.
+    pub tangential_motion_rms: f64,
+    /// RMS relative change of the cage's edge lengths against the template.
+    pub edge_strain_rms: f64,
+}
+
+/// Seconds per phase of one frame.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct FrameTimings {
+    /// Reading the file.
+    pub read: f64,
+    /// Target analysis.
+    pub analyse: f64,
+    /// Target images of the silhouette term.
+    pub silhouette: f64,
+    /// Fitting (with the measurement at its end).
+    pub fit: f64,
+    /// The whole frame.
+    pub total: f64,
+}
+
+/// The sequence's report (`report.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SequenceReport {
+    /// Frames fitted.
+    pub frames_fitted: usize,
+    /// Control points of the cage (every frame).
+    pub control_points: usize,
+    /// Control faces.
+    pub control_faces: usize,
+    /// The subdivision scheme.
+    pub scheme: String,
+    /// Where the template came from: `"fit"` (the first frame fitted with `fit_scan`) or the
+    /// file given.
+    pub template: String,
+    /// The template fit's own report when it was fitted here.
+    pub template_report: Option<Box<crate::Report>>,
+    /// Per-frame options in effect.
+    pub options: SequenceOptionsSummary,
+    /// Worst frame's two-sided RMS (fraction of its diagonal).
+    pub worst_rms_fraction_of_diagonal: f64,
+    /// Worst frame's two-sided maximum (fraction of its diagonal).
+    pub worst_max_fraction_of_diagonal: f64,
+    /// Mean seconds per frame (after the first).
+    pub mean_seconds_per_frame: f64,
+    /// Per frame.
+    pub frames: Vec<FrameReport>,
+    /// Warnings, in order.
+    pub warnings: Vec<String>,
+}
+
+/// The options a sequence ran with (`report.json` → `options`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SequenceOptionsSummary {
+    /// Data term.
+    pub method: String,
+    /// `λ`.
+    pub lambda: f64,
+    /// ARAP `α` towards the template.
+    pub arap: f64,
+    /// LM iterations per frame at most.
+    pub iterations: usize,
+    /// Per-frame tolerance (normalized units).
+    pub tolerance_rms: f64,
+    /// Silhouette views (0: off).
+    pub silhouette_views: usize,
+    /// Silhouette image resolution.
+    pub silhouette_resolution: usize,
+    /// Silhouette weight.
+    pub silhouette_weight: f64,
+    /// Sample level.
+    pub sample_level: usize,
+}
+
+/// One fitted frame, as given to the callback of [`fit_sequence`].
+pub struct SequenceFrame<'a> {
+    /// The cage in the frame's (the input's) coordinates; same faces every frame.
+    pub cage: &'a PolyMesh,
+    /// Its tags (the template's).
+    pub tags: &'a Tags,
+    /// The scheme.
+    pub scheme: Scheme,
+    /// The frame's report.
+    pub report: &'a FrameReport,
+}
+
+/// What [`fit_sequence`] returns: the cage's connectivity, every frame's positions (input
+/// coordinates) and the report.
+pub struct Sequence {
+    /// Faces of the cage (every frame).
+    pub faces: Polygons,
+    /// Tags of the cage.
+    pub tags: Tags,
+    /// The scheme.
+    pub scheme: Scheme,
+    /// The boundary rule (the per-frame fit's, [`FitOptions::boundary`]).
+    pub boundary: BoundaryRule,
+    /// Positions per frame.
+    pub positions: Vec<Vec<[f64; 3]>>,
+    /// The report.
+    pub report: SequenceReport,
+}
+
+/// What carries over from frame to frame.
+struct Carry {
+    normalization: Normalization,
+    faces: Polygons,
+    tags: Tags,
+    scheme: Scheme,
+    template: Arc<Vec<[f64; 3]>>,
+    previous: Vec<[f64; 3]>,
+    /// Limit points of the control vertices (`#V × #V` stencils) and their tangents.
+    limit: LimitStencils,
+    previous_limit: Option<Vec<[f64; 3]>>,
+    template_edges: Vec<(u32, u32, f64)>,
+}
+
+struct LimitStencils {
+    position: StencilMatrix,
+    tangent1: StencilMatrix,
+    tangent2: StencilMatrix,
+}
+
+/// Fits one cage to every frame of `frames` in order (see the module docs), calling
+/// `on_frame` with each fitted frame as soon as it is done (to write it; an error there stops
+/// the run). `warn` receives what the user should know.
+///
+/// Errors: an unreadable or unusable frame (named), a failed fit, a cage whose topology does
+/// not suit the first frame, an interruption, the callback's error. Cost per frame: one target
+/// analysis (near-linear in its points), the silhouette's target images, one fitter set-up and
+/// at most [`SequenceOptions::iterations`] LM iterations, one two-sided measurement.
+pub fn fit_sequence<I>(
+    frames: I,
+    options: &SequenceOptions,
+    on_frame: &mut dyn FnMut(SequenceFrame<'_>) -> Result<(), Error>,
+    warn: &mut dyn FnMut(&str),
+) -> Result<Sequence, Error>
+where
+    I: IntoIterator<Item = Input>,
+{
+    validate(options)?;
+    let mut warnings: Vec<String> = Vec::new();
+    let mut warn_all = |m: String| {
+        warn(&m);
+        warnings.push(m);
+    };
+    let mut carry: Option<Carry> = None;
+    let mut reports: Vec<FrameReport> = Vec::new();
+    let mut positions: Vec<Vec<[f64; 3]>> = Vec::new();
+    let mut template_report = None;
+    let mut template_name = "fit".to_string();
+    for (index, input) in frames.into_iter().enumerate() {
+        options.cancel.check().map_err(|_| Error::Interrupted)?;
+        let t0 = Instant::now();
+        let (report, cage) = match carry.as_mut() {
+            None if matches!(options.template, InitialCage::Auto) => {
+                let (c, report, fitted_report) = template_frame(input, options, &mut warn_all)?;
+                template_report = Some(Box::new(fitted_report));
+                let cage = original_cage(&c);
+                carry = Some(c);
+                (report, cage)
+            }
+            None => {
+                let InitialCage::Given { mesh, tags, name } = &options.template else {
+                    unreachable!("matched above")
+                };
+                template_name.clone_from(name);
+                let (mesh_in, fname, reoriented, read) = read_frame(input, &mut warn_all)?;
+                let (lo, hi) = mesh_in.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
+                let normalization = Normalization::from_bounds(lo, hi)
+                    .ok_or_else(|| Error::input(&fname, "all points coincide: nothing to fit"))?;
+                let cage: Vec<[f64; 3]> = mesh
+                    .positions
+                    .iter()
+                    .map(|&p| normalization.to_normalized(p))
+                    .collect();
+                let scheme = options
+                    .template_fit
+                    .scheme
+                    .unwrap_or(if mesh.faces.is_triangles() {
+                        Scheme::Loop
+                    } else {
+                        Scheme::CatmullClark
+                    });
+                let mut c = Carry::new(
+                    normalization,
+                    mesh.faces.clone(),
+                    tags.clone(),
+                    scheme,
+                    cage,
+                    &options.fit,
+                )
+                .map_err(|e| Error::input(name, e))?;
+                let report = fit_frame(
+                    &mut c,
+                    (mesh_in, fname, reoriented, read),
+                    index,
+                    options,
+                    t0,
+                )?;
+                let cage = original_cage(&c);
+                carry = Some(c);
+                (report, cage)
+            }
+            Some(c) => {
+                let frame = read_frame(input, &mut warn_all)?;
+                let report = fit_frame(c, frame, index, options, t0)?;
+                (report, original_cage(c))
+            }
+        };
+        let c = carry.as_ref().expect("set above");
+        on_frame(SequenceFrame {
+            cage: &cage,
+            tags: &c.tags,
+            scheme: c.scheme,
+            report: &report,
+        })?;
+        positions.push(cage.positions);
+        reports.push(report);
+    }
+    let Some(c) = carry else {
+        return Err(Error::Options("a sequence needs at least one frame".into()));
+    };
+    let later: Vec<f64> = reports.iter().skip(1).map(|r| r.timings_s.total).collect();
+    let report = SequenceReport {
+        frames_fitted: reports.len(),
+        control_points: c.template.len(),
+        control_faces: c.faces.len(),
+        scheme: format!("{:?}", c.scheme),
+        template: template_name,
+        template_report,
+        options: SequenceOptionsSummary {
+            method: format!("{:?}", options.fit.method).to_uppercase(),
+            lambda: options.lambda,
+            arap: options.arap,
+            iterations: options.iterations,
+            tolerance_rms: options.tolerance_rms,
+            silhouette_views: options.silhouette.views,
+            silhouette_resolution: options.silhouette.resolution,
+            silhouette_weight: options.silhouette.weight,
+            sample_level: options.fit.sample_level,
+        },
+        worst_rms_fraction_of_diagonal: reports
+            .iter()
+            .map(|r| r.two_sided.e_rms_fraction_of_diagonal)
+            .fold(0.0, f64::max),
+        worst_max_fraction_of_diagonal: reports
+            .iter()
+            .map(|r| r.two_sided.e_max_fraction_of_diagonal)
+            .fold(0.0, f64::max),
+        mean_seconds_per_frame: if later.is_empty() {
+            0.0
+        } else {
+            later.iter().sum::<f64>() / later.len() as f64
+        },
+        frames: reports,
+        warnings,
+    };
+    Ok(Sequence {
+        faces: c.faces,
+        tags: c.tags,
+        scheme: c.scheme,
+        boundary: options.fit.boundary,
+        positions,
+        report,
+    })
+}
+
+impl Carry {
+    fn new(
+        normalization: Normalization,
+        faces: Polygons,
+        tags: Tags,
+        scheme: Scheme,
+        template: Vec<[f64; 3]>,
+        fit: &FitOptions,
+    ) -> Result<Self, String> {
+        let opts = fit.clone().with_scheme(scheme).subdivision();
+        let op = sampling_operator(&faces, template.len(), &tags, &opts, 0)
+            .map_err(|e| e.to_string())?;
+        let template_edges = edges(&faces)
+            .into_iter()
+            .map(|(a, b)| {
+                (
+                    a,
+                    b,
+                    dist2(template[a as usize], template[b as usize]).sqrt(),
+                )
+            })
+            .collect();
+        Ok(Self {
+            normalization,
+            faces,
+            tags,
+            scheme,
+            previous: template.clone(),
+            template: Arc::new(template),
+            limit: LimitStencils {
+                position: op.position,
+                tangent1: op.tangent1,
+                tangent2: op.tangent2,
+            },
+            previous_limit: None,
+            template_edges,
+        })
+    }
+
+    /// Drift diagnostics of `cage` (normalized units) against the previous frame's limit
+    /// points and the template's edges, as fractions of `diagonal` (normalized units).
+    fn drift(&mut self, cage: &[[f64; 3]], diagonal: f64) -> DriftDiagnostics {
+        let limit = self.limit.position.apply(cage);
+        let t1 = self.limit.tangent1.apply(cage);
+        let t2 = self.limit.tangent2.apply(cage);
+        let strain = {
+            let s: f64 = self
+                .template_edges
+                .iter()
+                .map(|&(a, b, l0)| {
+                    let l = dist2(cage[a as usize], cage[b as usize]).sqrt();
+                    ((l - l0) / l0.max(1e-300)).powi(2)
+                })
+                .sum();
+            (s / self.template_edges.len().max(1) as f64).sqrt()
+        };
+        let mut d = DriftDiagnostics {
+            edge_strain_rms: strain,
+            ..DriftDiagnostics::default()
+        };
+        if let Some(prev) = &self.previous_limit {
+            let (mut all, mut normal) = (0.0, 0.0);
+            for i in 0..limit.len() {
+                let m = sub(limit[i], prev[i]);
+                let n = cross(t1[i], t2[i]);
+                let nn = dot(n, n).sqrt();
+                let along = if nn > 0.0 { dot(m, n) / nn } else { 0.0 };
+                all += dot(m, m);
+                normal += along * along;
+            }
+            let k = limit.len().max(1) as f64;
+            d.motion_rms = (all / k).sqrt() / diagonal;
+            d.normal_motion_rms = (normal / k).sqrt() / diagonal;
+            d.tangential_motion_rms = ((all - normal).max(0.0) / k).sqrt() / diagonal;
+        }
+        self.previous_limit = Some(limit);
+        d
+    }
+}
+
+/// The template: the first frame fitted with [`fit_scan`].
+fn template_frame(
+    input: Input,
+    options: &SequenceOptions,
+    warn: &mut dyn FnMut(String),
+) -> Result<(Carry, FrameReport, crate::Report), Error> {
+    let t0 = Instant::now();
+    let mut o = options.template_fit.clone();
+    o.init = InitialCage::Auto;
+    o.fit.boundary = options.fit.boundary;
+    o.cancel = options.cancel.clone();
+    let mut forward = |p: crate::Progress<'_>| {
+        if let crate::Progress::Warning(m) = p {
+            warn(m.to_string());
+        }
+    };
+    let fitted = fit_scan(input, &o, Some(&mut forward))?;
+    let target = fitted.target();
+    let mut carry = Carry::new(
+        *target.normalization(),
+        fitted.normalized_cage().faces.clone(),
+        fitted.tags.clone(),
+        fitted.scheme,
+        fitted.normalized_cage().positions.clone(),
+        &options.fit,
+    )
+    .map_err(|e| Error::input(&fitted.report.target, e))?;
+    let r = &fitted.report;
+    let diagonal = r.bbox_diagonal_unit_cube;
+    let drift = carry.drift(&fitted.normalized_cage().positions, diagonal);
+    let report = FrameReport {
+        index: 0,
+        name: r.target.clone(),
+        points: r.target_points,
+        mesh: target.mesh().is_some(),
+        reoriented: r.reoriented.clone(),
+        bbox_diagonal: diagonal * r.normalized_unit_in_original_units,
+        two_sided: r.r#final.two_sided,
+        tolerance_reached: r.tolerance_reached_two_sided,
+        iterations: r.iterations.len(),
+        silhouette_loss: None,
+        drift,
+        timings_s: FrameTimings {
+            read: r.timings_s.read,
+            analyse: r.timings_s.preprocess,
+            silhouette: 0.0,
+            fit: r.timings_s.fit + r.timings_s.init,
+            total: t0.elapsed().as_secs_f64(),
+        },
+    };
+    Ok((carry, report, fitted.report))
+}
+
+type ReadFrame = (PolyMesh, String, Option<Reorientation>, f64);
+
+fn read_frame(input: Input, warn: &mut dyn FnMut(String)) -> Result<ReadFrame, Error> {
+    let t = Instant::now();
+    let (mesh, name, reoriented) = read_input(input, false, warn)?;
+    Ok((mesh, name, reoriented, t.elapsed().as_secs_f64()))
+}
+
+/// Fits the carried cage to one frame, updating the carry.
+fn fit_frame(
+    carry: &mut Carry,
+    (mesh, name, reoriented, read): ReadFrame,
+    index: usize,
+    options: &SequenceOptions,
+    t0: Instant,
+) -> Result<FrameReport, Error> {
+    let t = Instant::now();
+    let target_options = TargetOptions {
+        normalization: Some(carry.normalization),
+        cancel: options.cancel.clone(),
+        ..TargetOptions::default()
+    };
+    let target = Target::build(&mesh, &target_options, None).map_err(|e| match e {
+        subfit_target::TargetError::Interrupted => Error::Interrupted,
+        e => Error::input(&name, e),
+    })?;
+    let analyse = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let silhouette = silhouette_term(&target, &options.silhouette);
+    let silhouette_time = t.elapsed().as_secs_f64();
+    let fit = FitOptions {
+        scheme: carry.scheme,
+        tags: carry.tags.clone(),
+        arap: options.arap,
+        arap_rest: (options.arap > 0.0).then(|| carry.template.clone()),
+
+        surface_term: silhouette.clone(),
+        cancel: options.cancel.clone(),
+        ..options.fit.clone()
+    };
+    let t = Instant::now();
+    let fit_err = |e: subfit_fit::FitError| match e {
+        subfit_fit::FitError::Interrupted => Error::Interrupted,
+        e => Error::Fit {
+            name: name.clone(),
+            source: e,
+        },
+    };
+    let term = AnyTerm::from_options(&target, &fit);
+    let mut fitter =
+        Fitter::with_term(term, &carry.faces, carry.previous.len(), &fit).map_err(fit_err)?;
+    let mut positions = carry.previous.clone();
+    let schedule = arap_schedule(options);
+    let mut iterations = 0;
+    for (k, &(alpha, iters)) in schedule.iter().enumerate() {
+        let last = k + 1 == schedule.len();
+        fitter.set_arap(alpha);
+        let tolerance = if last { options.tolerance_rms } else { 0.0 };
+        fitter.set_stage(options.lambda, iters, tolerance, 0.0, 1e-4);
+        let r = fitter.run(&mut positions, None).map_err(fit_err)?;
+        iterations += r.iterations.len();
+    }
+    let data = data_samples(&target, options.data_samples);
+    let (two, _, _) = fitter.measure_two_sided(&positions, &data.points);
+    let fit_time = t.elapsed().as_secs_f64();
+    let unit = carry.normalization.length_to_original(1.0);
+    let diagonal = subfit_fit::DataTerm::bbox_diagonal(&subfit_fit::FootPointTerm::from_options(
+        &target, &fit,
+    ));
+    let two = &two;
+    let silhouette_loss = silhouette.as_ref().map(|s| {
+        let op = sampling_operator(
+            &carry.faces,
+            positions.len(),
+            &carry.tags,
+            &fit.subdivision(),
+            fit.sample_level,
+        );
+        op.map_or(f64::NAN, |op| {
+            s.term.value(
+                &op.position.apply(&positions),
+                &subfit_fit::fan_triangles(&op.faces),
+            )
+        })
+    });
+    let drift = carry.drift(&positions, diagonal);
+    carry.previous = positions;
+    Ok(FrameReport {
+        index,
+        name,
+        points: target.len(),
+        mesh: target.mesh().is_some(),
+        reoriented,
+        bbox_diagonal: diagonal * unit,
+        two_sided: TwoSidedErrors::new(two, diagonal, unit),
+        tolerance_reached: two.within(options.tolerance_rms, 0.0),
+        iterations,
+        silhouette_loss,
+        drift,
+        timings_s: FrameTimings {
+            read,
+            analyse,
+            silhouette: silhouette_time,
+            fit: fit_time,
+            total: t0.elapsed().as_secs_f64(),
+        },
+    })
+}
+
+/// `(α, iterations)` per level of the annealing of [`SequenceOptions::arap_start`].
+fn arap_schedule(o: &SequenceOptions) -> Vec<(f64, usize)> {
+    let mut alphas = vec![o.arap_start.max(o.arap)];
+    while alphas.len() < 8 && *alphas.last().expect("one") > 10.0 * o.arap.max(1e-12) * 1.0001 {
+        let next = alphas.last().expect("one") / 10.0;
+        alphas.push(next.max(o.arap));
+    }
+    if *alphas.last().expect("one") != o.arap {
+        alphas.push(o.arap);
+    }
+    let k = alphas.len().min(o.iterations.max(1));
+    let alphas = &alphas[alphas.len() - k..];
+    let per = o.iterations / k;
+    alphas
+        .iter()
+        .enumerate()
+        .map(|(i, &a)| {
+            (
+                a,
+                if i + 1 == k {
+                    o.iterations - per * (k - 1)
+                } else {
+                    per
+                },
+            )
+        })
+        .collect()
+}
+
+/// The silhouette term of a frame: its target images from K views around its bounding sphere
+/// (the frame's triangles, or its points splatted as balls of the point spacing).
+fn silhouette_term(target: &Target, o: &SilhouetteOptions) -> Option<WeightedSurfaceTerm> {
+    use subfit_fit::silhouette::{cameras_around, Silhouette, SoftOptions};
+    if o.views == 0 || o.weight == 0.0 {
+        return None;
+    }
+    let (lo, hi) = subfit_mesh::bounding_box(target.points())?;
+    let center: [f64; 3] = std::array::from_fn(|a| 0.5 * (lo[a] + hi[a]));
+    let radius = 0.5 * dist2(lo, hi).sqrt();
+    let cameras = cameras_around(center, radius, o.views, o.resolution);
+    let soft = SoftOptions::default();
+    let silhouette = match target.mesh() {
+        Some(bvh) => Silhouette::from_mesh(cameras, bvh.vertices(), bvh.triangles(), soft),
+        None => Silhouette::from_points(
+            cameras,
+            target.points(),
+            target.stats().point_spacing.max(1e-9),
+            soft,
+        ),
+    };
+    Some(WeightedSurfaceTerm {
+        term: Arc::new(silhouette),
+        weight: o.weight,
+    })
+}
+
+/// The carried cage in the input's coordinates.
+fn original_cage(c: &Carry) -> PolyMesh {
+    PolyMesh::new(
+        c.previous
+            .iter()
+            .map(|&p| c.normalization.to_original(p))
+            .collect(),
+        c.faces.clone(),
+    )
+}
+
+fn validate(o: &SequenceOptions) -> Result<(), Error> {
+    let bad = |m: String| Err(Error::Options(m));
+    if !(o.lambda.is_finite() && o.lambda >= 0.0) {
+        return bad(format!(
+            "--lambda must be a finite number ≥ 0, got {}",
+            o.lambda
+        ));
+    }
+    if !(o.arap.is_finite() && o.arap >= 0.0) {
+        return bad(format!(
+            "--arap must be a finite number ≥ 0, got {}",
+            o.arap
+        ));
+    }
+    if o.iterations == 0 {
+        return bad("--iterations must be at least 1".into());
+    }
+    if !(o.tolerance_rms.is_finite() && o.tolerance_rms >= 0.0 && o.tolerance_rms < 1.0) {
+        return bad(format!(
+            "--tolerance must be in [0, 1) (unit-cube units), got {}",
+            o.tolerance_rms
+        ));
+    }
+    let s = &o.silhouette;
+    if s.views > 0 && !(16..=1024).contains(&s.resolution) {
+        return bad(format!(
+            "--silhouette-resolution must be within 16..=1024 pixels, got {}",
+            s.resolution
+        ));
+    }
+    if !(s.weight.is_finite() && s.weight >= 0.0) {
+        return bad(format!(
+            "--silhouette-weight must be a finite number ≥ 0, got {}",
+            s.weight
+        ));
+    }
+    if o.fit.method == Method::Imls && o.fit.imls_radius.is_some_and(|h| !(h > 0.0 && h < 1.0)) {
+        return bad("--imls-radius must be in (0, 1) (unit-cube units)".into());
+    }
+    Ok(())
+}
+
+/// Unique undirected edges of `faces`.
+fn edges(faces: &Polygons) -> Vec<(u32, u32)> {
+    let mut e: Vec<(u32, u32)> = faces
+        .iter()
+        .flat_map(|f| (0..f.len()).map(move |k| (f[k], f[(k + 1) % f.len()])))
+        .map(|(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e
+}
+
+impl Sequence {
+    /// The limit points of the cage refined `level` times (`level = 0`: the control vertices'
+    /// limit points), every frame, input coordinates: the same surface point has the same
+    /// index in every frame — what a user tracks (e.g. to measure drift).
+    ///
+    /// Errors: a topology the subdivision refuses (not after a successful fit).
+    pub fn limit_points(&self, level: usize) -> Result<Vec<Vec<[f64; 3]>>, Error> {
+        let n = self.positions.first().map_or(0, Vec::len);
+        let opts = subfit_subdiv::Options::default()
+            .with_scheme(self.scheme)
+            .with_boundary(self.boundary);
+        let op = sampling_operator(&self.faces, n, &self.tags, &opts, level)
+            .map_err(|e| Error::Output(e.to_string()))?;
+        Ok(self
+            .positions
+            .iter()
+            .map(|p| op.position.apply(p))
+            .collect())
+    }
+
+    /// The names of the files [`Self::write_into`] writes, in order.
+    pub fn output_names(&self) -> Vec<String> {
+        let mut v: Vec<String> = (0..self.positions.len()).map(frame_file_name).collect();
+        v.push("sequence.usda".into());
+        v.push("report.json".into());
+        v
+    }
+
+    /// Writes every frame's cage (`frame_0000.obj` …, ASCII OBJ in the input's coordinates),
+    /// `sequence.usda` (at `fps` frames per second) and `report.json` into `dir`, which must
+    /// exist.
+    pub fn write_into(&self, dir: &std::path::Path, fps: f64) -> Result<(), Error> {
+        let ascii = subfit_io::WriteOptions {
+            format: None,
+            encoding: subfit_io::Encoding::Ascii,
+            single_precision: false,
+        };
+        for (i, p) in self.positions.iter().enumerate() {
+            let cage = PolyMesh::new(p.clone(), self.faces.clone());
+            subfit_io::write_file(&dir.join(frame_file_name(i)), &cage, &ascii)?;
+        }
+        let write = |name: &str, bytes: &[u8]| {
+            std::fs::write(dir.join(name), bytes)
+                .map_err(|e| Error::Output(format!("{}: {e}", dir.join(name).display())))
+        };
+        subfit_io::write_usda_animated_file(
+            &dir.join("sequence.usda"),
+            &self.faces,
+            &self.positions,
+            &self.tags,
+            crate::outputs::usd_scheme(self.scheme),
+            crate::outputs::usd_boundary(self.boundary),
+            fps,
+        )?;
+        let json = serde_json::to_vec_pretty(&self.report)
+            .map_err(|e| Error::Output(format!("report.json: {e}")))?;
+        write("report.json", &json)
+    }
+
+    /// `sequence.usda`: one mesh with the cage's topology, scheme and tags and time-sampled
+    /// points (time codes 0 … frames − 1 at `fps` frames per second, `fps` > 0).
+    pub fn usda(&self, fps: f64) -> Vec<u8> {
+        let mut out = Vec::new();
+        subfit_io::usda::write_animated(
+            &self.faces,
+            &self.positions,
+            &self.tags,
+            crate::outputs::usd_scheme(self.scheme),
+            crate::outputs::usd_boundary(self.boundary),
+            fps,
+            &mut out,
+        );
+        out
+    }
+}
+
+/// `frame_0000.obj` for frame 0.
+pub fn frame_file_name(index: usize) -> String {
+    format!("frame_{index:04}.obj")
+}
