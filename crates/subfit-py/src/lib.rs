@@ -17,6 +17,7 @@ mod errors;
 mod fit;
 mod imls;
 mod io;
+mod sequence;
 mod surface;
 
 use pyo3::prelude::*;
@@ -27,6 +28,8 @@ fn _subfit(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     m.add_class::<fit::NativeFit>()?;
+    m.add_function(wrap_pyfunction!(sequence::fit_sequence_py, m)?)?;
+    m.add_class::<sequence::NativeSequence>()?;
     m.add_class::<surface::NativeSurface>()?;
     m.add_function(wrap_pyfunction!(surface::sampling_operator, m)?)?;
     m.add_class::<imls::ImlsField>()?;

@@ -54,6 +54,32 @@ def fit(
     progress: Optional[Callable[[dict], Any]] = None,
 ) -> NativeFit: ...
 
+class NativeSequence:
+    def vertices(self) -> npt.NDArray[np.float64]: ...
+    def faces(self) -> FaceArrays: ...
+    def tags(self) -> TagArrays: ...
+    def scheme(self) -> str: ...
+    def report_json(self) -> str: ...
+    def write_into(self, dir: str, fps: float) -> None: ...
+
+def fit_sequence(
+    frames: Any,
+    *,
+    template: Optional[Tuple[F64, FaceArrays]] = None,
+    control_points: Optional[int] = None,
+    scheme_name: str = "auto",
+    method: str = "sdm",
+    arap: float = 0.01,
+    lambda_: float = 1e-5,
+    iterations: int = 12,
+    tolerance: float = 5e-4,
+    sample_level: int = 2,
+    silhouette_views: int = 8,
+    silhouette_resolution: int = 128,
+    silhouette_weight: float = ...,
+    progress: Optional[Callable[[dict], Any]] = None,
+) -> NativeSequence: ...
+
 class NativeSurface:
     def __init__(self, vertices: F64, counts: I64, indices: I64, scheme_name: str,
                  tag_arrays: Optional[TagArrays] = None) -> None: ...
