@@ -124,8 +124,8 @@ pub fn cameras_around(center: [f64; 3], radius: f64, k: usize, resolution: usize
         2.0 * MARGIN_PIXELS
     );
     // half_size = (1 + m)·radius + MARGIN_PIXELS·h with h = 2·half_size/resolution.
-    let half_size = (1.0 + MARGIN_FRACTION) * radius
-        / (1.0 - 2.0 * MARGIN_PIXELS / resolution as f64);
+    let half_size =
+        (1.0 + MARGIN_FRACTION) * radius / (1.0 - 2.0 * MARGIN_PIXELS / resolution as f64);
     let golden_angle = std::f64::consts::PI * (3.0 - 5f64.sqrt());
     (0..k)
         .map(|i| {

@@ -294,7 +294,10 @@ impl Silhouette {
 
     /// `N`, the number of pixels over all views.
     pub fn pixel_count(&self) -> usize {
-        self.cameras.iter().map(|c| c.resolution * c.resolution).sum()
+        self.cameras
+            .iter()
+            .map(|c| c.resolution * c.resolution)
+            .sum()
     }
 
     /// The predicted images of a mesh, one per camera.
@@ -337,8 +340,8 @@ impl Silhouette {
                 for (corner, &v) in triangles[*f as usize].iter().enumerate() {
                     let (gx, gy) = (g[2 * corner] * inv_h, g[2 * corner + 1] * inv_h);
                     let out = &mut gradient[v as usize];
-                    for c in 0..3 {
-                        out[c] += gx * camera.right[c] + gy * camera.up[c];
+                    for ((o, r), u) in out.iter_mut().zip(camera.right).zip(camera.up) {
+                        *o += gx * r + gy * u;
                     }
                 }
             }

@@ -1,19 +1,39 @@
 //! The tile rasterizer behind [`super`]: primitives projected to pixel coordinates, binned into
-//! `TILE × TILE` pixel tiles by their bounding boxes grown by the cutoff distance, then each
-//! tile visits, triangle by triangle, only the pixels of that grown box (forward: the product
-//! of the `1 − D` factors; backward: the gradient of the loss w.r.t. the projected corners).
+//! `TILE × TILE` pixel tiles by their bounding boxes grown by the cutoff distance; each tile
+//! visits, primitive by primitive, the pixels that can lie within the cutoff (the grown box cut
+//! by a disc around the primitive, row by row), `LANES` pixels of a row at a time (forward:
+//! the product of the `1 − D` factors; backward: the gradient of the loss w.r.t. the projected
+//! triangle corners).
 //!
 //! Everything here is in pixel units: coordinates in pixels, `σ` in pixel², distances in
 //! pixels. The world ↔ pixel map (a constant Jacobian) lives in [`super::camera`].
+
+// The kernels index several per-lane arrays in step (`for j in 0..LANES`), the form the
+// compiler vectorizes and the clearest to read.
+#![allow(clippy::needless_range_loop)]
 
 use rayon::prelude::*;
 
 use super::{Camera, Image, SoftOptions};
 
 /// Side of a square tile, pixels.
-pub(super) const TILE: usize = 16;
+pub(super) const TILE: usize = 32;
 
-/// Largest exponent fed to `exp` (beyond it the factor `1 − D` underflows anyway).
+/// Pixels evaluated together: the kernels are loops over `[f64; LANES]` without branches,
+/// which the compiler turns into SIMD instructions.
+const LANES: usize = 4;
+
+/// A chunk of `LANES` pixel values.
+type Lanes = [f64; LANES];
+
+/// Row stride of the tile buffers: a chunk starting near the end of a tile row spills up to
+/// `LANES − 1` values into padding columns, which hold no pixel.
+const STRIDE: usize = TILE + LANES;
+
+/// Length of a tile buffer.
+const TILE_BUF: usize = TILE * STRIDE;
+
+/// Exponents are clamped to `±Z_MAX` (beyond it `1 − D` or `D` is below 1e-304 anyway).
 const Z_MAX: f64 = 700.0;
 
 /// The soft coverage function in pixel units, with the cutoff folded in.
@@ -21,14 +41,16 @@ const Z_MAX: f64 = 700.0;
 /// `D(s) = sigmoid(s/σ)` for the signed squared distance `s` (positive inside). The kept factor
 /// is `q̃ = min(1, (1 − D)/(1 − ε))`: exactly 1 (no effect) once `D ≤ ε`, i.e. beyond the cutoff
 /// distance `√(σ·ln((1 − ε)/ε))` outside the primitive, and continuous there, so the pixel value
-/// `I = 1 − Π q̃` and its gradient have no jump when a primitive crosses the cutoff.
+/// `I = 1 − Π q̃` and its gradient have no jump when a primitive crosses the cutoff. The kernels
+/// accumulate `P = Π 1/q̃ = Π (1 + e^{s/σ})(1 − ε)` (a multiplication per visit, no division)
+/// and take `Q = Π q̃ = 1/P` per pixel; `P` may overflow to `+∞`, which gives `Q = 0`.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Soft {
     inv_sigma: f64,
     /// Squared cutoff distance outside a primitive, px²: `D = ε` there.
     cut2: f64,
-    /// `1/(1 − ε)`.
-    rescale: f64,
+    /// `1 − ε`.
+    keep: f64,
 }
 
 impl Soft {
@@ -46,7 +68,7 @@ impl Soft {
         Self {
             inv_sigma: 1.0 / sigma,
             cut2: sigma * ((1.0 - eps) / eps).ln(),
-            rescale: 1.0 / (1.0 - eps),
+            keep: 1.0 - eps,
         }
     }
 
@@ -55,25 +77,64 @@ impl Soft {
         self.cut2.sqrt()
     }
 
-    /// `(q̃, D)` for the signed squared distance `s` (px², positive inside); `None` beyond the
-    /// cutoff, where `q̃ = 1`.
-    #[inline]
-    fn factor(&self, s: f64) -> Option<(f64, f64)> {
-        if s <= -self.cut2 {
-            return None;
-        }
-        let e = (s * self.inv_sigma).min(Z_MAX).exp();
-        let q = 1.0 / (1.0 + e);
-        Some((q * self.rescale, e * q))
+    /// `e^{s/σ}` with the exponent clamped to `±Z_MAX`.
+    #[inline(always)]
+    fn exp(&self, s: f64) -> f64 {
+        let z = s * self.inv_sigma;
+        let z = if z > Z_MAX { Z_MAX } else { z };
+        let z = if z < -Z_MAX { -Z_MAX } else { z };
+        exp(z)
     }
+}
+
+/// `1/k!` for `k = 0..=13`.
+const INV_FACTORIALS: [f64; 14] = [
+    1.0,
+    1.0,
+    1.0 / 2.0,
+    1.0 / 6.0,
+    1.0 / 24.0,
+    1.0 / 120.0,
+    1.0 / 720.0,
+    1.0 / 5_040.0,
+    1.0 / 40_320.0,
+    1.0 / 362_880.0,
+    1.0 / 3_628_800.0,
+    1.0 / 39_916_800.0,
+    1.0 / 479_001_600.0,
+    1.0 / 6_227_020_800.0,
+];
+
+/// `e^z` for `|z| ≤ 708`, within a few ulp, without branches so that it vectorizes (the C
+/// library's `exp` is an opaque call). Cody–Waite reduction `z = n·ln 2 + r`, `|r| ≤ ½ ln 2`,
+/// a degree-13 Taylor polynomial for `e^r` (remainder below 5e-18), and `2^n` assembled in the
+/// exponent bits.
+#[inline(always)]
+pub(super) fn exp(z: f64) -> f64 {
+    // 1.5·2^52: adding it rounds to an integer, which then sits in the low mantissa bits.
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    const LN2_HI: f64 = 6.931_471_803_691_238e-1;
+    const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+    let shifted = z * std::f64::consts::LOG2_E + SHIFT;
+    let n = shifted - SHIFT;
+    let r = (z - n * LN2_HI) - n * LN2_LO;
+    let mut p = INV_FACTORIALS[13];
+    for k in (0..13).rev() {
+        p = p * r + INV_FACTORIALS[k];
+    }
+    let n_bits = shifted.to_bits().wrapping_sub(SHIFT.to_bits());
+    p * f64::from_bits(n_bits.wrapping_add(1023) << 52)
 }
 
 /// A shape in pixel coordinates with a signed squared distance to its boundary.
 pub(super) trait Primitive: Sync {
     /// `[x_min, y_min, x_max, y_max]`, pixels.
     fn bbox(&self) -> [f64; 4];
-    /// `±d²`, `d` the distance from `p` to the boundary: positive inside, negative outside.
-    fn signed_sq(&self, p: [f64; 2]) -> f64;
+    /// A disc `(centre, radius)` containing the shape, pixels.
+    fn bounding_disc(&self) -> ([f64; 2], f64);
+    /// `±d²` at the pixel centres `(x[j], y[j])`, `d` the distance to the boundary: positive
+    /// inside, negative outside.
+    fn signed_sq(&self, x: &Lanes, y: &Lanes) -> Lanes;
 }
 
 /// A projected triangle with its edges precomputed. Either orientation; a zero-area triangle
@@ -89,18 +150,18 @@ pub(super) struct TriPx {
     orient: f64,
 }
 
-/// The nearest boundary point of a triangle to a pixel centre.
-#[derive(Clone, Copy, Debug)]
+/// The nearest boundary points of a triangle to `LANES` pixel centres.
 struct Closest {
-    /// Signed squared distance, positive inside.
-    s: f64,
-    inside: bool,
-    /// The nearest edge `k`, from `v[k]` to `v[k+1]`.
-    edge: usize,
-    /// Parameter of the nearest point on that edge, in `[0, 1]`.
-    t: f64,
+    /// Squared distance to the boundary.
+    d2: Lanes,
+    /// Whether the pixel centre is inside.
+    inside: [bool; LANES],
+    /// Which edge is nearest: `edge[k][j]` is 1.0 for the nearest edge `k`, else 0.0.
+    edge: [Lanes; 3],
+    /// Parameter of the nearest point on the nearest edge, in `[0, 1]`.
+    t: Lanes,
     /// `p − nearest point`.
-    r: [f64; 2],
+    r: [Lanes; 2],
 }
 
 impl TriPx {
@@ -131,38 +192,67 @@ impl TriPx {
         }
     }
 
-    #[inline]
-    fn closest(&self, p: [f64; 2]) -> Closest {
-        let mut inside = self.orient != 0.0;
-        let mut best = Closest {
-            s: f64::INFINITY,
-            inside: false,
-            edge: 0,
-            t: 0.0,
-            r: [0.0; 2],
+    /// Edge `k` seen from the pixel centres: `(orient · e_k × w, t, r)` with `w = p − v_k`,
+    /// `t` the clamped parameter of the nearest point, `r = w − t·e_k`.
+    #[inline(always)]
+    fn edge(&self, k: usize, x: &Lanes, y: &Lanes) -> (Lanes, Lanes, [Lanes; 2]) {
+        let (a, e, il) = (self.v[k], self.e[k], self.inv_len2[k]);
+        let mut side = [0.0; LANES];
+        let mut t = [0.0; LANES];
+        let mut r = [[0.0; LANES]; 2];
+        for j in 0..LANES {
+            let (wx, wy) = (x[j] - a[0], y[j] - a[1]);
+            side[j] = (e[0] * wy - e[1] * wx) * self.orient;
+            let tj = (wx * e[0] + wy * e[1]) * il;
+            let tj = if tj < 0.0 { 0.0 } else { tj };
+            let tj = if tj > 1.0 { 1.0 } else { tj };
+            t[j] = tj;
+            r[0][j] = wx - tj * e[0];
+            r[1][j] = wy - tj * e[1];
+        }
+        (side, t, r)
+    }
+
+    /// The nearest boundary point for each lane (for the gradient).
+    #[inline(always)]
+    fn closest(&self, x: &Lanes, y: &Lanes) -> Closest {
+        let (side0, t0, r0) = self.edge(0, x, y);
+        let mut c = Closest {
+            d2: [0.0; LANES],
+            inside: [false; LANES],
+            edge: [[1.0; LANES], [0.0; LANES], [0.0; LANES]],
+            t: t0,
+            r: r0,
         };
-        for k in 0..3 {
-            let (a, e) = (self.v[k], self.e[k]);
-            let w = [p[0] - a[0], p[1] - a[1]];
-            inside &= (e[0] * w[1] - e[1] * w[0]) * self.orient > 0.0;
-            let t = ((w[0] * e[0] + w[1] * e[1]) * self.inv_len2[k]).clamp(0.0, 1.0);
-            let r = [w[0] - t * e[0], w[1] - t * e[1]];
-            let d2 = r[0] * r[0] + r[1] * r[1];
-            if d2 < best.s {
-                best = Closest {
-                    s: d2,
-                    inside: false,
-                    edge: k,
-                    t,
-                    r,
+        let mut side_min = side0;
+        for j in 0..LANES {
+            c.d2[j] = r0[0][j] * r0[0][j] + r0[1][j] * r0[1][j];
+        }
+        for k in 1..3 {
+            let (side, t, r) = self.edge(k, x, y);
+            for j in 0..LANES {
+                let d2 = r[0][j] * r[0][j] + r[1][j] * r[1][j];
+                let nearer = d2 < c.d2[j];
+                c.d2[j] = if nearer { d2 } else { c.d2[j] };
+                c.t[j] = if nearer { t[j] } else { c.t[j] };
+                c.r[0][j] = if nearer { r[0][j] } else { c.r[0][j] };
+                c.r[1][j] = if nearer { r[1][j] } else { c.r[1][j] };
+                for m in 0..3 {
+                    let is_k = if m == k { 1.0 } else { 0.0 };
+                    c.edge[m][j] = if nearer { is_k } else { c.edge[m][j] };
+                }
+                side_min[j] = if side[j] < side_min[j] {
+                    side[j]
+                } else {
+                    side_min[j]
                 };
             }
         }
-        best.inside = inside;
-        if !inside {
-            best.s = -best.s;
+        for j in 0..LANES {
+            // A degenerate triangle has orient = 0, so no side is positive: no inside.
+            c.inside[j] = side_min[j] > 0.0;
         }
-        best
+        c
     }
 }
 
@@ -177,9 +267,38 @@ impl Primitive for TriPx {
         ]
     }
 
-    #[inline]
-    fn signed_sq(&self, p: [f64; 2]) -> f64 {
-        self.closest(p).s
+    fn bounding_disc(&self) -> ([f64; 2], f64) {
+        let [a, b, c] = self.v;
+        let m = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+        let r2 = self
+            .v
+            .iter()
+            .map(|v| (v[0] - m[0]).powi(2) + (v[1] - m[1]).powi(2))
+            .fold(0.0, f64::max);
+        (m, r2.sqrt())
+    }
+
+    #[inline(always)]
+    fn signed_sq(&self, x: &Lanes, y: &Lanes) -> Lanes {
+        let mut d2 = [f64::INFINITY; LANES];
+        let mut side_min = [f64::INFINITY; LANES];
+        for k in 0..3 {
+            let (side, _, r) = self.edge(k, x, y);
+            for j in 0..LANES {
+                let dk = r[0][j] * r[0][j] + r[1][j] * r[1][j];
+                d2[j] = if dk < d2[j] { dk } else { d2[j] };
+                side_min[j] = if side[j] < side_min[j] {
+                    side[j]
+                } else {
+                    side_min[j]
+                };
+            }
+        }
+        let mut s = [0.0; LANES];
+        for j in 0..LANES {
+            s[j] = if side_min[j] > 0.0 { d2[j] } else { -d2[j] };
+        }
+        s
     }
 }
 
@@ -200,10 +319,19 @@ impl Primitive for DiscPx {
         ]
     }
 
-    #[inline]
-    fn signed_sq(&self, p: [f64; 2]) -> f64 {
-        let d = ((p[0] - self.c[0]).powi(2) + (p[1] - self.c[1]).powi(2)).sqrt() - self.r;
-        -d * d.abs()
+    fn bounding_disc(&self) -> ([f64; 2], f64) {
+        (self.c, self.r)
+    }
+
+    #[inline(always)]
+    fn signed_sq(&self, x: &Lanes, y: &Lanes) -> Lanes {
+        let mut s = [0.0; LANES];
+        for j in 0..LANES {
+            let (dx, dy) = (x[j] - self.c[0], y[j] - self.c[1]);
+            let d = (dx * dx + dy * dy).sqrt() - self.r;
+            s[j] = if d > 0.0 { -d * d } else { d * d };
+        }
+        s
     }
 }
 
@@ -213,6 +341,8 @@ pub(super) struct View<P> {
     /// Inclusive pixel range `[x0, y0, x1, y1]` each primitive can reach (its box grown by the
     /// cutoff, clipped to the image).
     range: Vec<[u32; 4]>,
+    /// A disc `[cx, cy, ρ²]` holding every pixel centre within the cutoff of the primitive.
+    reach: Vec<[f64; 3]>,
     /// Index of each primitive in the caller's list (triangle or point index).
     source: Vec<u32>,
     resolution: usize,
@@ -229,6 +359,7 @@ impl<P: Primitive> View<P> {
         let last = resolution as f64 - 1.0;
         let mut prims = Vec::new();
         let mut range = Vec::new();
+        let mut reach = Vec::new();
         let mut source = Vec::new();
         for (src, p) in candidates {
             let b = p.bbox();
@@ -241,8 +372,10 @@ impl<P: Primitive> View<P> {
             if !(lo_x <= hi_x && lo_y <= hi_y) {
                 continue;
             }
+            let (c, r) = p.bounding_disc();
             prims.push(p);
             range.push([lo_x as u32, lo_y as u32, hi_x as u32, hi_y as u32]);
+            reach.push([c[0], c[1], (r + grow) * (r + grow)]);
             source.push(src);
         }
         let tiles_x = resolution.div_ceil(TILE);
@@ -277,6 +410,7 @@ impl<P: Primitive> View<P> {
         Self {
             prims,
             range,
+            reach,
             source,
             resolution,
             tiles_x,
@@ -289,7 +423,7 @@ impl<P: Primitive> View<P> {
         self.tiles_x * self.tiles_x
     }
 
-    /// Pixel rectangle `[x0, x1) × [y0, y1)` of tile `t`.
+    /// Pixel rectangle `[x0, x1) × [y0, y1)` of tile `t`, as `[x0, x1, y0, y1]`.
     fn tile_rect(&self, t: usize) -> [usize; 4] {
         let (x0, y0) = ((t % self.tiles_x) * TILE, (t / self.tiles_x) * TILE);
         [
@@ -304,35 +438,67 @@ impl<P: Primitive> View<P> {
         &self.items[self.start[t] as usize..self.start[t + 1] as usize]
     }
 
-    /// Calls `visit(local pixel index, pixel centre)` for the pixels of tile `rect` that
-    /// primitive `i` can reach.
-    #[inline]
-    fn for_pixels(&self, i: usize, rect: [usize; 4], mut visit: impl FnMut(usize, [f64; 2])) {
+    /// Calls `visit(buffer index of the chunk's first pixel, x, y)` for chunks of `LANES`
+    /// consecutive pixels of a row covering every pixel of tile `rect` within the cutoff of
+    /// primitive `i`: the rows of its grown box cut by its reach disc. A chunk may take in
+    /// pixels beyond the cutoff, or padding columns past the tile's end.
+    #[inline(always)]
+    fn for_chunks(&self, i: usize, rect: [usize; 4], mut visit: impl FnMut(usize, &Lanes, &Lanes)) {
         let r = self.range[i];
-        let (x0, x1) = ((r[0] as usize).max(rect[0]), (r[2] as usize + 1).min(rect[1]));
-        let (y0, y1) = ((r[1] as usize).max(rect[2]), (r[3] as usize + 1).min(rect[3]));
+        let [cx, cy, rho2] = self.reach[i];
+        let (x0, x1) = (
+            (r[0] as usize).max(rect[0]),
+            (r[2] as usize + 1).min(rect[1]),
+        );
+        let (y0, y1) = (
+            (r[1] as usize).max(rect[2]),
+            (r[3] as usize + 1).min(rect[3]),
+        );
         for y in y0..y1 {
-            let row = (y - rect[2]) * TILE;
             let py = y as f64 + 0.5;
-            for x in x0..x1 {
-                visit(row + x - rect[0], [x as f64 + 0.5, py]);
+            let h2 = rho2 - (py - cy) * (py - cy);
+            if h2 < 0.0 {
+                continue;
+            }
+            let h = h2.sqrt();
+            let xa = (cx - h - 0.5).ceil().max(x0 as f64);
+            let xb = ((cx + h - 0.5).floor() + 1.0).min(x1 as f64);
+            if xb <= xa {
+                continue;
+            }
+            let row = (y - rect[2]) * STRIDE;
+            let ys = [py; LANES];
+            let mut x = xa as usize;
+            while x < xb as usize {
+                let xs: Lanes = std::array::from_fn(|j| (x + j) as f64 + 0.5);
+                visit(row + x - rect[0], &xs, &ys);
+                x += LANES;
             }
         }
     }
 
-    /// The product `Q = Π q̃` over the tile's pixels (local index `(y − y0)·TILE + x − x0`).
-    fn forward(&self, t: usize, soft: &Soft) -> [f64; TILE * TILE] {
-        let mut q = [1.0; TILE * TILE];
+    /// `P = Π 1/q̃` over the tile's pixels (buffer index `(y − y0)·STRIDE + x − x0`). With
+    /// `store`, the `e^{s/σ}` of every visited lane are appended in visiting order, for
+    /// [`backward`] to reuse.
+    fn forward(&self, t: usize, soft: &Soft, mut store: Option<&mut Vec<f64>>) -> [f64; TILE_BUF] {
+        let mut p = [1.0; TILE_BUF];
         let rect = self.tile_rect(t);
         for &i in self.tile_items(t) {
             let prim = &self.prims[i as usize];
-            self.for_pixels(i as usize, rect, |l, p| {
-                if let Some((qf, _)) = soft.factor(prim.signed_sq(p)) {
-                    q[l] *= qf;
+            self.for_chunks(i as usize, rect, |l, x, y| {
+                let s = prim.signed_sq(x, y);
+                let e: Lanes = std::array::from_fn(|j| soft.exp(s[j]));
+                let chunk = &mut p[l..l + LANES];
+                for j in 0..LANES {
+                    let f = (1.0 + e[j]) * soft.keep;
+                    chunk[j] *= if s[j] > -soft.cut2 { f } else { 1.0 };
+                }
+                if let Some(store) = store.as_deref_mut() {
+                    store.extend_from_slice(&e);
                 }
             });
         }
-        q
+        p
     }
 }
 
@@ -377,16 +543,21 @@ pub(super) fn points_view(
     View::new(discs, camera.resolution, soft)
 }
 
-/// The images of `views`, all tiles of all views in parallel.
-pub(super) fn render<P: Primitive>(views: &[View<P>], soft: &Soft) -> Vec<Image> {
-    let tasks: Vec<(usize, usize)> = views
+/// All (view, tile) pairs, the unit of parallel work.
+fn tasks<P: Primitive>(views: &[View<P>]) -> Vec<(usize, usize)> {
+    views
         .iter()
         .enumerate()
         .flat_map(|(v, view)| (0..view.tile_count()).map(move |t| (v, t)))
-        .collect();
-    let tiles: Vec<[f64; TILE * TILE]> = tasks
+        .collect()
+}
+
+/// The images of `views`, all tiles of all views in parallel.
+pub(super) fn render<P: Primitive>(views: &[View<P>], soft: &Soft) -> Vec<Image> {
+    let tasks = tasks(views);
+    let tiles: Vec<[f64; TILE_BUF]> = tasks
         .par_iter()
-        .map(|&(v, t)| views[v].forward(t, soft))
+        .map(|&(v, t)| views[v].forward(t, soft, None))
         .collect();
     let mut images: Vec<Image> = views
         .iter()
@@ -395,12 +566,13 @@ pub(super) fn render<P: Primitive>(views: &[View<P>], soft: &Soft) -> Vec<Image>
             pixels: vec![0.0; view.resolution * view.resolution],
         })
         .collect();
-    for (&(v, t), q) in tasks.iter().zip(&tiles) {
+    for (&(v, t), p) in tasks.iter().zip(&tiles) {
         let view = &views[v];
         let [x0, x1, y0, y1] = view.tile_rect(t);
         for y in y0..y1 {
             for x in x0..x1 {
-                images[v].pixels[y * view.resolution + x] = 1.0 - q[(y - y0) * TILE + x - x0];
+                let q = 1.0 / p[(y - y0) * STRIDE + x - x0];
+                images[v].pixels[y * view.resolution + x] = 1.0 - q;
             }
         }
     }
@@ -424,33 +596,30 @@ pub(super) fn loss_tiles(
     soft: &Soft,
     weight: Option<f64>,
 ) -> Vec<TileResult> {
-    let tasks: Vec<(usize, usize)> = views
-        .iter()
-        .enumerate()
-        .flat_map(|(v, view)| (0..view.tile_count()).map(move |t| (v, t)))
-        .collect();
-    tasks
+    tasks(views)
         .par_iter()
         .map(|&(v, t)| {
             let view = &views[v];
             let target = &targets[v].pixels;
-            let q = view.forward(t, soft);
+            let mut exps = Vec::new();
+            let p = view.forward(t, soft, weight.map(|_| &mut exps));
             let [x0, x1, y0, y1] = view.tile_rect(t);
             let mut sum_sq = 0.0;
-            // w = ∂L/∂I · Q per local pixel: ∂I/∂z_f = D_f·Q for z_f = s_f/σ.
-            let mut w = [0.0; TILE * TILE];
+            // w = ∂L/∂I · Q per pixel (zero in the padding): ∂I/∂z_f = D_f·Q for z_f = s_f/σ.
+            let mut w = [0.0; TILE_BUF];
             for y in y0..y1 {
                 for x in x0..x1 {
-                    let l = (y - y0) * TILE + x - x0;
-                    let diff = 1.0 - q[l] - target[y * view.resolution + x];
+                    let l = (y - y0) * STRIDE + x - x0;
+                    let q = 1.0 / p[l];
+                    let diff = 1.0 - q - target[y * view.resolution + x];
                     sum_sq += diff * diff;
                     if let Some(weight) = weight {
-                        w[l] = weight * diff * q[l];
+                        w[l] = weight * diff * q;
                     }
                 }
             }
             let grads = if weight.is_some() {
-                backward(view, t, soft, &w)
+                backward(view, t, soft, &w, &exps)
             } else {
                 Vec::new()
             };
@@ -468,35 +637,64 @@ pub(super) fn loss_tiles(
 /// With `z = s/σ`, `∂L/∂s = w·D/σ`; `s = ±d²`, `d² = |r|²`, `r = p − (a + t(b − a))` on the
 /// nearest edge `(a, b)`, so `∂d²/∂a = −2r(1 − t)`, `∂d²/∂b = −2rt` (with `t` clamped the
 /// envelope theorem leaves these unchanged).
-fn backward(view: &View<TriPx>, t: usize, soft: &Soft, w: &[f64; TILE * TILE]) -> Vec<(u32, [f64; 6])> {
+fn backward(
+    view: &View<TriPx>,
+    t: usize,
+    soft: &Soft,
+    w: &[f64; TILE_BUF],
+    exps: &[f64],
+) -> Vec<(u32, [f64; 6])> {
     let rect = view.tile_rect(t);
     let mut out = Vec::new();
+    let mut next = 0;
     for &i in view.tile_items(t) {
         let tri = &view.prims[i as usize];
-        let mut acc = [0.0; 6];
-        let mut touched = false;
-        view.for_pixels(i as usize, rect, |l, p| {
-            if w[l] == 0.0 {
+        // Per corner and coordinate, per lane.
+        let mut acc = [[0.0; LANES]; 6];
+        view.for_chunks(i as usize, rect, |l, x, y| {
+            let wl = &w[l..l + LANES];
+            let e = &exps[next..next + LANES];
+            next += LANES;
+            if wl.iter().all(|&v| v == 0.0) {
                 return;
             }
-            let c = tri.closest(p);
-            let Some((_, d)) = soft.factor(c.s) else {
-                return;
-            };
-            let ds = w[l] * d * soft.inv_sigma;
-            // ∂s/∂a = ∓2r(1 − t) (inside: s = d², outside: s = −d²).
-            let f = if c.inside { -2.0 * ds } else { 2.0 * ds };
-            let (ia, ib) = (2 * c.edge, 2 * ((c.edge + 1) % 3));
-            let (fa, fb) = (f * (1.0 - c.t), f * c.t);
-            acc[ia] += fa * c.r[0];
-            acc[ia + 1] += fa * c.r[1];
-            acc[ib] += fb * c.r[0];
-            acc[ib + 1] += fb * c.r[1];
-            touched = true;
+            let c = tri.closest(x, y);
+            for j in 0..LANES {
+                let s = if c.inside[j] { c.d2[j] } else { -c.d2[j] };
+                let d = e[j] / (1.0 + e[j]);
+                let ds = wl[j] * d * soft.inv_sigma;
+                // ∂s/∂a = ∓2r(1 − t) (inside: s = d², outside: s = −d²).
+                let f = if c.inside[j] { -2.0 * ds } else { 2.0 * ds };
+                let f = if s > -soft.cut2 { f } else { 0.0 };
+                let (fa, fb) = (f * (1.0 - c.t[j]), f * c.t[j]);
+                // Corner k starts edge k and ends edge k − 1.
+                for k in 0..3 {
+                    let coef = c.edge[k][j] * fa + c.edge[(k + 2) % 3][j] * fb;
+                    acc[2 * k][j] += coef * c.r[0][j];
+                    acc[2 * k + 1][j] += coef * c.r[1][j];
+                }
+            }
         });
-        if touched {
-            out.push((view.source[i as usize], acc));
+        let g: [f64; 6] = std::array::from_fn(|m| acc[m].iter().sum());
+        if g.iter().any(|&v| v != 0.0) {
+            out.push((view.source[i as usize], g));
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exp_matches_the_library() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=200_000 {
+            let z = -Z_MAX + 2.0 * Z_MAX * i as f64 / 200_000.0;
+            let (fast, reference) = (exp(z), z.exp());
+            worst = worst.max(((fast - reference) / reference).abs());
+        }
+        assert!(worst < 4.0 * f64::EPSILON, "relative error {worst:e}");
+    }
 }
