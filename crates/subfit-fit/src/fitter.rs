@@ -65,8 +65,9 @@ pub struct Fitter<'t, T: DataTerm = FootPointTerm<'t>> {
     scratch: FillScratch,
     /// The ARAP regularizer when [`FitOptions::arap`] `> 0` (rest shape: the first run's cage).
     arap: Option<ArapState>,
-    /// The triangles of the sample tessellation when a [`FitOptions::surface_term`] is set.
-    surface_triangles: Vec<[u32; 3]>,
+    /// The tessellation a [`FitOptions::surface_term`] sees (its own sampling operator at its
+    /// level and the triangles of its faces).
+    surface: Option<(SamplingOperator, Vec<[u32; 3]>)>,
     /// The target (or whatever the term borrows) outlives the fitter.
     _data: PhantomData<&'t ()>,
 }
@@ -142,6 +143,20 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             options.sample_level,
         )?;
         term.prepare(&op);
+        let surface = match &options.surface_term {
+            None => None,
+            Some(st) => {
+                let sop = sampling_operator(
+                    faces,
+                    num_vertices,
+                    &options.tags,
+                    &options.subdivision(),
+                    st.level,
+                )?;
+                let tris = fan_triangles(&sop.faces);
+                Some((sop, tris))
+            }
+        };
         let lap = Laplacian::umbrella(faces, num_vertices);
         let block = if term.isotropic() { 1 } else { 3 };
         let pattern = Pattern::new(&op.position, &lap, block);
@@ -165,11 +180,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             active: None,
             scratch: FillScratch::default(),
             arap: (options.arap > 0.0).then(|| ArapState::Pending(faces.clone())),
-            surface_triangles: if options.surface_term.is_some() {
-                fan_triangles(&op.faces)
-            } else {
-                Vec::new()
-            },
+            surface,
             op,
             _data: PhantomData,
         })
@@ -366,7 +377,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         // Active samples get no coverage (see `DataTerm::project`): objective = errors.
         let (_, sum, max) = sums_d2(&self.term, &samples, &projected);
         let (fs, fm) = a.fixed.as_ref().map_or((0.0, 0.0), |f| (f.sum, f.max));
-        let surface = self.surface_value(control, None);
+        let surface = self.surface_value(control);
         let stats = self.stats(control, sum + fs + surface, sum + fs, max.max(fm));
         t.sample += t1 - t0;
         t.project += t2 - t1;
@@ -405,7 +416,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         let projected = self.term.project(None, &samples);
         let t2 = Instant::now();
         let (objective, sum, max) = sums_d2(&self.term, &samples, &projected);
-        let surface = self.surface_value(control, Some(&samples));
+        let surface = self.surface_value(control);
         let stats = self.stats(control, objective + surface, sum, max);
         t.sample += t1 - t0;
         t.project += t2 - t1;
@@ -417,21 +428,14 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         }
     }
 
-    /// `m · w · value` of the [`FitOptions::surface_term`] at `control` (all samples, taken
-    /// from `samples` when given), so that [`Self::stats`]' division by `m` leaves `w · value`;
-    /// 0 without one.
-    fn surface_value(&self, control: &[[f64; 3]], samples: Option<&[[f64; 3]]>) -> f64 {
-        let Some(st) = &self.options.surface_term else {
+    /// `m · w · value` of the [`FitOptions::surface_term`] at `control` (on its own
+    /// tessellation), so that [`Self::stats`]' division by `m` leaves `w · value`; 0 without one.
+    fn surface_value(&self, control: &[[f64; 3]]) -> f64 {
+        let (Some(st), Some((sop, tris))) = (&self.options.surface_term, &self.surface) else {
             return 0.0;
         };
         let m = self.num_samples().max(1) as f64;
-        let value = match samples {
-            Some(s) => st.term.value(s, &self.surface_triangles),
-            None => st
-                .term
-                .value(&self.op.position.apply(control), &self.surface_triangles),
-        };
-        m * st.weight * value
+        m * st.weight * st.term.value(&sop.position.apply(control), tris)
     }
 
     /// Error statistics over all `m` samples from the sum of their objective shares, the sum
@@ -722,24 +726,6 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 .map(|(&s, f)| term.model(f, s).1)
                 .collect()
         };
-        let mut r = r;
-        if let Some(st) = &self.options.surface_term {
-            // Half the gradient of w·value, scaled by m as the fill divides r by m.
-            let all = match &self.active {
-                None => None,
-                Some(_) => Some(self.op.position.apply(control)),
-            };
-            let samples = all.as_deref().unwrap_or(&cur.samples);
-            let (_, grad) = st.term.value_and_gradient(samples, &self.surface_triangles);
-            let c = 0.5 * m * st.weight;
-            let rows: Option<&[u32]> = self.active.as_ref().map(|a| &a.samples[..]);
-            for (i, rk) in r.iter_mut().enumerate() {
-                let k = rows.map_or(i, |rows| rows[i] as usize);
-                for a in 0..3 {
-                    rk[a] += c * grad[k][a];
-                }
-            }
-        }
         let (mut g, pattern, values, points) = match &mut self.active {
             None => {
                 let g = self.pattern.fill_with_gradient(
@@ -772,6 +758,30 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 (g, &a.pattern, &mut a.values, Some(&a.points[..]))
             }
         };
+        if let (Some(st), Some((sop, tris))) = (&self.options.surface_term, &self.surface) {
+            // Half the gradient of w·value: ½ w Cₛᵀ ∇value, over the active points.
+            let (_, grad) = st
+                .term
+                .value_and_gradient(&sop.position.apply(control), tris);
+            let mut gp = vec![[0.0; 3]; control.len()];
+            for (k, gk) in grad.iter().enumerate() {
+                let (cols, ws) = sop.position.row(k);
+                for (&j, &w) in cols.iter().zip(ws) {
+                    for a in 0..3 {
+                        gp[j as usize][a] += w * gk[a];
+                    }
+                }
+            }
+            let c = 0.5 * st.weight;
+            match points {
+                None => g.iter_mut().zip(&gp).for_each(|(g, p)| {
+                    (0..3).for_each(|a| g[a] += c * p[a]);
+                }),
+                Some(pts) => g.iter_mut().zip(pts).for_each(|(g, &i)| {
+                    (0..3).for_each(|a| g[a] += c * gp[i as usize][a]);
+                }),
+            }
+        }
         if let Some(arap) = self.arap.as_ref().and_then(ArapState::ready) {
             let w = 2.0 * self.options.arap / n;
             if let Err((i, j)) = arap.add_to_system(control, w, pattern, values, &mut g, points) {

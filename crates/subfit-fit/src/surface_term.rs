@@ -1,7 +1,8 @@
 //! Terms on the whole sampled surface rather than per sample: a value of all the samples at
 //! once and its gradient with respect to each (e.g. the soft silhouette loss of
-//! [`crate::silhouette`], Xie et al. 2023 §4.2). The fitter adds `weight · value(S)` to its
-//! objective and the gradient, pulled back through the sampling operator (`Cᵀ ∇_S`), to the
+//! [`crate::silhouette`], Xie et al. 2023 §4.2), on a limit tessellation of its own level. The
+//! fitter adds `weight · value(S)` to its objective and the gradient, pulled back through that
+//! tessellation's sampling operator (`Cₛᵀ ∇_S`), to the
 //! gradient of its model — a first-order term: it contributes no curvature to the normal
 //! matrix, the LM damping and the data term's Gauss-Newton matrix bound the step, and the gain
 //! ratio judges it on the true objective like every other term.
@@ -33,19 +34,26 @@ pub struct WeightedSurfaceTerm {
     pub term: Arc<dyn SurfaceTerm>,
     /// Its weight `w ≥ 0`: the objective gains `w · value`.
     pub weight: f64,
+    /// The refinement level of the limit tessellation the term sees (its own sampling
+    /// operator, independent of [`crate::FitOptions::sample_level`]): a silhouette needs far
+    /// fewer triangles than the data term needs samples.
+    pub level: usize,
 }
 
 impl fmt::Debug for WeightedSurfaceTerm {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("WeightedSurfaceTerm")
             .field("weight", &self.weight)
+            .field("level", &self.level)
             .finish_non_exhaustive()
     }
 }
 
 impl PartialEq for WeightedSurfaceTerm {
     fn eq(&self, other: &Self) -> bool {
-        Arc::ptr_eq(&self.term, &other.term) && self.weight == other.weight
+        Arc::ptr_eq(&self.term, &other.term)
+            && self.weight == other.weight
+            && self.level == other.level
     }
 }
 

@@ -38,6 +38,7 @@ fn options(weight: f64) -> FitOptions {
         surface_term: (weight > 0.0).then(|| WeightedSurfaceTerm {
             term: Arc::new(Plane { z0: 0.5 }),
             weight,
+            level: 3,
         }),
         ..FitOptions::default()
     }

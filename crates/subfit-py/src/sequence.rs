@@ -140,6 +140,7 @@ pub fn fit_sequence_py(
             views: in_range("silhouette_views", silhouette_views, 0, 64)?,
             resolution: in_range("silhouette_resolution", silhouette_resolution, 16, 1024)?,
             weight: silhouette_weight,
+            ..subfit::SilhouetteOptions::default()
         },
         cancel: cancel.clone(),
         ..SequenceOptions::default()

@@ -118,6 +118,7 @@ fn options(a: &SequenceArgs) -> anyhow::Result<SequenceOptions> {
             views: a.silhouette_views as usize,
             resolution: a.silhouette_resolution as usize,
             weight: a.silhouette_weight,
+            ..subfit::SilhouetteOptions::default()
         },
         cancel: crate::interrupt::token(),
         ..SequenceOptions::default()
