@@ -155,6 +155,16 @@ pub struct BenchSequenceArgs {
     /// Silhouette weight [default: `subfit sequence`'s].
     #[arg(long)]
     pub silhouette_weight: Option<f64>,
+    /// Peak twist of the generated motion, radians per unit length (0: none) [default: the
+    /// motion's].
+    #[arg(long)]
+    pub twist: Option<f64>,
+    /// Peak curvature of the generated bend (0: none) [default: the motion's].
+    #[arg(long)]
+    pub bend: Option<f64>,
+    /// Peak relative thickness change of the generated motion (0: none) [default: the motion's].
+    #[arg(long)]
+    pub thickness: Option<f64>,
     /// Also write each run's outputs (frames, sequence.usda, report.json) under this directory.
     #[arg(short, long)]
     pub output: Option<PathBuf>,

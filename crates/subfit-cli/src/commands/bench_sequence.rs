@@ -41,10 +41,19 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
     );
     let mut rows = Vec::new();
     for (name, params) in motions {
-        let params = DeformingParams {
+        let mut params = DeformingParams {
             frames: a.frames as usize,
             ..params
         };
+        if let Some(v) = a.twist {
+            params.twist = v;
+        }
+        if let Some(v) = a.bend {
+            params.bend = v;
+        }
+        if let Some(v) = a.thickness {
+            params.thickness = v;
+        }
         let seq = DeformingSequence::new(params).context("sequence parameters")?;
         for views in [a.silhouette_views as usize, 0] {
             rows.push(run_one(&a, name, &seq, views)?);
