@@ -34,6 +34,7 @@
 use std::sync::{Mutex, PoisonError};
 
 use rayon::prelude::*;
+use subfit_mesh::vec3::dot;
 use subfit_target::{FootPoint, Target};
 
 use crate::coverage::{CoverSum, Coverage};
@@ -96,6 +97,10 @@ pub struct FootPointTerm<'t> {
     hints: Mutex<Vec<u32>>,
     /// The data → surface part of the objective, if any.
     coverage: Option<Coverage>,
+    /// With coverage on a mesh target with boundaries: which data points are on its boundary
+    /// (a sample whose foot point is there and which lies beyond the data's edge is pulled
+    /// point-to-point, see [`DataTerm::model`]); empty otherwise.
+    rim: Vec<bool>,
 }
 
 /// What [`FootPointTerm`] keeps per sample: the foot point and, on projections of all samples
@@ -130,6 +135,7 @@ impl<'t> FootPointTerm<'t> {
             source,
             hints: Mutex::new(Vec::new()),
             coverage: None,
+            rim: Vec::new(),
         }
     }
 
@@ -148,7 +154,31 @@ impl<'t> FootPointTerm<'t> {
     /// Cost: O(#points + #triangles).
     pub fn with_coverage(mut self, weight: f64) -> Self {
         self.coverage = Some(Coverage::new(self.target, weight));
+        if let Some(bvh) = self.target.mesh() {
+            let b = crate::coverage::boundary_vertices(bvh.triangles());
+            if !b.is_empty() {
+                self.rim = vec![false; self.target.len()];
+                for v in b {
+                    if let Some(r) = self.rim.get_mut(v as usize) {
+                        *r = true;
+                    }
+                }
+            }
+        }
         self
+    }
+
+    /// Whether the sample at `x` with foot point `f` lies beyond the data's edge: its foot
+    /// point is at a boundary vertex or edge of a mesh target (the nearest corner is a boundary
+    /// vertex) and the offset `x − V` leans more along the surface than across it.
+    #[inline]
+    fn beyond_rim(&self, f: &FootPoint, e: [f64; 3]) -> bool {
+        if !self.rim.get(f.nearest as usize).copied().unwrap_or(false) {
+            return false;
+        }
+        let along = dot(e, f.normal);
+        let all = dot(e, e);
+        all > 0.0 && along * along < 0.5 * all
     }
 
     /// The data → surface part, if any.
@@ -255,7 +285,9 @@ impl DataTerm for FootPointTerm<'_> {
     #[inline]
     fn model(&self, f: &FootSample, x: [f64; 3]) -> (Mat3, [f64; 3]) {
         let e = std::array::from_fn(|a| x[a] - f.point[a]);
-        let (q, r) = if self.method == Method::Pdm {
+        // Beyond the data's edge the gap is along the surface: point-to-point pulls the rim
+        // back (SD/TD would leave it, their tangential weight being small).
+        let (q, r) = if self.method == Method::Pdm || self.beyond_rim(f, e) {
             (IDENTITY, e)
         } else {
             let q = error_matrix(self.method, f);
