@@ -12,6 +12,8 @@ use crate::options::{FitOptions, Method};
 use crate::term::{DataTerm, Mat3};
 
 /// Either data term, chosen by [`FitOptions::method`] ([`Self::from_options`]).
+// One per fitter, never moved in a loop: the size of the larger variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 pub enum AnyTerm<'t> {
     /// PD, TD or SD on foot points.
