@@ -97,9 +97,11 @@ pub struct FootPointTerm<'t> {
     hints: Mutex<Vec<u32>>,
     /// The data → surface part of the objective, if any.
     coverage: Option<Coverage>,
-    /// With coverage on a mesh target with boundaries: which data points are on its boundary
-    /// (a sample whose foot point is there and which lies beyond the data's edge is pulled
-    /// point-to-point, see [`DataTerm::model`]); empty otherwise.
+    /// With coverage on an open target: which data points are on its edge — a mesh target's
+    /// boundary vertices, a cloud's points by the angle criterion
+    /// ([`subfit_target::cloud_boundary_points`]) — so that a sample whose foot point is there
+    /// and which lies beyond the data's edge is pulled point-to-point (see
+    /// [`DataTerm::model`]); empty for a closed target.
     rim: Vec<bool>,
 }
 
@@ -163,6 +165,16 @@ impl<'t> FootPointTerm<'t> {
                         *r = true;
                     }
                 }
+            }
+        } else {
+            // A point cloud: its edge by the angle criterion.
+            let rim = subfit_target::cloud_boundary_points(
+                self.target,
+                subfit_target::RIM_NEIGHBORS,
+                subfit_target::RIM_GAP,
+            );
+            if rim.iter().any(|&b| b) {
+                self.rim = rim;
             }
         }
         self

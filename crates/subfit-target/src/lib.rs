@@ -33,6 +33,7 @@
 mod blend;
 pub mod boundary_corners;
 pub mod closest;
+pub mod cloud_rim;
 mod error;
 pub mod estimate;
 pub mod features;
@@ -52,6 +53,7 @@ mod winding;
 
 pub use boundary_corners::{boundary_corners, BoundaryCorners};
 pub use closest::{MeshClosestPoint, TriangleBvh};
+pub use cloud_rim::{cloud_boundary_points, RIM_GAP, RIM_NEIGHBORS};
 pub use error::TargetError;
 pub use estimate::Neighborhood;
 pub use features::{detect_features, FeatureCurve, FeatureOptions, Features};
