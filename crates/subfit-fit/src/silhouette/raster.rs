@@ -150,20 +150,6 @@ pub(super) struct TriPx {
     orient: f64,
 }
 
-/// The nearest boundary points of a triangle to `LANES` pixel centres.
-struct Closest {
-    /// Squared distance to the boundary.
-    d2: Lanes,
-    /// Whether the pixel centre is inside.
-    inside: [bool; LANES],
-    /// Which edge is nearest: `edge[k][j]` is 1.0 for the nearest edge `k`, else 0.0.
-    edge: [Lanes; 3],
-    /// Parameter of the nearest point on the nearest edge, in `[0, 1]`.
-    t: Lanes,
-    /// `p − nearest point`.
-    r: [Lanes; 2],
-}
-
 impl TriPx {
     fn new(v: [[f64; 2]; 3]) -> Self {
         let mut e = [[0.0; 2]; 3];
@@ -211,48 +197,6 @@ impl TriPx {
             r[1][j] = wy - tj * e[1];
         }
         (side, t, r)
-    }
-
-    /// The nearest boundary point for each lane (for the gradient).
-    #[inline(always)]
-    fn closest(&self, x: &Lanes, y: &Lanes) -> Closest {
-        let (side0, t0, r0) = self.edge(0, x, y);
-        let mut c = Closest {
-            d2: [0.0; LANES],
-            inside: [false; LANES],
-            edge: [[1.0; LANES], [0.0; LANES], [0.0; LANES]],
-            t: t0,
-            r: r0,
-        };
-        let mut side_min = side0;
-        for j in 0..LANES {
-            c.d2[j] = r0[0][j] * r0[0][j] + r0[1][j] * r0[1][j];
-        }
-        for k in 1..3 {
-            let (side, t, r) = self.edge(k, x, y);
-            for j in 0..LANES {
-                let d2 = r[0][j] * r[0][j] + r[1][j] * r[1][j];
-                let nearer = d2 < c.d2[j];
-                c.d2[j] = if nearer { d2 } else { c.d2[j] };
-                c.t[j] = if nearer { t[j] } else { c.t[j] };
-                c.r[0][j] = if nearer { r[0][j] } else { c.r[0][j] };
-                c.r[1][j] = if nearer { r[1][j] } else { c.r[1][j] };
-                for m in 0..3 {
-                    let is_k = if m == k { 1.0 } else { 0.0 };
-                    c.edge[m][j] = if nearer { is_k } else { c.edge[m][j] };
-                }
-                side_min[j] = if side[j] < side_min[j] {
-                    side[j]
-                } else {
-                    side_min[j]
-                };
-            }
-        }
-        for j in 0..LANES {
-            // A degenerate triangle has orient = 0, so no side is positive: no inside.
-            c.inside[j] = side_min[j] > 0.0;
-        }
-        c
     }
 }
 
@@ -478,8 +422,8 @@ impl<P: Primitive> View<P> {
     }
 
     /// `P = Π 1/q̃` over the tile's pixels (buffer index `(y − y0)·STRIDE + x − x0`). With
-    /// `store`, the `e^{s/σ}` of every visited lane are appended in visiting order, for
-    /// [`backward`] to reuse.
+    /// `store`, the `±e^{s/σ}` of every visited lane (`+` inside, `−` outside) are appended in
+    /// visiting order, for [`backward`] to reuse.
     fn forward(&self, t: usize, soft: &Soft, mut store: Option<&mut Vec<f64>>) -> [f64; TILE_BUF] {
         let mut p = [1.0; TILE_BUF];
         let rect = self.tile_rect(t);
@@ -494,7 +438,9 @@ impl<P: Primitive> View<P> {
                     chunk[j] *= if s[j] > -soft.cut2 { f } else { 1.0 };
                 }
                 if let Some(store) = store.as_deref_mut() {
-                    store.extend_from_slice(&e);
+                    for j in 0..LANES {
+                        store.push(if s[j] > 0.0 { e[j] } else { -e[j] });
+                    }
                 }
             });
         }
@@ -632,7 +578,8 @@ pub(super) fn loss_tiles(
         .collect()
 }
 
-/// `∂L/∂(projected corners)` of the tile's triangles given `w = ∂L/∂I · Q` per pixel.
+/// `∂L/∂(projected corners)` of the tile's triangles given `w = ∂L/∂I · Q` per pixel and the
+/// signed exponentials stored by the forward pass (same visiting order).
 ///
 /// With `z = s/σ`, `∂L/∂s = w·D/σ`; `s = ±d²`, `d² = |r|²`, `r = p − (a + t(b − a))` on the
 /// nearest edge `(a, b)`, so `∂d²/∂a = −2r(1 − t)`, `∂d²/∂b = −2rt` (with `t` clamped the
@@ -653,25 +600,42 @@ fn backward(
         let mut acc = [[0.0; LANES]; 6];
         view.for_chunks(i as usize, rect, |l, x, y| {
             let wl = &w[l..l + LANES];
-            let e = &exps[next..next + LANES];
+            let signed_e = &exps[next..next + LANES];
             next += LANES;
             if wl.iter().all(|&v| v == 0.0) {
                 return;
             }
-            let c = tri.closest(x, y);
+            let edges = [0, 1, 2].map(|k| tri.edge(k, x, y));
             for j in 0..LANES {
-                let s = if c.inside[j] { c.d2[j] } else { -c.d2[j] };
-                let d = e[j] / (1.0 + e[j]);
+                let d2: [f64; 3] = std::array::from_fn(|k| {
+                    let r = &edges[k].2;
+                    r[0][j] * r[0][j] + r[1][j] * r[1][j]
+                });
+                let inside = signed_e[j] > 0.0;
+                let e = signed_e[j].abs();
+                let d = e / (1.0 + e);
                 let ds = wl[j] * d * soft.inv_sigma;
                 // ∂s/∂a = ∓2r(1 − t) (inside: s = d², outside: s = −d²).
-                let f = if c.inside[j] { -2.0 * ds } else { 2.0 * ds };
-                let f = if s > -soft.cut2 { f } else { 0.0 };
-                let (fa, fb) = (f * (1.0 - c.t[j]), f * c.t[j]);
-                // Corner k starts edge k and ends edge k − 1.
+                let f = if inside { -2.0 * ds } else { 2.0 * ds };
+                let d2_min = d2[0].min(d2[1]).min(d2[2]);
+                let f = if inside || d2_min < soft.cut2 { f } else { 0.0 };
+                // The nearest edge (the first on ties) takes the whole derivative.
+                let nearest = [
+                    d2[0] <= d2[1] && d2[0] <= d2[2],
+                    d2[1] < d2[0] && d2[1] <= d2[2],
+                    d2[2] < d2[0] && d2[2] < d2[1],
+                ];
                 for k in 0..3 {
-                    let coef = c.edge[k][j] * fa + c.edge[(k + 2) % 3][j] * fb;
-                    acc[2 * k][j] += coef * c.r[0][j];
-                    acc[2 * k + 1][j] += coef * c.r[1][j];
+                    let (_, tk, r) = &edges[k];
+                    let g = if nearest[k] { f } else { 0.0 };
+                    let gb = g * tk[j];
+                    let ga = g - gb;
+                    // Edge k runs from corner k to corner k + 1.
+                    let (a, b) = (2 * k, 2 * ((k + 1) % 3));
+                    acc[a][j] += ga * r[0][j];
+                    acc[a + 1][j] += ga * r[1][j];
+                    acc[b][j] += gb * r[0][j];
+                    acc[b + 1][j] += gb * r[1][j];
                 }
             }
         });
