@@ -107,7 +107,8 @@ const INV_FACTORIALS: [f64; 14] = [
 
 /// `e^z` for `|z| ≤ 708`, within a few ulp, without branches so that it vectorizes (the C
 /// library's `exp` is an opaque call). Cody–Waite reduction `z = n·ln 2 + r`, `|r| ≤ ½ ln 2`,
-/// a degree-13 Taylor polynomial for `e^r` (remainder below 5e-18), and `2^n` assembled in the
+/// a degree-13 Taylor polynomial for `e^r` (remainder below 5e-18) evaluated by Estrin's scheme
+/// (a dependency chain of 4 multiply-adds instead of Horner's 13), and `2^n` assembled in the
 /// exponent bits.
 #[inline(always)]
 pub(super) fn exp(z: f64) -> f64 {
@@ -115,13 +116,16 @@ pub(super) fn exp(z: f64) -> f64 {
     const SHIFT: f64 = 6_755_399_441_055_744.0;
     const LN2_HI: f64 = 6.931_471_803_691_238e-1;
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+    const C: [f64; 14] = INV_FACTORIALS;
     let shifted = z * std::f64::consts::LOG2_E + SHIFT;
     let n = shifted - SHIFT;
     let r = (z - n * LN2_HI) - n * LN2_LO;
-    let mut p = INV_FACTORIALS[13];
-    for k in (0..13).rev() {
-        p = p * r + INV_FACTORIALS[k];
-    }
+    let (r2, r4) = (r * r, r * r * (r * r));
+    let q0 = (C[0] + C[1] * r) + (C[2] + C[3] * r) * r2;
+    let q1 = (C[4] + C[5] * r) + (C[6] + C[7] * r) * r2;
+    let q2 = (C[8] + C[9] * r) + (C[10] + C[11] * r) * r2;
+    let q3 = C[12] + C[13] * r;
+    let p = (q0 + q1 * r4) + (q2 + q3 * r4) * (r4 * r4);
     let n_bits = shifted.to_bits().wrapping_sub(SHIFT.to_bits());
     p * f64::from_bits(n_bits.wrapping_add(1023) << 52)
 }
@@ -405,16 +409,29 @@ impl<P: Primitive> View<P> {
                 continue;
             }
             let h = h2.sqrt();
-            let xa = (cx - h - 0.5).ceil().max(x0 as f64);
-            let xb = ((cx + h - 0.5).floor() + 1.0).min(x1 as f64);
+            // Pixels x with |x + ½ − cx| ≤ h, clipped to [x0, x1). Casting truncates towards
+            // zero, which is the floor for the non-negative values kept (cheaper than the
+            // library's ceil/floor, calls without SSE4.1).
+            let lo = cx - h - 0.5;
+            let xa = if lo <= x0 as f64 {
+                x0
+            } else {
+                let t = lo as usize;
+                t + usize::from((t as f64) < lo)
+            };
+            let hi = cx + h + 0.5;
+            let xb = if hi >= x1 as f64 { x1 } else { hi as usize };
             if xb <= xa {
                 continue;
             }
             let row = (y - rect[2]) * STRIDE;
             let ys = [py; LANES];
-            let mut x = xa as usize;
-            while x < xb as usize {
-                let xs: Lanes = std::array::from_fn(|j| (x + j) as f64 + 0.5);
+            let mut x = xa;
+            while x < xb {
+                let mut xs = [0.0; LANES];
+                for (j, xj) in xs.iter_mut().enumerate() {
+                    *xj = (x + j) as f64 + 0.5;
+                }
                 visit(row + x - rect[0], &xs, &ys);
                 x += LANES;
             }
@@ -431,16 +448,21 @@ impl<P: Primitive> View<P> {
             let prim = &self.prims[i as usize];
             self.for_chunks(i as usize, rect, |l, x, y| {
                 let s = prim.signed_sq(x, y);
-                let e: Lanes = std::array::from_fn(|j| soft.exp(s[j]));
+                let mut e = [0.0; LANES];
+                for j in 0..LANES {
+                    e[j] = soft.exp(s[j]);
+                }
                 let chunk = &mut p[l..l + LANES];
                 for j in 0..LANES {
                     let f = (1.0 + e[j]) * soft.keep;
                     chunk[j] *= if s[j] > -soft.cut2 { f } else { 1.0 };
                 }
                 if let Some(store) = store.as_deref_mut() {
+                    let mut signed = [0.0; LANES];
                     for j in 0..LANES {
-                        store.push(if s[j] > 0.0 { e[j] } else { -e[j] });
+                        signed[j] = if s[j] > 0.0 { e[j] } else { -e[j] };
                     }
+                    store.extend_from_slice(&signed);
                 }
             });
         }
@@ -605,12 +627,14 @@ fn backward(
             if wl.iter().all(|&v| v == 0.0) {
                 return;
             }
-            let edges = [0, 1, 2].map(|k| tri.edge(k, x, y));
+            // (Not `[0, 1, 2].map(…)`: that is not inlined.)
+            let edges = [tri.edge(0, x, y), tri.edge(1, x, y), tri.edge(2, x, y)];
             for j in 0..LANES {
-                let d2: [f64; 3] = std::array::from_fn(|k| {
+                let mut d2 = [0.0; 3];
+                for k in 0..3 {
                     let r = &edges[k].2;
-                    r[0][j] * r[0][j] + r[1][j] * r[1][j]
-                });
+                    d2[k] = r[0][j] * r[0][j] + r[1][j] * r[1][j];
+                }
                 let inside = signed_e[j] > 0.0;
                 let e = signed_e[j].abs();
                 let d = e / (1.0 + e);
