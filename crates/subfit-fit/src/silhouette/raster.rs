@@ -148,21 +148,23 @@ pub(super) struct TriPx {
     v: [[f64; 2]; 3],
     /// `e[k] = v[k+1] − v[k]`.
     e: [[f64; 2]; 3],
-    /// `1/|e[k]|²`, 0 for a zero-length edge.
-    inv_len2: [f64; 3],
-    /// Sign of the signed area (+1, −1, or 0 when degenerate).
-    orient: f64,
+    /// `e[k]/|e[k]|²` (zero for a zero-length edge): `t = w·g[k]`.
+    g: [[f64; 2]; 3],
+    /// `orient·e[k]`, `orient` the sign of the signed area (+1, −1, or 0 when degenerate):
+    /// `n[k] × w > 0` on the inner side of every edge.
+    n: [[f64; 2]; 3],
 }
 
 impl TriPx {
     fn new(v: [[f64; 2]; 3]) -> Self {
         let mut e = [[0.0; 2]; 3];
-        let mut inv_len2 = [0.0; 3];
+        let mut g = [[0.0; 2]; 3];
         for k in 0..3 {
             let b = v[(k + 1) % 3];
             e[k] = [b[0] - v[k][0], b[1] - v[k][1]];
             let len2 = e[k][0] * e[k][0] + e[k][1] * e[k][1];
-            inv_len2[k] = if len2 > 0.0 { 1.0 / len2 } else { 0.0 };
+            let il = if len2 > 0.0 { 1.0 / len2 } else { 0.0 };
+            g[k] = [e[k][0] * il, e[k][1] * il];
         }
         // Twice the signed area, e0 × (v2 − v0): positive when counter-clockwise, where the
         // inside lies to the left of every edge.
@@ -174,26 +176,22 @@ impl TriPx {
         } else {
             0.0
         };
-        Self {
-            v,
-            e,
-            inv_len2,
-            orient,
-        }
+        let n = e.map(|ek| [ek[0] * orient, ek[1] * orient]);
+        Self { v, e, g, n }
     }
 
     /// Edge `k` seen from the pixel centres: `(orient · e_k × w, t, r)` with `w = p − v_k`,
     /// `t` the clamped parameter of the nearest point, `r = w − t·e_k`.
     #[inline(always)]
     fn edge(&self, k: usize, x: &Lanes, y: &Lanes) -> (Lanes, Lanes, [Lanes; 2]) {
-        let (a, e, il) = (self.v[k], self.e[k], self.inv_len2[k]);
+        let (a, e, g, n) = (self.v[k], self.e[k], self.g[k], self.n[k]);
         let mut side = [0.0; LANES];
         let mut t = [0.0; LANES];
         let mut r = [[0.0; LANES]; 2];
         for j in 0..LANES {
             let (wx, wy) = (x[j] - a[0], y[j] - a[1]);
-            side[j] = (e[0] * wy - e[1] * wx) * self.orient;
-            let tj = (wx * e[0] + wy * e[1]) * il;
+            side[j] = n[0] * wy - n[1] * wx;
+            let tj = wx * g[0] + wy * g[1];
             let tj = if tj < 0.0 { 0.0 } else { tj };
             let tj = if tj > 1.0 { 1.0 } else { tj };
             t[j] = tj;
