@@ -213,6 +213,16 @@ fn points_target_matches_the_mesh_target() {
 }
 
 #[test]
+fn a_non_finite_vertex_leaves_its_triangles_out() {
+    let (silhouette, mut positions, triangles) = offset_fixture();
+    positions[3] = [f64::NAN, 0.0, f64::INFINITY];
+    let (loss, gradient) = silhouette.loss_and_gradient(&positions, &triangles);
+    assert!(loss.is_finite());
+    assert_eq!(gradient[3], [0.0; 3]);
+    assert!(gradient.iter().flatten().all(|g| g.is_finite()));
+}
+
+#[test]
 fn orientation_does_not_matter() {
     let (positions, triangles) = uv_sphere(0.5, [0.0; 3], 12, 8);
     let flipped: Vec<[u32; 3]> = triangles.iter().map(|t| [t[0], t[2], t[1]]).collect();

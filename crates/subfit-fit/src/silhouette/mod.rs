@@ -187,8 +187,9 @@ impl Image {
 /// The soft silhouette of a triangle mesh seen by `camera`.
 ///
 /// `positions` is `#V by 3` (world units), `triangles` `#F by 3` indices into it (any
-/// orientation). Cost: see the module documentation; the tiles run in parallel. Panics if a
-/// triangle indexes past `positions`, or on invalid `opts`.
+/// orientation). A triangle with a non-finite corner is left out. Cost: see the module
+/// documentation; the tiles run in parallel. Panics if a triangle indexes past `positions`, or
+/// on invalid `opts`.
 #[track_caller]
 pub fn render_mesh(
     camera: &Camera,
@@ -345,7 +346,8 @@ impl Silhouette {
     }
 
     /// `L = Σ_views Σ_pixels (I − T)² / N` for the mesh (`#V by 3` positions, `#F by 3`
-    /// triangles). Deterministic (independent of the thread count).
+    /// triangles, as for [`render_mesh`]). Deterministic (independent of the thread count).
+    /// Cost: one forward pass over all views (module documentation).
     #[track_caller]
     pub fn loss(&self, positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> f64 {
         let soft = Soft::new(&self.options);
@@ -354,8 +356,10 @@ impl Silhouette {
         tiles.iter().map(|t| t.sum_sq).sum::<f64>() / self.pixel_count() as f64
     }
 
-    /// The loss and its exact gradient w.r.t. every position (`#V by 3`; zero for vertices no
-    /// triangle uses or whose triangles reach no pixel). Deterministic.
+    /// The loss and its exact gradient w.r.t. every position (`#V by 3`, loss per world unit;
+    /// zero for vertices no triangle uses, whose triangles reach no pixel, or that are not
+    /// finite). Deterministic. Cost: about twice [`Self::loss`], plus memory for the
+    /// exponentials of the tiles in flight (8 bytes per pixel visit of a tile).
     #[track_caller]
     pub fn loss_and_gradient(
         &self,

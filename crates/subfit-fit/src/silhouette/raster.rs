@@ -314,7 +314,6 @@ impl<P: Primitive> View<P> {
             let lo_y = (b[1] - grow - 0.5).ceil().max(0.0);
             let hi_x = (b[2] + grow - 0.5).floor().min(last);
             let hi_y = (b[3] + grow - 0.5).floor().min(last);
-            // Also rejects NaN boxes (non-finite positions reach no pixel).
             if !(lo_x <= hi_x && lo_y <= hi_y) {
                 continue;
             }
@@ -468,7 +467,8 @@ impl<P: Primitive> View<P> {
     }
 }
 
-/// The triangles of a mesh seen by `camera`. Cost O(#V + #F).
+/// The triangles of a mesh seen by `camera`; a triangle with a non-finite corner is left out.
+/// Cost O(#V + #F).
 #[track_caller]
 pub(super) fn mesh_view(
     camera: &Camera,
@@ -484,12 +484,14 @@ pub(super) fn mesh_view(
             "triangle {f} = {t:?} indexes past the {n} positions"
         );
         let v = t.map(|v| px[v as usize]);
-        (f as u32, TriPx::new(v))
+        let finite = v.iter().flatten().all(|c| c.is_finite());
+        finite.then(|| (f as u32, TriPx::new(v)))
     });
-    View::new(tris, camera.resolution, soft)
+    View::new(tris.flatten(), camera.resolution, soft)
 }
 
-/// The points seen by `camera`, each a ball of `radius` world units. Cost O(#points).
+/// The points seen by `camera`, each a ball of `radius` world units; non-finite points are left
+/// out. Cost O(#points).
 pub(super) fn points_view(
     camera: &Camera,
     points: &[[f64; 3]],
@@ -497,14 +499,9 @@ pub(super) fn points_view(
     soft: &Soft,
 ) -> View<DiscPx> {
     let r = radius / camera.pixel_size();
-    let discs = points.iter().enumerate().map(|(i, &p)| {
-        (
-            i as u32,
-            DiscPx {
-                c: camera.project(p),
-                r,
-            },
-        )
+    let discs = points.iter().enumerate().filter_map(|(i, &p)| {
+        let c = camera.project(p);
+        (c[0].is_finite() && c[1].is_finite()).then_some((i as u32, DiscPx { c, r }))
     });
     View::new(discs, camera.resolution, soft)
 }
