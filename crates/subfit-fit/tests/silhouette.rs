@@ -196,9 +196,12 @@ fn points_target_matches_the_mesh_target() {
     let spacing = (4.0 * PI * r * r / n as f64).sqrt();
     let (positions, triangles) = uv_sphere(r, [0.0; 3], 150, 100);
     let options = SoftOptions::default();
-    for camera in cameras_around([0.0; 3], r, 3, 128) {
-        let mesh = render_mesh(&camera, &positions, &triangles, &options);
-        let points = render_points(&camera, &cloud.positions, spacing, &options);
+    let cameras = cameras_around([0.0; 3], r, 3, 128);
+    let silhouette = Silhouette::from_points(cameras.clone(), &cloud.positions, spacing, options);
+    for (camera, target) in cameras.iter().zip(silhouette.targets()) {
+        let mesh = render_mesh(camera, &positions, &triangles, &options);
+        let points = render_points(camera, &cloud.positions, spacing, &options);
+        assert_eq!(&points, target);
         let rel = points.coverage() / mesh.coverage() - 1.0;
         assert!(rel.abs() < 0.05, "relative area difference {rel:e}");
         // No holes inside.
