@@ -196,9 +196,12 @@ fn points_target_matches_the_mesh_target() {
     let spacing = (4.0 * PI * r * r / n as f64).sqrt();
     let (positions, triangles) = uv_sphere(r, [0.0; 3], 150, 100);
     let options = SoftOptions::default();
-    for camera in cameras_around([0.0; 3], r, 3, 128) {
-        let mesh = render_mesh(&camera, &positions, &triangles, &options);
-        let points = render_points(&camera, &cloud.positions, spacing, &options);
+    let cameras = cameras_around([0.0; 3], r, 3, 128);
+    let silhouette = Silhouette::from_points(cameras.clone(), &cloud.positions, spacing, options);
+    for (camera, target) in cameras.iter().zip(silhouette.targets()) {
+        let mesh = render_mesh(camera, &positions, &triangles, &options);
+        let points = render_points(camera, &cloud.positions, spacing, &options);
+        assert_eq!(&points, target);
         let rel = points.coverage() / mesh.coverage() - 1.0;
         assert!(rel.abs() < 0.05, "relative area difference {rel:e}");
         // No holes inside.
@@ -210,6 +213,16 @@ fn points_target_matches_the_mesh_target() {
             .count();
         assert_eq!(holes, 0);
     }
+}
+
+#[test]
+fn a_non_finite_vertex_leaves_its_triangles_out() {
+    let (silhouette, mut positions, triangles) = offset_fixture();
+    positions[3] = [f64::NAN, 0.0, f64::INFINITY];
+    let (loss, gradient) = silhouette.loss_and_gradient(&positions, &triangles);
+    assert!(loss.is_finite());
+    assert_eq!(gradient[3], [0.0; 3]);
+    assert!(gradient.iter().flatten().all(|g| g.is_finite()));
 }
 
 #[test]

@@ -107,7 +107,8 @@ const INV_FACTORIALS: [f64; 14] = [
 
 /// `e^z` for `|z| ≤ 708`, within a few ulp, without branches so that it vectorizes (the C
 /// library's `exp` is an opaque call). Cody–Waite reduction `z = n·ln 2 + r`, `|r| ≤ ½ ln 2`,
-/// a degree-13 Taylor polynomial for `e^r` (remainder below 5e-18), and `2^n` assembled in the
+/// a degree-13 Taylor polynomial for `e^r` (remainder below 5e-18) evaluated by Estrin's scheme
+/// (a dependency chain of 4 multiply-adds instead of Horner's 13), and `2^n` assembled in the
 /// exponent bits.
 #[inline(always)]
 pub(super) fn exp(z: f64) -> f64 {
@@ -115,13 +116,16 @@ pub(super) fn exp(z: f64) -> f64 {
     const SHIFT: f64 = 6_755_399_441_055_744.0;
     const LN2_HI: f64 = 6.931_471_803_691_238e-1;
     const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+    const C: [f64; 14] = INV_FACTORIALS;
     let shifted = z * std::f64::consts::LOG2_E + SHIFT;
     let n = shifted - SHIFT;
     let r = (z - n * LN2_HI) - n * LN2_LO;
-    let mut p = INV_FACTORIALS[13];
-    for k in (0..13).rev() {
-        p = p * r + INV_FACTORIALS[k];
-    }
+    let (r2, r4) = (r * r, r * r * (r * r));
+    let q0 = (C[0] + C[1] * r) + (C[2] + C[3] * r) * r2;
+    let q1 = (C[4] + C[5] * r) + (C[6] + C[7] * r) * r2;
+    let q2 = (C[8] + C[9] * r) + (C[10] + C[11] * r) * r2;
+    let q3 = C[12] + C[13] * r;
+    let p = (q0 + q1 * r4) + (q2 + q3 * r4) * (r4 * r4);
     let n_bits = shifted.to_bits().wrapping_sub(SHIFT.to_bits());
     p * f64::from_bits(n_bits.wrapping_add(1023) << 52)
 }
@@ -144,35 +148,23 @@ pub(super) struct TriPx {
     v: [[f64; 2]; 3],
     /// `e[k] = v[k+1] − v[k]`.
     e: [[f64; 2]; 3],
-    /// `1/|e[k]|²`, 0 for a zero-length edge.
-    inv_len2: [f64; 3],
-    /// Sign of the signed area (+1, −1, or 0 when degenerate).
-    orient: f64,
-}
-
-/// The nearest boundary points of a triangle to `LANES` pixel centres.
-struct Closest {
-    /// Squared distance to the boundary.
-    d2: Lanes,
-    /// Whether the pixel centre is inside.
-    inside: [bool; LANES],
-    /// Which edge is nearest: `edge[k][j]` is 1.0 for the nearest edge `k`, else 0.0.
-    edge: [Lanes; 3],
-    /// Parameter of the nearest point on the nearest edge, in `[0, 1]`.
-    t: Lanes,
-    /// `p − nearest point`.
-    r: [Lanes; 2],
+    /// `e[k]/|e[k]|²` (zero for a zero-length edge): `t = w·g[k]`.
+    g: [[f64; 2]; 3],
+    /// `orient·e[k]`, `orient` the sign of the signed area (+1, −1, or 0 when degenerate):
+    /// `n[k] × w > 0` on the inner side of every edge.
+    n: [[f64; 2]; 3],
 }
 
 impl TriPx {
     fn new(v: [[f64; 2]; 3]) -> Self {
         let mut e = [[0.0; 2]; 3];
-        let mut inv_len2 = [0.0; 3];
+        let mut g = [[0.0; 2]; 3];
         for k in 0..3 {
             let b = v[(k + 1) % 3];
             e[k] = [b[0] - v[k][0], b[1] - v[k][1]];
             let len2 = e[k][0] * e[k][0] + e[k][1] * e[k][1];
-            inv_len2[k] = if len2 > 0.0 { 1.0 / len2 } else { 0.0 };
+            let il = if len2 > 0.0 { 1.0 / len2 } else { 0.0 };
+            g[k] = [e[k][0] * il, e[k][1] * il];
         }
         // Twice the signed area, e0 × (v2 − v0): positive when counter-clockwise, where the
         // inside lies to the left of every edge.
@@ -184,26 +176,22 @@ impl TriPx {
         } else {
             0.0
         };
-        Self {
-            v,
-            e,
-            inv_len2,
-            orient,
-        }
+        let n = e.map(|ek| [ek[0] * orient, ek[1] * orient]);
+        Self { v, e, g, n }
     }
 
     /// Edge `k` seen from the pixel centres: `(orient · e_k × w, t, r)` with `w = p − v_k`,
     /// `t` the clamped parameter of the nearest point, `r = w − t·e_k`.
     #[inline(always)]
     fn edge(&self, k: usize, x: &Lanes, y: &Lanes) -> (Lanes, Lanes, [Lanes; 2]) {
-        let (a, e, il) = (self.v[k], self.e[k], self.inv_len2[k]);
+        let (a, e, g, n) = (self.v[k], self.e[k], self.g[k], self.n[k]);
         let mut side = [0.0; LANES];
         let mut t = [0.0; LANES];
         let mut r = [[0.0; LANES]; 2];
         for j in 0..LANES {
             let (wx, wy) = (x[j] - a[0], y[j] - a[1]);
-            side[j] = (e[0] * wy - e[1] * wx) * self.orient;
-            let tj = (wx * e[0] + wy * e[1]) * il;
+            side[j] = n[0] * wy - n[1] * wx;
+            let tj = wx * g[0] + wy * g[1];
             let tj = if tj < 0.0 { 0.0 } else { tj };
             let tj = if tj > 1.0 { 1.0 } else { tj };
             t[j] = tj;
@@ -211,48 +199,6 @@ impl TriPx {
             r[1][j] = wy - tj * e[1];
         }
         (side, t, r)
-    }
-
-    /// The nearest boundary point for each lane (for the gradient).
-    #[inline(always)]
-    fn closest(&self, x: &Lanes, y: &Lanes) -> Closest {
-        let (side0, t0, r0) = self.edge(0, x, y);
-        let mut c = Closest {
-            d2: [0.0; LANES],
-            inside: [false; LANES],
-            edge: [[1.0; LANES], [0.0; LANES], [0.0; LANES]],
-            t: t0,
-            r: r0,
-        };
-        let mut side_min = side0;
-        for j in 0..LANES {
-            c.d2[j] = r0[0][j] * r0[0][j] + r0[1][j] * r0[1][j];
-        }
-        for k in 1..3 {
-            let (side, t, r) = self.edge(k, x, y);
-            for j in 0..LANES {
-                let d2 = r[0][j] * r[0][j] + r[1][j] * r[1][j];
-                let nearer = d2 < c.d2[j];
-                c.d2[j] = if nearer { d2 } else { c.d2[j] };
-                c.t[j] = if nearer { t[j] } else { c.t[j] };
-                c.r[0][j] = if nearer { r[0][j] } else { c.r[0][j] };
-                c.r[1][j] = if nearer { r[1][j] } else { c.r[1][j] };
-                for m in 0..3 {
-                    let is_k = if m == k { 1.0 } else { 0.0 };
-                    c.edge[m][j] = if nearer { is_k } else { c.edge[m][j] };
-                }
-                side_min[j] = if side[j] < side_min[j] {
-                    side[j]
-                } else {
-                    side_min[j]
-                };
-            }
-        }
-        for j in 0..LANES {
-            // A degenerate triangle has orient = 0, so no side is positive: no inside.
-            c.inside[j] = side_min[j] > 0.0;
-        }
-        c
     }
 }
 
@@ -368,7 +314,6 @@ impl<P: Primitive> View<P> {
             let lo_y = (b[1] - grow - 0.5).ceil().max(0.0);
             let hi_x = (b[2] + grow - 0.5).floor().min(last);
             let hi_y = (b[3] + grow - 0.5).floor().min(last);
-            // Also rejects NaN boxes (non-finite positions reach no pixel).
             if !(lo_x <= hi_x && lo_y <= hi_y) {
                 continue;
             }
@@ -461,16 +406,29 @@ impl<P: Primitive> View<P> {
                 continue;
             }
             let h = h2.sqrt();
-            let xa = (cx - h - 0.5).ceil().max(x0 as f64);
-            let xb = ((cx + h - 0.5).floor() + 1.0).min(x1 as f64);
+            // Pixels x with |x + ½ − cx| ≤ h, clipped to [x0, x1). Casting truncates towards
+            // zero, which is the floor for the non-negative values kept (cheaper than the
+            // library's ceil/floor, calls without SSE4.1).
+            let lo = cx - h - 0.5;
+            let xa = if lo <= x0 as f64 {
+                x0
+            } else {
+                let t = lo as usize;
+                t + usize::from((t as f64) < lo)
+            };
+            let hi = cx + h + 0.5;
+            let xb = if hi >= x1 as f64 { x1 } else { hi as usize };
             if xb <= xa {
                 continue;
             }
             let row = (y - rect[2]) * STRIDE;
             let ys = [py; LANES];
-            let mut x = xa as usize;
-            while x < xb as usize {
-                let xs: Lanes = std::array::from_fn(|j| (x + j) as f64 + 0.5);
+            let mut x = xa;
+            while x < xb {
+                let mut xs = [0.0; LANES];
+                for (j, xj) in xs.iter_mut().enumerate() {
+                    *xj = (x + j) as f64 + 0.5;
+                }
                 visit(row + x - rect[0], &xs, &ys);
                 x += LANES;
             }
@@ -478,8 +436,8 @@ impl<P: Primitive> View<P> {
     }
 
     /// `P = Π 1/q̃` over the tile's pixels (buffer index `(y − y0)·STRIDE + x − x0`). With
-    /// `store`, the `e^{s/σ}` of every visited lane are appended in visiting order, for
-    /// [`backward`] to reuse.
+    /// `store`, the `±e^{s/σ}` of every visited lane (`+` inside, `−` outside) are appended in
+    /// visiting order, for [`backward`] to reuse.
     fn forward(&self, t: usize, soft: &Soft, mut store: Option<&mut Vec<f64>>) -> [f64; TILE_BUF] {
         let mut p = [1.0; TILE_BUF];
         let rect = self.tile_rect(t);
@@ -487,14 +445,21 @@ impl<P: Primitive> View<P> {
             let prim = &self.prims[i as usize];
             self.for_chunks(i as usize, rect, |l, x, y| {
                 let s = prim.signed_sq(x, y);
-                let e: Lanes = std::array::from_fn(|j| soft.exp(s[j]));
+                let mut e = [0.0; LANES];
+                for j in 0..LANES {
+                    e[j] = soft.exp(s[j]);
+                }
                 let chunk = &mut p[l..l + LANES];
                 for j in 0..LANES {
                     let f = (1.0 + e[j]) * soft.keep;
                     chunk[j] *= if s[j] > -soft.cut2 { f } else { 1.0 };
                 }
                 if let Some(store) = store.as_deref_mut() {
-                    store.extend_from_slice(&e);
+                    let mut signed = [0.0; LANES];
+                    for j in 0..LANES {
+                        signed[j] = if s[j] > 0.0 { e[j] } else { -e[j] };
+                    }
+                    store.extend_from_slice(&signed);
                 }
             });
         }
@@ -502,7 +467,8 @@ impl<P: Primitive> View<P> {
     }
 }
 
-/// The triangles of a mesh seen by `camera`. Cost O(#V + #F).
+/// The triangles of a mesh seen by `camera`; a triangle with a non-finite corner is left out.
+/// Cost O(#V + #F).
 #[track_caller]
 pub(super) fn mesh_view(
     camera: &Camera,
@@ -518,12 +484,14 @@ pub(super) fn mesh_view(
             "triangle {f} = {t:?} indexes past the {n} positions"
         );
         let v = t.map(|v| px[v as usize]);
-        (f as u32, TriPx::new(v))
+        let finite = v.iter().flatten().all(|c| c.is_finite());
+        finite.then(|| (f as u32, TriPx::new(v)))
     });
-    View::new(tris, camera.resolution, soft)
+    View::new(tris.flatten(), camera.resolution, soft)
 }
 
-/// The points seen by `camera`, each a ball of `radius` world units. Cost O(#points).
+/// The points seen by `camera`, each a ball of `radius` world units; non-finite points are left
+/// out. Cost O(#points).
 pub(super) fn points_view(
     camera: &Camera,
     points: &[[f64; 3]],
@@ -531,14 +499,9 @@ pub(super) fn points_view(
     soft: &Soft,
 ) -> View<DiscPx> {
     let r = radius / camera.pixel_size();
-    let discs = points.iter().enumerate().map(|(i, &p)| {
-        (
-            i as u32,
-            DiscPx {
-                c: camera.project(p),
-                r,
-            },
-        )
+    let discs = points.iter().enumerate().filter_map(|(i, &p)| {
+        let c = camera.project(p);
+        (c[0].is_finite() && c[1].is_finite()).then_some((i as u32, DiscPx { c, r }))
     });
     View::new(discs, camera.resolution, soft)
 }
@@ -632,7 +595,8 @@ pub(super) fn loss_tiles(
         .collect()
 }
 
-/// `∂L/∂(projected corners)` of the tile's triangles given `w = ∂L/∂I · Q` per pixel.
+/// `∂L/∂(projected corners)` of the tile's triangles given `w = ∂L/∂I · Q` per pixel and the
+/// signed exponentials stored by the forward pass (same visiting order).
 ///
 /// With `z = s/σ`, `∂L/∂s = w·D/σ`; `s = ±d²`, `d² = |r|²`, `r = p − (a + t(b − a))` on the
 /// nearest edge `(a, b)`, so `∂d²/∂a = −2r(1 − t)`, `∂d²/∂b = −2rt` (with `t` clamped the
@@ -653,25 +617,44 @@ fn backward(
         let mut acc = [[0.0; LANES]; 6];
         view.for_chunks(i as usize, rect, |l, x, y| {
             let wl = &w[l..l + LANES];
-            let e = &exps[next..next + LANES];
+            let signed_e = &exps[next..next + LANES];
             next += LANES;
             if wl.iter().all(|&v| v == 0.0) {
                 return;
             }
-            let c = tri.closest(x, y);
+            // (Not `[0, 1, 2].map(…)`: that is not inlined.)
+            let edges = [tri.edge(0, x, y), tri.edge(1, x, y), tri.edge(2, x, y)];
             for j in 0..LANES {
-                let s = if c.inside[j] { c.d2[j] } else { -c.d2[j] };
-                let d = e[j] / (1.0 + e[j]);
+                let mut d2 = [0.0; 3];
+                for k in 0..3 {
+                    let r = &edges[k].2;
+                    d2[k] = r[0][j] * r[0][j] + r[1][j] * r[1][j];
+                }
+                let inside = signed_e[j] > 0.0;
+                let e = signed_e[j].abs();
+                let d = e / (1.0 + e);
                 let ds = wl[j] * d * soft.inv_sigma;
                 // ∂s/∂a = ∓2r(1 − t) (inside: s = d², outside: s = −d²).
-                let f = if c.inside[j] { -2.0 * ds } else { 2.0 * ds };
-                let f = if s > -soft.cut2 { f } else { 0.0 };
-                let (fa, fb) = (f * (1.0 - c.t[j]), f * c.t[j]);
-                // Corner k starts edge k and ends edge k − 1.
+                let f = if inside { -2.0 * ds } else { 2.0 * ds };
+                let d2_min = d2[0].min(d2[1]).min(d2[2]);
+                let f = if inside || d2_min < soft.cut2 { f } else { 0.0 };
+                // The nearest edge (the first on ties) takes the whole derivative.
+                let nearest = [
+                    d2[0] <= d2[1] && d2[0] <= d2[2],
+                    d2[1] < d2[0] && d2[1] <= d2[2],
+                    d2[2] < d2[0] && d2[2] < d2[1],
+                ];
                 for k in 0..3 {
-                    let coef = c.edge[k][j] * fa + c.edge[(k + 2) % 3][j] * fb;
-                    acc[2 * k][j] += coef * c.r[0][j];
-                    acc[2 * k + 1][j] += coef * c.r[1][j];
+                    let (_, tk, r) = &edges[k];
+                    let g = if nearest[k] { f } else { 0.0 };
+                    let gb = g * tk[j];
+                    let ga = g - gb;
+                    // Edge k runs from corner k to corner k + 1.
+                    let (a, b) = (2 * k, 2 * ((k + 1) % 3));
+                    acc[a][j] += ga * r[0][j];
+                    acc[a + 1][j] += ga * r[1][j];
+                    acc[b][j] += gb * r[0][j];
+                    acc[b + 1][j] += gb * r[1][j];
                 }
             }
         });
