@@ -141,6 +141,21 @@ impl PointIndex {
             .collect()
     }
 
+    /// Calls `f(index)` for every point within `radius` (inclusive) of `q`, in the order of
+    /// [`Self::within_unsorted`], without collecting them: no allocation, for kernels that
+    /// only sum over the neighbourhood (IMLS).
+    #[inline]
+    pub fn for_each_within(&self, q: &[f64; 3], radius: f64, mut f: impl FnMut(u32)) {
+        if !(radius >= 0.0) {
+            return;
+        }
+        self.tree
+            .query(q)
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .unsorted()
+            .visit(|r| f(r.item));
+    }
+
     /// All points within `radius` of `q`, in no particular order (faster than [`Self::within`]).
     pub fn within_unsorted(&self, q: &[f64; 3], radius: f64) -> Vec<Neighbor> {
         if !(radius >= 0.0) {
