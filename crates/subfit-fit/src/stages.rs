@@ -529,7 +529,8 @@ pub fn fit_stages(
             time: Duration::ZERO,
         };
         let badness = stages.badness(&last, &m.two_sided);
-        if best.as_ref().is_none_or(|b| badness < b.badness) {
+        let improved = best.as_ref().is_none_or(|b| badness < b.badness);
+        if improved {
             best = Some(Best {
                 stage,
                 badness,
@@ -605,7 +606,12 @@ pub fn fit_stages(
             stop = StageStop::Limit;
             break;
         }
-        if !changed {
+        // With the control-point budget spent and λ at its end only flips change the cage; a
+        // stage after which the best cage did not improve ends the fit. (The bunny's points at
+        // 4,667 control points: IMLS's stages 3–4 and SDM's 3–7 came after their best or within
+        // 1 % of it, at 1.4 s and 17 s.)
+        let spent = n >= stages.max_control_points && next_lambda >= lambda;
+        if !changed || (spent && !improved) {
             stop = if mesh.num_vertices() >= stages.max_control_points {
                 StageStop::Budget
             } else {

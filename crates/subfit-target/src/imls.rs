@@ -47,7 +47,8 @@ impl Target {
 /// The IMLS value and gradient at `x` over `points` (`#P by 3`) with unit `normals` (`#P by 3`)
 /// indexed by `index` (built over `points`), support radius `h > 0` (units of the points): the
 /// kernel of [`Target::imls_with_radius`], for callers with their own points and normals (the
-/// Python package's autograd layer). Cost: a radius query plus O(#neighbours).
+/// Python package's autograd layer). Cost: a radius query plus O(#neighbours), no allocation
+/// (the sums are taken while the tree is visited).
 ///
 /// Not checked: that `index` was built over `points` and that the slices have equal lengths
 /// (an index past their end panics).
@@ -58,17 +59,18 @@ pub fn imls_value(
     x: [f64; 3],
     h: f64,
 ) -> ImlsValue {
-    let nb = index.within_unsorted(&x, h);
     let inv_h2 = 1.0 / (h * h);
     // s0 = Σφ, s1 = Σ n·(x−p) φ; g0 = Σ∇φ, g1 = Σ (n φ + n·(x−p) ∇φ).
     let (mut s0, mut s1) = (0.0, 0.0);
     let (mut g0, mut g1) = ([0.0; 3], [0.0; 3]);
-    for b in &nb {
-        let i = b.index as usize;
+    let mut neighbors = 0;
+    index.for_each_within(&x, h, |i| {
+        neighbors += 1;
+        let i = i as usize;
         let d = sub(x, points[i]);
         let t = 1.0 - dot(d, d) * inv_h2;
         if t <= 0.0 {
-            continue;
+            return;
         }
         let t3 = t * t * t;
         let phi = t3 * t;
@@ -80,14 +82,14 @@ pub fn imls_value(
             g0[k] += dphi * d[k];
             g1[k] += normals[i][k] * phi + s * dphi * d[k];
         }
-    }
+    });
     if s0 > 0.0 && s0.is_finite() {
         let value = s1 / s0;
         let gradient = [0, 1, 2].map(|k| (g1[k] - value * g0[k]) / s0);
         return ImlsValue {
             value,
             gradient,
-            neighbors: nb.len(),
+            neighbors,
             fallback: false,
         };
     }

@@ -141,6 +141,21 @@ impl PointIndex {
             .collect()
     }
 
+    /// Calls `f(index)` for every point within `radius` (inclusive) of `q`, in the order of
+    /// [`Self::within_unsorted`], without collecting them: no allocation, for kernels that
+    /// only sum over the neighbourhood (IMLS).
+    #[inline]
+    pub fn for_each_within(&self, q: &[f64; 3], radius: f64, mut f: impl FnMut(u32)) {
+        if !(radius >= 0.0) {
+            return;
+        }
+        self.tree
+            .query(q)
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .unsorted()
+            .visit(|r| f(r.item));
+    }
+
     /// All points within `radius` of `q`, in no particular order (faster than [`Self::within`]).
     pub fn within_unsorted(&self, q: &[f64; 3], radius: f64) -> Vec<Neighbor> {
         if !(radius >= 0.0) {
@@ -162,6 +177,50 @@ impl PointIndex {
     /// [`Self::nearest`] for every query, in parallel (rayon). Output `#Q` entries, in order.
     pub fn nearest_batch(&self, queries: &[[f64; 3]]) -> Vec<Neighbor> {
         queries.par_iter().map(|q| self.nearest(q)).collect()
+    }
+
+    /// The distance to the nearest point of every node of the uniform grid with `dims` nodes
+    /// (x fastest) spaced `cell` from `origin`, where it is at most `bound`; `INFINITY` where
+    /// it is larger. Rows in parallel (rayon); along a row the distance changes by at most
+    /// `cell` per node, so after a node at distance `d > bound` the next `⌊(d − bound) / cell⌋`
+    /// nodes are skipped without a query: a grid around a scan costs about one [`Self::nearest`]
+    /// per node near the points. Values within `bound` are those of [`Self::nearest`].
+    /// Only the slabs `zs` (a range of z indices) are computed: output
+    /// `dims[0]·dims[1]·zs.len()` entries.
+    pub fn grid_distances(
+        &self,
+        origin: [f64; 3],
+        cell: f64,
+        dims: [usize; 3],
+        zs: std::ops::Range<usize>,
+        bound: f64,
+    ) -> Vec<f64> {
+        let [nx, ny, _] = dims;
+        let mut out = vec![f64::INFINITY; nx * ny * zs.len()];
+        if nx == 0 || ny == 0 {
+            return out;
+        }
+        out.par_chunks_mut(nx).enumerate().for_each(|(row, out)| {
+            let (y, z) = (row % ny, zs.start + row / ny);
+            let mut x = 0;
+            while x < nx {
+                let q = [
+                    origin[0] + x as f64 * cell,
+                    origin[1] + y as f64 * cell,
+                    origin[2] + z as f64 * cell,
+                ];
+                let d = self.nearest(&q).distance;
+                if d <= bound {
+                    out[x] = d;
+                    x += 1;
+                } else {
+                    // Nodes x + 1 ..= x + skip are farther than `bound` too.
+                    let skip = ((d - bound) / cell).floor();
+                    x += 1 + if skip.is_finite() { skip as usize } else { nx };
+                }
+            }
+        });
+        out
     }
 
     /// [`Self::k_nearest`] for every query, in parallel (rayon). Output `#Q` lists, in order.
