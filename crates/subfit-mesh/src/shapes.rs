@@ -385,9 +385,67 @@ pub fn cube_mesh(h: f64) -> PolyMesh {
     PolyMesh::new(pos, Polygons::from_quads(&quads))
 }
 
+/// The unit cube `[0, 1]³` with an `n × n` grid of triangle pairs on each side (outward
+/// orientation, shared vertices), without its top side (`z = 1`) when `open_top`: the CAD-like
+/// shape of sharp features (12 crease curves and 8 corners; open: 8 curves, 4 corners and a
+/// square rim).
+///
+/// # Panics
+/// If `n` is 0.
+pub fn gridded_box(n: usize, open_top: bool) -> PolyMesh {
+    assert!(n > 0, "a grid needs at least one cell per side");
+    let mut index: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
+    let mut pos = Vec::new();
+    let mut tris = Vec::new();
+    // (origin, u, v) with u × v outward.
+    let mut sides = vec![
+        ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
+        ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
+    ];
+    if !open_top {
+        sides.push(([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]));
+    }
+    let k = n as f64;
+    for (o, u, v) in sides {
+        let mut vertex = |i: usize, j: usize| {
+            let p: [f64; 3] =
+                std::array::from_fn(|c| o[c] + u[c] * i as f64 / k + v[c] * j as f64 / k);
+            // Grid coordinates are exact multiples of 1/n: key by them.
+            let key = p.map(|x| (x * k).round() as u64);
+            *index.entry(key).or_insert_with(|| {
+                pos.push(p);
+                (pos.len() - 1) as u32
+            })
+        };
+        for i in 0..n {
+            for j in 0..n {
+                let (a, b) = (vertex(i, j), vertex(i + 1, j));
+                let (c, d) = (vertex(i + 1, j + 1), vertex(i, j + 1));
+                tris.push([a, b, c]);
+                tris.push([a, c, d]);
+            }
+        }
+    }
+    PolyMesh::new(pos, Polygons::from_triangles(&tris))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn gridded_boxes_are_closed_or_open_manifolds() {
+        let closed = crate::HalfEdgeMesh::from_mesh(&gridded_box(4, false)).unwrap();
+        assert_eq!(closed.genus(), 0);
+        assert!(closed.boundary_loops().is_empty());
+        assert_eq!(closed.num_vertices(), 6 * 16 + 2);
+        let open = crate::HalfEdgeMesh::from_mesh(&gridded_box(4, true)).unwrap();
+        assert_eq!(open.boundary_loops().len(), 1);
+        assert_eq!(open.boundary_loops()[0].len(), 16);
+    }
 
     fn max_implicit_residual(shape: &Shape, m: &PolyMesh) -> f64 {
         m.positions
