@@ -6,17 +6,23 @@
 //! tetrahedra) and then simplified, as Cheng et al. 2004 §4.3 (marching cubes on an octree, then
 //! simplification). Between the two, the contour of an open cloud is cut where no data supports
 //! it ([`crate::trim`](mod@crate::trim)), so that the cage has the open target's boundary loops
-//! (DESIGN.md §3.6; the open surfaces of Lavoué et al. 2007 §4).
+//! (DESIGN.md §3.6; the open surfaces of Lavoué et al. 2007 §4). With
+//! [`InitOptions::features`], a mesh target's sharp features
+//! ([`subfit_target::detect_features`]) are kept by the simplification as cage edges and come
+//! back as crease and corner tags ([`InitReport::tags`]): a feature-aligned cage (Lavoué et al.
+//! §6 mark patch boundaries as sharp control edges).
 
 use std::time::{Duration, Instant};
 
-use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, TopologyError};
-use subfit_target::Target;
+use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Tags, TopologyError};
+use subfit_target::{detect_features, FeatureOptions, Target};
 
 use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
 use crate::quads::{pair_triangles, PairOptions, PairReport};
-use crate::simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
+use crate::simplify::{
+    simplify_with_features, FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport,
+};
 use crate::trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};
 
 /// Options of [`initial_control_mesh`].
@@ -51,6 +57,10 @@ pub struct InitOptions {
     pub quad_dominant: bool,
     /// Options of the pairing (used with [`Self::quad_dominant`]).
     pub pairing: PairOptions,
+    /// Mesh targets: detect sharp features with these options and keep them as crease and
+    /// corner tags of a feature-aligned cage. Default `None` (no tags). Ignored for point
+    /// clouds.
+    pub features: Option<FeatureOptions>,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
     /// level and per batch of cells, evaluations and edge collapses; once cancelled,
@@ -70,6 +80,7 @@ impl Default for InitOptions {
             contour_vertices_per_control: 8.0,
             quad_dominant: false,
             pairing: PairOptions::default(),
+            features: None,
             cancel: Cancel::default(),
         }
     }
@@ -165,8 +176,26 @@ pub struct InitReport {
     pub carve_radius: Option<f64>,
     /// The pairing into quads, with [`InitOptions::quad_dominant`].
     pub pairing: Option<PairReport>,
+    /// Crease and corner tags of the result (infinitely sharp; empty without
+    /// [`InitOptions::features`] or when none were found).
+    pub tags: Tags,
+    /// The sharp features detected on a mesh target with [`InitOptions::features`].
+    pub features: Option<FeatureCounts>,
     /// Step times.
     pub timings: InitTimings,
+}
+
+/// How many sharp features of each kind a mesh target has ([`InitReport::features`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FeatureCounts {
+    /// Sharp edges of the target.
+    pub edges: usize,
+    /// Feature curves.
+    pub curves: usize,
+    /// Corners.
+    pub corners: usize,
+    /// Darts (curve ends in smooth regions).
+    pub darts: usize,
 }
 
 impl InitReport {
@@ -329,18 +358,30 @@ pub fn initial_control_mesh(
         cancel: options.cancel.clone(),
         ..options.simplify.clone()
     };
-    let (mut out, srep) = simplify(&dense, &sopt)?;
+    let lock = match (&options.features, report.source) {
+        (Some(fo), InitSource::Mesh) => {
+            let f = detect_features(&dense.positions, &dense.faces, fo);
+            report.features = Some(FeatureCounts {
+                edges: f.edges.len(),
+                curves: f.curves.len(),
+                corners: f.corners.len(),
+                darts: f.darts.len(),
+            });
+            FeatureLock {
+                edges: f.edges,
+                corners: f.corners,
+            }
+        }
+        _ => FeatureLock::default(),
+    };
+    let (mut out, tags, srep) = simplify_with_features(&dense, &lock, &sopt)?;
     report.timings.simplify = t.elapsed();
     report.simplify = srep;
+    report.tags = tags;
     if options.quad_dominant {
         options.cancel.check()?;
         let t = Instant::now();
-        let (paired, prep) = pair_triangles(
-            &out,
-            &subfit_mesh::Tags::new(),
-            Some(target),
-            &options.pairing,
-        )?;
+        let (paired, prep) = pair_triangles(&out, &report.tags, Some(target), &options.pairing)?;
         out = paired;
         report.timings.pair = t.elapsed();
         report.pairing = Some(prep);

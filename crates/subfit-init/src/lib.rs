@@ -24,6 +24,7 @@
 
 pub mod carve;
 pub mod contour;
+mod heap;
 pub mod init;
 mod march;
 mod octree;
@@ -34,9 +35,11 @@ pub mod trim;
 pub use carve::carve;
 pub use contour::{contour, ContourError, ContourOptions, ContourReport, MAX_RESOLUTION};
 pub use init::{
-    default_control_points, initial_control_mesh, min_vertices_for_topology, InitError,
-    InitOptions, InitReport, InitSource, InitTimings,
+    default_control_points, initial_control_mesh, min_vertices_for_topology, FeatureCounts,
+    InitError, InitOptions, InitReport, InitSource, InitTimings,
 };
 pub use quads::{coherency_score, pair_triangles, PairOptions, PairReport};
-pub use simplify::{simplify, SimplifyError, SimplifyOptions, SimplifyReport};
+pub use simplify::{
+    simplify, simplify_with_features, FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport,
+};
 pub use trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};

@@ -22,13 +22,26 @@
 //! exactly one endpoint of an edge is on the boundary, the collapse keeps the boundary vertex
 //! where it is.
 //!
+//! **Sharp features** ([`simplify_with_features`]): the sharp edges of the input (from
+//! `subfit_target::detect_features`) stay edges of the output. A vertex on a feature curve is
+//! removed only by a collapse along its curve into a neighbour on the same curve (the kept
+//! vertex stays where it is, so the cage's sharp edges stay on the data's), and only when it has
+//! exactly two sharp edges and is not a corner; corners, darts and junctions are never removed.
+//! Each sharp edge adds the constraint planes of a boundary edge for both of its faces, so a
+//! curve's shape costs as a boundary's does. The surviving sharp edges come back as
+//! infinitely sharp crease tags, the corners as corner tags (OpenSubdiv semantics; Lavoué et al.
+//! 2005 §6 tag patch boundaries the same way; Hoppe et al. 1994 tag by hand).
+//!
 //! Data structure: a flat triangle list with per-vertex face lists updated per collapse. Cost:
 //! `O(E log E)` overall; each collapse touches the two-ring of the kept vertex.
 
 use std::cmp::Ordering;
 
+use crate::heap::{Entry, QuadHeap};
 use subfit_mesh::vec3::{add, cross, dot, norm, scale, sub};
-use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, TopologyError};
+use subfit_mesh::{
+    Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, Tags, TopologyError, SHARPNESS_INFINITE,
+};
 
 /// Options of [`simplify`]. Lengths are in the mesh's units; the checks are scale-invariant.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +57,11 @@ pub struct SimplifyOptions {
     /// Weight of the boundary constraint planes relative to face planes (both are multiplied by
     /// an area: face area, or boundary edge length²). Default 100.
     pub boundary_weight: f64,
+    /// Past `target_vertices`, collapses go on while their error (the RMS distance to the
+    /// accumulated planes, mesh units) stays at or below this: regions the surface spans exactly
+    /// with fewer vertices (the flat sides and straight rulings of a CAD part) lose them.
+    /// Default 0 (stop at the target).
+    pub exact_error: f64,
     /// Cancellation token, polled every 1024 candidate collapses; once cancelled,
     /// [`simplify`] returns [`SimplifyError::Interrupted`]. Default: a fresh token, never
     /// cancelled. ([`crate::initial_control_mesh`] uses [`crate::InitOptions::cancel`] instead.)
@@ -61,9 +79,19 @@ impl Default for SimplifyOptions {
             max_normal_rotation_deg: 75.0,
             min_triangle_quality: 0.02,
             boundary_weight: 100.0,
+            exact_error: 0.0,
             cancel: Cancel::default(),
         }
     }
+}
+
+/// Sharp features [`simplify_with_features`] keeps: vertex ids of the input mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FeatureLock {
+    /// Sharp edges `[a, b]` (either order); they stay edges of the output, as creases.
+    pub edges: Vec<[u32; 2]>,
+    /// Corner vertices: never removed, tagged as corners.
+    pub corners: Vec<u32>,
 }
 
 /// What [`simplify`] did.
@@ -96,6 +124,9 @@ pub struct SimplifyReport {
     /// How many times the geometric checks were relaxed because no legal collapse remained
     /// (0–2: first to 85° and 1/4 of the quality bound, then to 89° and 1/50 of it).
     pub relaxations: usize,
+    /// Candidates rejected because they would remove a corner, cut a feature curve or leave it
+    /// ([`simplify_with_features`]).
+    pub rejected_feature: usize,
 }
 
 /// Why [`simplify`] cannot run.
@@ -136,6 +167,19 @@ pub fn simplify(
     mesh: &PolyMesh,
     options: &SimplifyOptions,
 ) -> Result<(PolyMesh, SimplifyReport), SimplifyError> {
+    let (out, _, report) = simplify_with_features(mesh, &FeatureLock::default(), options)?;
+    Ok((out, report))
+}
+
+/// [`simplify`] keeping the sharp edges and corners of `features` (see the module docs): the
+/// output's surviving sharp edges and corners are returned as infinitely sharp tags
+/// ([`SHARPNESS_INFINITE`]) in the output's vertex ids. Feature edges that are not edges of
+/// the mesh, and ids out of range, are ignored.
+pub fn simplify_with_features(
+    mesh: &PolyMesh,
+    features: &FeatureLock,
+    options: &SimplifyOptions,
+) -> Result<(PolyMesh, Tags, SimplifyReport), SimplifyError> {
     if mesh.faces.is_empty() {
         return Err(SimplifyError::NoFaces);
     }
@@ -152,7 +196,7 @@ pub fn simplify(
 
     let cancel = &options.cancel;
     cancel.check()?;
-    let mut c = Collapser::new(mesh.positions.clone(), tris, options);
+    let mut c = Collapser::new(mesh.positions.clone(), tris, features, options);
     c.run(options.target_vertices, cancel)?;
     // Stuck before the target: retry the rejected collapses with relaxed geometric checks
     // (never beyond a 90° normal rotation or a zero-area face).
@@ -166,7 +210,7 @@ pub fn simplify(
         );
         c.run(options.target_vertices, cancel)?;
     }
-    Ok(c.finish())
+    Ok(c.finish(&features.corners))
 }
 
 /// Symmetric 4×4 quadric, upper triangle row by row:
@@ -230,67 +274,6 @@ fn q_minimizer(q: &Quadric) -> Option<[f64; 3]> {
     p.iter().all(|x| x.is_finite()).then_some(p)
 }
 
-/// A queued collapse (24 bytes: the heap's sift-down dominated the run time with the position
-/// stored too, so the position is recomputed when the entry is popped and still valid).
-#[derive(Clone, Copy, Debug)]
-struct Entry {
-    cost: f64,
-    keep: u32,
-    remove: u32,
-    stamp_keep: u32,
-    stamp_remove: u32,
-}
-
-/// A 4-ary max-heap of entries (by [`Entry`]'s reversed order: the top is the cheapest). Half the
-/// depth of a binary heap, and the four children share about two cache lines: the queue holds
-/// ~10 entries per collapse (lazy invalidation), far beyond the caches on large meshes.
-struct QuadHeap(Vec<Entry>);
-
-impl QuadHeap {
-    fn push(&mut self, e: Entry) {
-        let v = &mut self.0;
-        v.push(e);
-        let mut i = v.len() - 1;
-        while i > 0 {
-            let p = (i - 1) / 4;
-            if v[p] >= v[i] {
-                break;
-            }
-            v.swap(p, i);
-            i = p;
-        }
-    }
-
-    fn pop(&mut self) -> Option<Entry> {
-        let v = &mut self.0;
-        let last = v.pop()?;
-        if v.is_empty() {
-            return Some(last);
-        }
-        let top = std::mem::replace(&mut v[0], last);
-        let n = v.len();
-        let mut i = 0;
-        loop {
-            let first = 4 * i + 1;
-            if first >= n {
-                break;
-            }
-            let mut best = first;
-            for c in first + 1..(first + 4).min(n) {
-                if v[c] > v[best] {
-                    best = c;
-                }
-            }
-            if v[i] >= v[best] {
-                break;
-            }
-            v.swap(i, best);
-            i = best;
-        }
-        Some(top)
-    }
-}
-
 /// A collapse about to be checked or performed.
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
@@ -300,34 +283,13 @@ struct Candidate {
     pos: [f64; 3],
 }
 
-impl PartialEq for Entry {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Entry {
-    /// Reversed (the greatest is the cheapest), ties broken by vertex ids.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then_with(|| other.remove.cmp(&self.remove))
-            .then_with(|| other.keep.cmp(&self.keep))
-    }
-}
-
 enum Verdict {
     Ok,
     Link,
     Boundary,
     Flip,
     Degenerate,
+    Feature,
 }
 
 struct Collapser {
@@ -339,6 +301,10 @@ struct Collapser {
     face_alive: Vec<bool>,
     vfaces: Vec<Vec<u32>>,
     boundary: Vec<bool>,
+    /// Sharp-edge neighbours of each vertex (empty off the features).
+    sharp: Vec<Vec<u32>>,
+    /// Corners, darts and junctions of the features: never removed.
+    pinned: Vec<bool>,
     stamp: Vec<u32>,
     /// Whether a collapse of an edge at this vertex was rejected since its edges were last queued.
     dirty: Vec<bool>,
@@ -347,13 +313,19 @@ struct Collapser {
     min_cos: f64,
     min_quality: f64,
     min_area2: f64,
+    exact_error: f64,
     report: SimplifyReport,
     scratch_a: Vec<u32>,
     scratch_b: Vec<u32>,
 }
 
 impl Collapser {
-    fn new(pos: Vec<[f64; 3]>, tris: Vec<[u32; 3]>, options: &SimplifyOptions) -> Self {
+    fn new(
+        pos: Vec<[f64; 3]>,
+        tris: Vec<[u32; 3]>,
+        features: &FeatureLock,
+        options: &SimplifyOptions,
+    ) -> Self {
         let nv = pos.len();
         let mut vfaces = vec![Vec::new(); nv];
         for (f, t) in tris.iter().enumerate() {
@@ -404,6 +376,7 @@ impl Collapser {
                 }
             }
         }
+        let (sharp, pinned) = sharp_edges(&pos, &tris, &vfaces, features, options, &mut quad);
         let alive_vertices = vfaces.iter().filter(|f| !f.is_empty()).count();
         let report = SimplifyReport {
             vertices_before: alive_vertices,
@@ -419,6 +392,8 @@ impl Collapser {
             face_alive: vec![true; nf],
             vfaces,
             boundary,
+            sharp,
+            pinned,
             stamp: vec![0; nv],
             dirty: vec![false; nv],
             alive_vertices,
@@ -426,6 +401,7 @@ impl Collapser {
             min_cos: options.max_normal_rotation_deg.to_radians().cos(),
             min_quality: options.min_triangle_quality,
             min_area2: (1e-14 * diag2.max(f64::MIN_POSITIVE)).powi(2),
+            exact_error: options.exact_error.max(0.0),
             report,
             scratch_a: Vec::new(),
             scratch_b: Vec::new(),
@@ -452,12 +428,29 @@ impl Collapser {
         out.dedup();
     }
 
+    /// Whether removing `r` into `k` can keep the features and boundaries: `r` is not pinned,
+    /// a curve vertex goes only along its curve, a boundary vertex only along the boundary.
+    fn removable(&self, r: usize, k: u32) -> bool {
+        !self.pinned[r]
+            && (self.sharp[r].is_empty() || self.sharp[r].contains(&k))
+            && (!self.boundary[r] || self.boundary[k as usize])
+    }
+
     fn push(&mut self, a: u32, b: u32) {
         let (ai, bi) = (a as usize, b as usize);
-        let (keep, remove) = if self.boundary[bi] && !self.boundary[ai] {
-            (b, a)
-        } else {
-            (a, b)
+        let (keep, remove) = match (self.removable(bi, a), self.removable(ai, b)) {
+            (true, false) => (a, b),
+            (false, true) => (b, a),
+            // Along a curve either way: the cheaper of the two half-edge collapses.
+            (true, true) if !self.sharp[ai].is_empty() => {
+                if self.plan(bi, ai).0 < self.plan(ai, bi).0 {
+                    (b, a)
+                } else {
+                    (a, b)
+                }
+            }
+            _ if self.boundary[bi] && !self.boundary[ai] => (b, a),
+            _ => (a, b),
         };
         let (ki, ri) = (keep as usize, remove as usize);
         let (cost, _) = self.plan(ki, ri);
@@ -471,12 +464,15 @@ impl Collapser {
     }
 
     /// Cost and position of the collapse `remove → keep`: the quadric minimizer (near the
-    /// edge), else the best of the endpoints and the midpoint; the boundary endpoint when only
-    /// one is on the boundary.
+    /// edge), else the best of the endpoints and the midpoint; the kept vertex's position when
+    /// only one is on the boundary or either is on a feature curve.
     fn plan(&self, ki: usize, ri: usize) -> (f64, [f64; 3]) {
         let mut q = self.quad[ki];
         add_q(&mut q, &self.quad[ri]);
-        let pos = if self.boundary[ki] != self.boundary[ri] {
+        let pos = if self.boundary[ki] != self.boundary[ri]
+            || !self.sharp[ki].is_empty()
+            || !self.sharp[ri].is_empty()
+        {
             self.pos[ki]
         } else {
             let (pa, pb) = (self.pos[ki], self.pos[ri]);
@@ -513,11 +509,13 @@ impl Collapser {
         }
     }
 
-    /// Collapses cheapest first until `target` vertices remain or the heap is empty; polls
+    /// Collapses cheapest first until `target` vertices remain (then on, with
+    /// [`SimplifyOptions::exact_error`], only collapses within it) or the heap is empty; polls
     /// `cancel` every [`COLLAPSE_BATCH`] candidates.
     fn run(&mut self, target: usize, cancel: &Cancel) -> Result<(), Cancelled> {
         let mut examined = 0usize;
-        while self.alive_vertices > target {
+        let exact2 = self.exact_error * self.exact_error;
+        while self.alive_vertices > target || exact2 > 0.0 {
             if examined % COLLAPSE_BATCH == 0 {
                 cancel.check()?;
             }
@@ -532,6 +530,14 @@ impl Collapser {
                 continue;
             }
             let (cost, pos) = self.plan(k, r);
+            if self.alive_vertices <= target {
+                // Past the target: only collapses that keep the surface where it is.
+                let mut q = self.quad[k];
+                add_q(&mut q, &self.quad[r]);
+                if cost > exact2 * q_weight(&q) {
+                    continue;
+                }
+            }
             let mut c = Candidate {
                 cost,
                 keep: e.keep,
@@ -542,6 +548,8 @@ impl Collapser {
             if self.report.relaxations > 0
                 && matches!(verdict, Verdict::Flip | Verdict::Degenerate)
                 && self.boundary[k] == self.boundary[r]
+                && self.sharp[k].is_empty()
+                && self.sharp[r].is_empty()
             {
                 // Stuck: try the half-edge collapses, which leave one endpoint where it is.
                 let mut q = self.quad[k];
@@ -561,6 +569,7 @@ impl Collapser {
                 Verdict::Boundary => self.report.rejected_boundary += 1,
                 Verdict::Flip => self.report.rejected_flip += 1,
                 Verdict::Degenerate => self.report.rejected_degenerate += 1,
+                Verdict::Feature => self.report.rejected_feature += 1,
             }
             if !matches!(verdict, Verdict::Ok) {
                 self.dirty[k] = true;
@@ -588,6 +597,17 @@ impl Collapser {
     }
 
     fn check(&mut self, k: u32, r: u32, p: [f64; 3]) -> Verdict {
+        if !self.removable(r as usize, k) {
+            return Verdict::Feature;
+        }
+        // Along a curve: its next vertex must not already be the kept one's sharp neighbour
+        // (a closed curve of three would fold onto one edge).
+        if let [x, y] = self.sharp[r as usize][..] {
+            let next = if x == k { y } else { x };
+            if self.sharp[k as usize].contains(&next) {
+                return Verdict::Feature;
+            }
+        }
         let (opp, n_opp) = self.edge_opposites(k, r);
         if n_opp == 0 || n_opp > 2 {
             return Verdict::Link;
@@ -724,6 +744,13 @@ impl Collapser {
                 self.vfaces[ki].push(f);
             }
         }
+        for c in std::mem::take(&mut self.sharp[ri]) {
+            self.sharp[c as usize].retain(|&x| x != r);
+            if c != k {
+                self.sharp[c as usize].push(k);
+                self.sharp[ki].push(c);
+            }
+        }
         let q_r = self.quad[ri];
         add_q(&mut self.quad[ki], &q_r);
         self.pos[ki] = c.pos;
@@ -758,7 +785,7 @@ impl Collapser {
         self.scratch_b = ring;
     }
 
-    fn finish(self) -> (PolyMesh, SimplifyReport) {
+    fn finish(self, corners: &[u32]) -> (PolyMesh, Tags, SimplifyReport) {
         let mut map = vec![u32::MAX; self.pos.len()];
         let mut positions = Vec::with_capacity(self.alive_vertices);
         let mut tris = Vec::new();
@@ -776,14 +803,86 @@ impl Collapser {
             });
             tris.push(t);
         }
+        let mut tags = Tags::new();
+        for (v, around) in self.sharp.iter().enumerate() {
+            for &u in around {
+                let (a, b) = (map[v], map[u as usize]);
+                if (v as u32) < u && a != u32::MAX && b != u32::MAX {
+                    tags.set_crease(a, b, SHARPNESS_INFINITE);
+                }
+            }
+        }
+        for &c in corners {
+            if let Some(&m) = map.get(c as usize).filter(|&&m| m != u32::MAX) {
+                tags.set_corner(m, SHARPNESS_INFINITE);
+            }
+        }
         let mut report = self.report;
         report.vertices_after = positions.len();
         report.faces_after = tris.len();
         (
             PolyMesh::new(positions, Polygons::from_triangles(&tris)),
+            tags,
             report,
         )
     }
+}
+
+/// The sharp-edge neighbours of every vertex (the feature edges that are mesh edges) and the
+/// pinned vertices (corners, and feature vertices without exactly two sharp edges); adds each
+/// sharp edge's constraint planes (through the edge, perpendicular to each of its faces,
+/// weighted as boundary edges) to the quadrics of its ends.
+fn sharp_edges(
+    pos: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    vfaces: &[Vec<u32>],
+    features: &FeatureLock,
+    options: &SimplifyOptions,
+    quad: &mut [Quadric],
+) -> (Vec<Vec<u32>>, Vec<bool>) {
+    let nv = pos.len();
+    let mut sharp: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    let mut pinned = vec![false; nv];
+    for &[a, b] in &features.edges {
+        let (ai, bi) = (a as usize, b as usize);
+        if a == b || ai >= nv || bi >= nv || sharp[ai].contains(&b) {
+            continue;
+        }
+        let faces: Vec<u32> = vfaces[ai]
+            .iter()
+            .copied()
+            .filter(|&f| tris[f as usize].contains(&b))
+            .collect();
+        if faces.is_empty() {
+            continue;
+        }
+        sharp[ai].push(b);
+        sharp[bi].push(a);
+        let e = sub(pos[bi], pos[ai]);
+        for f in faces {
+            let [p0, p1, p2] = tris[f as usize].map(|v| pos[v as usize]);
+            let m = cross(e, cross(sub(p1, p0), sub(p2, p0)));
+            let ml = norm(m);
+            if ml > 0.0 {
+                let q = plane_quadric(
+                    scale(m, 1.0 / ml),
+                    pos[ai],
+                    options.boundary_weight * dot(e, e),
+                );
+                add_q(&mut quad[ai], &q);
+                add_q(&mut quad[bi], &q);
+            }
+        }
+    }
+    for &c in &features.corners {
+        if let Some(p) = pinned.get_mut(c as usize) {
+            *p = true;
+        }
+    }
+    for (p, s) in pinned.iter_mut().zip(&sharp) {
+        *p |= !s.is_empty() && s.len() != 2;
+    }
+    (sharp, pinned)
 }
 
 /// `4√3·A / Σ l²` with `2A = area2`.
@@ -801,32 +900,6 @@ fn quality(p: &[[f64; 3]; 3], area2: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn quad_heap_pops_cheapest_first_with_id_ties() {
-        let mut h = QuadHeap(Vec::new());
-        let mut x: u64 = 12345;
-        let mut costs = Vec::new();
-        for i in 0..1000u32 {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let cost = (x >> 40) as f64 % 97.0;
-            costs.push((cost, i));
-            h.push(Entry {
-                cost,
-                keep: 0,
-                remove: i,
-                stamp_keep: 0,
-                stamp_remove: 0,
-            });
-        }
-        costs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let popped: Vec<(f64, u32)> = std::iter::from_fn(|| h.pop())
-            .map(|e| (e.cost, e.remove))
-            .collect();
-        assert_eq!(popped, costs);
-    }
 
     #[test]
     fn quadric_minimizer_of_three_planes_is_their_corner() {
