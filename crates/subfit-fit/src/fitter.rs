@@ -157,7 +157,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 Some((sop, tris))
             }
         };
-        let lap = Laplacian::umbrella(faces, num_vertices);
+        let lap = Laplacian::umbrella_tagged(faces, num_vertices, &options.tags);
         let block = if term.isotropic() { 1 } else { 3 };
         let pattern = Pattern::new(&op.position, &lap, block);
         let values = vec![0.0; pattern.nnz()];

@@ -668,7 +668,9 @@ fn flip_pass(
     unmet: (bool, bool),
     base: &FitOptions,
 ) -> Result<(usize, usize), FitError> {
-    let flips = independent_flips(&mesh.faces, mesh.num_vertices(), score, 1.0);
+    let mut flips = independent_flips(&mesh.faces, mesh.num_vertices(), score, 1.0);
+    // A crease stays where the features put it.
+    flips.retain(|f| base.tags.crease(f.a, f.b) == 0.0);
     if flips.is_empty() {
         return Ok((0, 0));
     }
