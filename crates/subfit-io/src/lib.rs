@@ -406,6 +406,28 @@ pub fn write_usda_file(
     write_atomic(path, &out)
 }
 
+/// Writes a control cage as OBJ with its crease and corner tags as OpenSubdiv `t` statements
+/// ([`obj::write_with_tags`]), atomically.
+pub fn write_obj_with_tags_file(
+    path: &Path,
+    mesh: &PolyMesh,
+    tags: &subfit_mesh::Tags,
+) -> Result<()> {
+    check_writable(mesh, Format::Obj, &WriteOptions::default(), path)?;
+    let mut out = Vec::new();
+    obj::write_with_tags(mesh, tags, &mut out).map_err(|e| Error::file(path, ErrorKind::Io(e)))?;
+    write_atomic(path, &out)
+}
+
+/// The crease and corner tags stored with a control mesh of `num_vertices` vertices: an OBJ
+/// file's `t crease`/`t corner` statements ([`obj::read_tags`]); no tags for other formats.
+pub fn read_tags_file(path: &Path, num_vertices: usize) -> Result<subfit_mesh::Tags> {
+    if Format::from_path(path) != Some(Format::Obj) {
+        return Ok(subfit_mesh::Tags::new());
+    }
+    obj::read_tags(&read_all(path)?, path, num_vertices)
+}
+
 /// Writes an animated control cage as USDA (see [`usda::write_animated`]) atomically:
 /// `frames` holds the points of each frame (`N` frames of `#V by 3`), played at `fps` frames
 /// per second.

@@ -20,6 +20,12 @@
 //! normals are dropped. When no corner refers to a normal and there are exactly as many `vn` as
 //! `v` (a point cloud with normals), they are paired in order.
 //!
+//! Tags: OpenSubdiv's OBJ tag statements (the `t` lines of its `shape_utils` reader and of
+//! Hbr's test shapes), `t crease 2/1/0 a b sharpness` and `t corner 1/1/0 v sharpness` with
+//! 0-based vertex indices, are read by [`read_tags`] and written by [`write_with_tags`]; the
+//! mesh reader skips `t` lines. Blender's OBJ importer ignores them (it reads control.usda's
+//! creases).
+//!
 //! Dropped: texture coordinates, groups, materials, smoothing groups, lines, points, free-form
 //! geometry. A file without any `v` is [`ErrorKind::Empty`].
 //!
@@ -28,7 +34,7 @@
 
 use std::path::Path;
 
-use subfit_mesh::{PolyMesh, Polygons};
+use subfit_mesh::{PolyMesh, Polygons, Tags};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{parse_int, push_f64_exact, push_u64, syntax, unit_to_u8, NumberedLines};
@@ -38,6 +44,7 @@ const NONE: u32 = u32::MAX;
 
 /// Statements that are read and ignored.
 const IGNORED: &[&str] = &[
+    "t",
     "l",
     "p",
     "o",
@@ -568,6 +575,74 @@ pub fn write(mesh: &PolyMesh, out: &mut Vec<u8>) -> std::io::Result<()> {
         out.push(b'\n');
     }
     Ok(())
+}
+
+/// [`write`] followed by the crease and corner tags as OpenSubdiv `t` statements (see the
+/// module documentation).
+pub fn write_with_tags(mesh: &PolyMesh, tags: &Tags, out: &mut Vec<u8>) -> std::io::Result<()> {
+    write(mesh, out)?;
+    for ((a, b), s) in tags.creases() {
+        out.extend_from_slice(format!("t crease 2/1/0 {a} {b} {s}\n").as_bytes());
+    }
+    for (v, s) in tags.corners() {
+        out.extend_from_slice(format!("t corner 1/1/0 {v} {s}\n").as_bytes());
+    }
+    Ok(())
+}
+
+/// The `t crease` and `t corner` tags of an OBJ file (other `t` tags and every other
+/// statement are skipped; see the module documentation). Errors name the line: a malformed
+/// count triple, missing or non-numeric arguments, a negative or non-finite sharpness, a
+/// vertex index beyond `num_vertices`.
+pub fn read_tags(bytes: &[u8], path: &Path, num_vertices: usize) -> Result<Tags> {
+    let mut tags = Tags::new();
+    for (no, raw) in NumberedLines::new(bytes) {
+        let line = strip_comment(utf8_line(raw, no, path)?);
+        let mut tok = line.split_ascii_whitespace();
+        if tok.next() != Some("t") {
+            continue;
+        }
+        let name = tok.next().unwrap_or_default();
+        let wanted = match name {
+            "crease" => 2,
+            "corner" => 1,
+            _ => continue,
+        };
+        let bad = |what: &str, t: &str| syntax(path, no, what, t.as_bytes());
+        let counts = tok.next().unwrap_or_default();
+        let n: Vec<usize> = counts
+            .split('/')
+            .map(|c| c.parse::<usize>())
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|_| bad("expected int/float/string counts", counts))?;
+        if n.len() != 3 || n[0] != wanted || n[1] != 1 {
+            return Err(bad(
+                &format!("expected {wanted}/1/0 for a {name} tag"),
+                counts,
+            ));
+        }
+        let mut ids = [0u32; 2];
+        for id in ids.iter_mut().take(wanted) {
+            let t = tok.next().unwrap_or_default();
+            *id = t
+                .parse::<u32>()
+                .ok()
+                .filter(|&v| (v as usize) < num_vertices)
+                .ok_or_else(|| bad(&format!("expected a vertex index below {num_vertices}"), t))?;
+        }
+        let t = tok.next().unwrap_or_default();
+        let sharpness = t
+            .parse::<f64>()
+            .ok()
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .ok_or_else(|| bad("expected a sharpness ≥ 0", t))?;
+        if wanted == 2 {
+            tags.set_crease(ids[0], ids[1], sharpness);
+        } else {
+            tags.set_corner(ids[0], sharpness);
+        }
+    }
+    Ok(tags)
 }
 
 fn push_line(out: &mut Vec<u8>, kw: &[u8], v: &[f64; 3]) {
