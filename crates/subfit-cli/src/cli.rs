@@ -73,6 +73,9 @@ pub struct InitArgs {
     /// Keep the cage all triangles.
     #[arg(long)]
     pub no_quad_dominant: bool,
+    /// Sharp features of a mesh target (tags are written only into an .obj output).
+    #[command(flatten)]
+    pub features: FeatureArgs,
     /// The scheme the cage is for: `catmull-clark` and `quad-tri` make it quad-dominant unless
     /// `--no-quad-dominant`; `loop` and `auto` keep triangles.
     #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
@@ -316,10 +319,37 @@ pub struct FitArgs {
     /// Keep the cage all triangles (see `--quad-dominant`).
     #[arg(long)]
     pub no_quad_dominant: bool,
+    /// Sharp features of a mesh target.
+    #[command(flatten)]
+    pub features: FeatureArgs,
     /// Output directory (control.obj, control.usda, limit.ply, error.ply, log.csv,
     /// report.json).
     #[arg(short, long, default_value = "subfit-fit")]
     pub output: PathBuf,
+}
+
+/// Sharp features of mesh targets, for `fit` and `init`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct FeatureArgs {
+    /// Mesh targets: dihedral angle (degrees) from which an edge of the data is a sharp
+    /// feature. The initial cage keeps the feature curves as edges tagged as infinitely sharp
+    /// creases, and their corners as corners (control.usda; control.obj as OpenSubdiv `t`
+    /// lines).
+    #[arg(long, default_value_t = 40.0, value_parser = feature_angle)]
+    pub feature_angle: f64,
+    /// A smooth cage for a mesh target: no feature detection, no crease or corner tags.
+    #[arg(long)]
+    pub no_features: bool,
+}
+
+impl FeatureArgs {
+    /// The library's feature options (`None`: off).
+    pub fn options(&self) -> Option<subfit::target::FeatureOptions> {
+        (!self.no_features).then(|| subfit::target::FeatureOptions {
+            angle_deg: self.feature_angle,
+            ..subfit::target::FeatureOptions::default()
+        })
+    }
 }
 
 /// `subfit sequence`.
@@ -375,6 +405,18 @@ pub struct SequenceArgs {
     /// Output directory (frame_0000.obj …, sequence.usda, report.json).
     #[arg(short, long, default_value = "subfit-sequence")]
     pub output: PathBuf,
+}
+
+/// Parses a feature angle: degrees in `(0, 180)`.
+fn feature_angle(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v > 0.0 && v < 180.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{v}: a dihedral angle in degrees, between 0 and 180 (exclusive)"
+        ))
+    }
 }
 
 /// `--quad-dominant` / `--no-quad-dominant` as the library's `Option<bool>` (`None`: neither).

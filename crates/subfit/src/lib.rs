@@ -37,7 +37,9 @@ pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use outputs::{log_csv, OUTPUTS};
 pub use pipeline_report::Report;
-pub use scan::{fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
+pub use scan::{
+    fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
+};
 pub use sequence::{
     fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence,
     SequenceFrame, SequenceOptions, SequenceOptionsSummary, SequenceReport, SilhouetteOptions,

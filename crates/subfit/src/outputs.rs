@@ -1,6 +1,6 @@
 //! The files a fit writes, in the input's coordinates ([`OUTPUTS`], in the order a front end
-//! moves them into place, the report last): the cage as OBJ and as a UsdGeom Mesh with its
-//! scheme and tags, the limit tessellation with normals, the same coloured by the distance to
+//! moves them into place, the report last): the cage as OBJ (crease and corner tags as
+//! OpenSubdiv `t` statements) and as a UsdGeom Mesh with its scheme and tags, the limit tessellation with normals, the same coloured by the distance to
 //! the target (Cheng 2007 §IV-D colours), the per-iteration log, the page a person looks at
 //! (`report.html`, [`crate::html_report`]) and the report.
 
@@ -41,14 +41,9 @@ impl Fitted {
     /// cancelled (checked before each file).
     pub fn write_into(&mut self, dir: &Path) -> Result<(), Error> {
         let t = Instant::now();
-        let ascii = WriteOptions {
-            format: None,
-            encoding: Encoding::Ascii,
-            single_precision: false,
-        };
         let check = || self.cancel.check().map_err(|_| Error::Interrupted);
         check()?;
-        subfit_io::write_file(&dir.join("control.obj"), &self.cage, &ascii)?;
+        subfit_io::write_obj_with_tags_file(&dir.join("control.obj"), &self.cage, &self.tags)?;
         let usd_scheme = usd_scheme(self.scheme);
         let usd_boundary = usd_boundary(self.fit.boundary);
         check()?;

@@ -137,8 +137,27 @@ pub struct InitSummary {
     /// or a given cage).
     #[serde(default)]
     pub contour_faces_trimmed: usize,
+    /// Mesh targets with feature detection on: the target's sharp features, which the cage
+    /// keeps as crease and corner tags (`subfit_target::detect_features`). `None` otherwise.
+    #[serde(default)]
+    pub features: Option<FeatureSummary>,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
+}
+
+/// A mesh target's sharp features ([`InitSummary::features`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FeatureSummary {
+    /// The feature angle used (degrees).
+    pub angle_deg: f64,
+    /// Sharp edges of the target.
+    pub edges: usize,
+    /// Feature curves.
+    pub curves: usize,
+    /// Corners.
+    pub corners: usize,
+    /// Darts (curve ends in smooth regions).
+    pub darts: usize,
 }
 
 /// Quads and triangles of `faces`, and the fraction of quads (0 without faces). Cost `O(F)`.

@@ -17,10 +17,11 @@ use subfit_fit::{
 };
 use subfit_init::{
     default_control_points, initial_control_mesh, pair_triangles, InitOptions, InitReport,
+    SimplifyOptions,
 };
 use subfit_mesh::{reorient_faces, Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
-use subfit_target::{Target, TargetOptions};
+use subfit_target::{FeatureOptions, Target, TargetOptions};
 
 use crate::error::Error;
 use subfit_report::{
@@ -28,9 +29,9 @@ use subfit_report::{
 };
 
 use crate::pipeline_report::{
-    face_counts, BoundaryLoops, Errors, FinalErrors, InitSummary, InitTimings, IterationSummary,
-    OptionsSummary, Reorientation, Report, RmsMax, StageSummary, TagCounts, TessellationSummary,
-    Timings, Topology, TwoSidedErrors, UsdDifference,
+    face_counts, BoundaryLoops, Errors, FeatureSummary, FinalErrors, InitSummary, InitTimings,
+    IterationSummary, OptionsSummary, Reorientation, Report, RmsMax, StageSummary, TagCounts,
+    TessellationSummary, Timings, Topology, TwoSidedErrors, UsdDifference,
 };
 
 /// The scan to fit.
@@ -125,12 +126,24 @@ impl Default for FitScanOptions {
             },
             stages: StageOptions::default(),
             target: TargetOptions::default(),
-            init_options: InitOptions::default(),
+            init_options: InitOptions {
+                features: Some(FeatureOptions::default()),
+                simplify: SimplifyOptions {
+                    exact_error: EXACT_ERROR,
+                    ..SimplifyOptions::default()
+                },
+                ..InitOptions::default()
+            },
             error_scale: None,
             cancel: Cancel::default(),
         }
     }
 }
+
+/// The automatic cage's simplification goes on past the default control-point count while its
+/// collapses move the surface by at most this (unit cube): the flat sides and straight rulings
+/// of a CAD part keep only the vertices their shape needs (an open box: its corners).
+pub const EXACT_ERROR: f64 = 1e-6;
 
 /// A step of [`fit_scan`], for progress display.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -239,6 +252,10 @@ pub fn fit_scan(
     // what topology to aim for.
     let mut init_options = options.init_options.clone();
     init_options.cancel = options.cancel.clone();
+    if options.control_points.is_some() {
+        // The count asked for is the count given.
+        init_options.simplify.exact_error = 0.0;
+    }
     // Catmull-Clark and quad/triangle cages start quad-dominant; Loop needs triangles.
     init_options.quad_dominant = options
         .quad_dominant
@@ -336,6 +353,7 @@ pub fn fit_scan(
                 },
                 cloud_open: false,
                 contour_faces_trimmed: 0,
+                features: None,
                 timings_s: InitTimings {
                     pair: t_pair.elapsed().as_secs_f64(),
                     total: t_pair.elapsed().as_secs_f64(),
@@ -379,8 +397,8 @@ pub fn fit_scan(
                     &mut progress,
                 );
             }
-            let summary = init_summary(&r, n, &m);
-            (m, Tags::new(), summary)
+            let summary = init_summary(&r, n, &m, init_options.features.as_ref());
+            (m, r.tags.clone(), summary)
         }
     };
     let init_time = t_init.elapsed().as_secs_f64();
@@ -776,7 +794,12 @@ fn topology(m: &PolyMesh) -> Result<Topology, subfit_mesh::TopologyError> {
     })
 }
 
-fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
+fn init_summary(
+    r: &InitReport,
+    requested: usize,
+    m: &PolyMesh,
+    features: Option<&FeatureOptions>,
+) -> InitSummary {
     let (quads, triangles, quad_fraction) = face_counts(&m.faces);
     InitSummary {
         source: format!("{:?}", r.source),
@@ -797,6 +820,13 @@ fn init_summary(r: &InitReport, requested: usize, m: &PolyMesh) -> InitSummary {
         },
         cloud_open: r.cloud_open(),
         contour_faces_trimmed: r.trim.as_ref().map_or(0, |t| t.faces_trimmed),
+        features: r.features.zip(features).map(|(f, o)| FeatureSummary {
+            angle_deg: o.angle_deg,
+            edges: f.edges,
+            curves: f.curves,
+            corners: f.corners,
+            darts: f.darts,
+        }),
         timings_s: InitTimings {
             contour: r.timings.contour.as_secs_f64(),
             simplify: r.timings.simplify.as_secs_f64(),

@@ -14,7 +14,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context};
 use rayon::prelude::*;
 use serde::Serialize;
-use subfit::mesh::{PolyMesh, Tags};
+use subfit::mesh::PolyMesh;
 use subfit::report::data_samples::area_samples;
 use subfit::report::DistanceStats;
 use subfit::subdiv::{random_samples, ClosestOptions, ClosestPointFinder, Evaluator, Options};
@@ -75,8 +75,9 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         let ctx = || format!("{}: cannot evaluate its limit surface", a.a.display());
         let options = Options::new(pick_scheme(scheme, &ma));
         shown_a_options = Some(options);
-        let ev = Evaluator::new(&ma.faces, ma.num_vertices(), &Tags::new(), &options)
-            .with_context(ctx)?;
+        // The cage's own creases and corners (an OBJ's `t` lines, as control.obj has them).
+        let tags = subfit::io::read_tags_file(&a.a, ma.num_vertices())?;
+        let ev = Evaluator::new(&ma.faces, ma.num_vertices(), &tags, &options).with_context(ctx)?;
         let (_, points) =
             random_samples(&ev, &ma.positions, a.samples as usize, a.seed).with_context(ctx)?;
         let finder = ClosestPointFinder::new(&ev, &ma.positions, ClosestOptions::default())

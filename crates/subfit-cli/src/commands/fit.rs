@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use subfit::fit::{FitOptions, Method, StageOptions, StepControl};
+use subfit::init::InitOptions;
 use subfit::subdiv::Scheme;
 use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, OUTPUTS};
 
@@ -46,9 +47,11 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
                 path.display()
             );
         }
+        // Creases and corners come with an OBJ cage as OpenSubdiv `t` lines.
+        let tags = subfit::io::read_tags_file(&path, mesh.num_vertices())?;
         InitialCage::Given {
             mesh,
-            tags: subfit::mesh::Tags::new(),
+            tags,
             name: path.display().to_string(),
         }
     };
@@ -90,6 +93,10 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             ..StageOptions::default()
         },
         error_scale: a.error_scale,
+        init_options: InitOptions {
+            features: a.features.options(),
+            ..FitScanOptions::default().init_options
+        },
         ..FitScanOptions::default()
     })
 }

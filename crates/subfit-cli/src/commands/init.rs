@@ -89,6 +89,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
                 crate::cli::SchemeArg::CatmullClark | crate::cli::SchemeArg::QuadTri
             )),
         cancel: crate::interrupt::token(),
+        features: a.features.options(),
         ..InitOptions::default()
     };
     let sp = crate::progress::spinner(if use_mesh {
@@ -125,7 +126,19 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         single_precision: false,
     };
     crate::interrupt::watch_dir(&a.output);
-    subfit::io::write_file(&a.output, &out, &wopts)?;
+    if subfit::io::Format::from_path(&a.output) == Some(subfit::io::Format::Obj) {
+        subfit::io::write_obj_with_tags_file(&a.output, &out, &report.tags)?;
+    } else {
+        if !report.tags.is_empty() {
+            eprintln!(
+                "subfit: warning: {} has no place for the cage's {} crease and {} corner tags (write .obj to keep them)",
+                a.output.display(),
+                report.tags.creases().len(),
+                report.tags.corners().len()
+            );
+        }
+        subfit::io::write_file(&a.output, &out, &wopts)?;
+    }
     let write_time = t.elapsed();
 
     print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
