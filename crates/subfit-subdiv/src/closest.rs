@@ -191,7 +191,10 @@ impl<'a> ClosestPointFinder<'a> {
     }
 
     /// The starting guess for `q`: parameters of the nearest tessellation point.
-    fn start(&self, q: [f64; 3]) -> Option<SurfaceParam> {
+    /// Starting parameters: the nearest tessellation point, then (for a search that gets stuck)
+    /// the corners of its triangle and the centre of its patch; all moved slightly towards the
+    /// centre, off the patch corners where the parametrisation may be singular.
+    fn starts(&self, q: [f64; 3]) -> Option<[SurfaceParam; 5]> {
         let n = self.bvh.closest(q)?;
         let ps = &self.tri_params[n.triangle as usize];
         let (mut u, mut v) = (0.0, 0.0);
@@ -199,18 +202,24 @@ impl<'a> ClosestPointFinder<'a> {
             u += w * p.u;
             v += w * p.v;
         }
-        // Start off the patch corners, where the parametrisation may be singular.
         let (cu, cv) = if self.ev.triangle_patch(ps[0].face) {
             (1.0 / 3.0, 1.0 / 3.0)
         } else {
             (0.5, 0.5)
         };
         let e = 1e-3;
-        Some(SurfaceParam {
+        let at = |u: f64, v: f64| SurfaceParam {
             u: u + e * (cu - u),
             v: v + e * (cv - v),
             ..ps[0]
-        })
+        };
+        Some([
+            at(u, v),
+            at(ps[0].u, ps[0].v),
+            at(ps[1].u, ps[1].v),
+            at(ps[2].u, ps[2].v),
+            at(cu, cv),
+        ])
     }
 
     fn eval(&self, p: SurfaceParam) -> Result<SurfacePoint, EvalError> {
@@ -240,10 +249,28 @@ impl<'a> ClosestPointFinder<'a> {
     /// Errors: evaluation failures (none are expected for a valid mesh); an empty mesh gives
     /// [`EvalError::FaceOutOfRange`].
     pub fn closest(&self, q: [f64; 3]) -> Result<ClosestPoint, EvalError> {
-        let mut p = self.start(q).ok_or(EvalError::FaceOutOfRange {
+        let starts = self.starts(q).ok_or(EvalError::FaceOutOfRange {
             face: 0,
             num_faces: 0,
         })?;
+        let mut best = self.descend(q, starts[0])?;
+        // Stuck short of a stationary point (at a crease or a singular corner of the
+        // parametrisation): try again from the other corners of the starting triangle and the
+        // patch's centre, and keep the nearest point found.
+        for &p in &starts[1..] {
+            if best.converged {
+                break;
+            }
+            let c = self.descend(q, p)?;
+            if c.distance < best.distance || (c.converged && c.distance <= best.distance) {
+                best = c;
+            }
+        }
+        Ok(best)
+    }
+
+    /// The descent of [`Self::closest`] from the parameters `p`.
+    fn descend(&self, q: [f64; 3], mut p: SurfaceParam) -> Result<ClosestPoint, EvalError> {
         let mut s = self.eval(p)?;
         let mut f = half_norm2(sub(s.position, q));
         let mut mu = 0.0f64;

@@ -235,3 +235,61 @@ fn open_grid_boundary_closest_points_converge() {
         );
     }
 }
+
+/// A washer-like Loop cage: four rings (inner and outer radius, bottom and top) of `counts`
+/// vertices, neighbouring rings joined by triangles advancing along whichever ring is behind
+/// (irregular valences where the counts differ), the four ring loops creased (a CAD part's
+/// sharp rims, the cage a fit writes for them).
+fn creased_washer(counts: [usize; 4]) -> (Vec<[f64; 3]>, Polygons, Tags) {
+    let rings = [(0.45, 0.0), (1.0, 0.0), (1.0, 0.5), (0.45, 0.5)];
+    let mut pos = Vec::new();
+    let mut start = [0usize; 4];
+    for (k, &(r, z)) in rings.iter().enumerate() {
+        start[k] = pos.len();
+        for i in 0..counts[k] {
+            let t = 2.0 * std::f64::consts::PI * (i as f64 + 0.3 * k as f64) / counts[k] as f64;
+            pos.push([r * t.cos(), r * t.sin(), z]);
+        }
+    }
+    let id = |ring: usize, i: usize| (start[ring] + i % counts[ring]) as u32;
+    let angle = |ring: usize, i: usize| (i as f64 + 0.3 * ring as f64) / counts[ring] as f64;
+    let mut tris = Vec::new();
+    let mut tags = Tags::new();
+    for a in 0..4 {
+        let b = (a + 1) % 4;
+        let (mut i, mut j) = (0, 0);
+        while i < counts[a] || j < counts[b] {
+            let advance_a = j >= counts[b] || (i < counts[a] && angle(a, i + 1) <= angle(b, j + 1));
+            if advance_a {
+                tris.push([id(a, i), id(b, j), id(a, i + 1)]);
+                i += 1;
+            } else {
+                tris.push([id(a, i), id(b, j), id(b, j + 1)]);
+                j += 1;
+            }
+        }
+        for i in 0..counts[a] {
+            tags.set_crease(id(a, i), id(a, i + 1), 10.0);
+        }
+    }
+    (pos, Polygons::from_triangles(&tris), tags)
+}
+
+#[test]
+fn near_a_crease_the_search_never_ends_farther_than_a_known_surface_point() {
+    let (pos, faces, tags) = creased_washer([11, 37, 29, 13]);
+    let ev = Evaluator::new(&faces, pos.len(), &tags, &Options::new(Scheme::Loop)).unwrap();
+    let finder = ClosestPointFinder::new(&ev, &pos, ClosestOptions::default()).unwrap();
+    let params = ev.random_params(4000, 7);
+    let points = ev.evaluate_batch(&pos, &params).unwrap();
+    let mut worst: f64 = 0.0;
+    for (k, s) in points.iter().enumerate() {
+        // Just off the surface, on either side: the known point is 1e-3 away.
+        let side = if k % 2 == 0 { 1e-3 } else { -1e-3 };
+        let q: [f64; 3] = std::array::from_fn(|c| s.position[c] + side * s.normal[c]);
+        let c = finder.closest(q).unwrap();
+        worst = worst.max(c.distance - 1e-3);
+    }
+    println!("creased washer: closest distance at most {worst:.2e} beyond the known point's");
+    assert!(worst <= 1e-9, "{worst}");
+}
