@@ -142,11 +142,16 @@ impl<'t> FootPointTerm<'t> {
     }
 
     /// The term `options` name ([`FitOptions::method`], [`FitOptions::foot_points`], and
-    /// [`FitOptions::coverage`] > 0 adds the data → surface part).
+    /// [`FitOptions::coverage`] > 0 adds the data → surface part, with
+    /// [`FitOptions::feature_segments`] fitted by the creases).
     pub fn from_options(target: &'t Target, options: &FitOptions) -> Self {
         let term = Self::new(target, options.method, options.foot_points);
         if options.coverage > 0.0 {
-            term.with_coverage(options.coverage)
+            let mut term = term.with_coverage(options.coverage);
+            if let Some(f) = &options.feature_segments {
+                term.coverage = term.coverage.take().map(|c| c.with_features(f));
+            }
+            term
         } else {
             term
         }

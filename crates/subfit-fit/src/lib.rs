@@ -73,7 +73,7 @@ mod term;
 
 pub use any_term::{AnySample, AnyTerm};
 pub use arap::Arap;
-pub use coverage::{CoverSum, Coverage};
+pub use coverage::{CoverSum, Coverage, FEATURE_WEIGHT};
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
 pub use foot_point_term::{FootPointSource, FootPointTerm, FootSample};

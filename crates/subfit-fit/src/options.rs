@@ -174,6 +174,11 @@ pub struct FitOptions {
     /// Dimensionless, ≥ 0. Default 0 (off: the papers' one-sided objective, as in the
     /// convergence studies); `subfit::fit_scan` turns it on (1).
     pub coverage: f64,
+    /// The data's sharp feature curves as segments (normalized units), e.g. the sharp edges
+    /// [`subfit_target::detect_features`] finds on a mesh target: with [`Self::coverage`] > 0
+    /// they pull the creases of the limit surface onto them ([`crate::Coverage::with_features`]).
+    /// Default `None`; `subfit::fit_scan` sets the features its initial cage was built along.
+    pub feature_segments: Option<Arc<Vec<[[f64; 3]; 2]>>>,
     /// [`Method::Imls`]: the kernel support radius `h` (normalized units, the unit cube the
     /// target is scaled into — the units of Xie et al. 2023 §5.1's `h₀`). Default `None`:
     /// chosen from the target ([`crate::ImlsTerm::auto_radius`]: half the point spacing, at
@@ -235,6 +240,7 @@ impl Default for FitOptions {
             pcg_max_iterations: 500,
             foot_points: FootPointSource::Auto,
             coverage: 0.0,
+            feature_segments: None,
             imls_radius: None,
             imls_tangential: 0.0,
             arap: 0.0,

@@ -239,3 +239,79 @@ fn stages_reach_the_two_sided_tolerance_on_an_open_patch() {
 fn boundary_gap_of(target: &Target, mesh: &PolyMesh) -> f64 {
     boundary_gap(target, mesh, &mesh.positions)
 }
+
+/// The feature-curve part ([`subfit_fit::Coverage::with_features`], through
+/// `FitOptions::feature_segments`): on a creased cube cage, whose limit is the cube itself, data
+/// feature curves offset by `δ` from its edges add `FEATURE_WEIGHT · m · δ²` to the objective
+/// share (each curve point `δ` from the crease line it pulls), all of it on crease samples.
+#[test]
+fn feature_curves_pull_the_creases_perpendicular_to_them() {
+    use std::sync::Arc;
+    use subfit_fit::FEATURE_WEIGHT;
+    use subfit_mesh::shapes::{cube_mesh, gridded_box};
+    use subfit_mesh::{Tags, SHARPNESS_INFINITE};
+
+    let target = Target::from_mesh(&gridded_box(8, false), &TargetOptions::default()).unwrap();
+    let cube = cube_mesh(0.5);
+    let positions: Vec<[f64; 3]> = cube
+        .positions
+        .iter()
+        .map(|p| target.to_normalized(p.map(|c| c + 0.5)))
+        .collect();
+    let faces = Polygons::from_triangles(&cube.faces.triangulate_fan());
+    let mut tags = Tags::new();
+    let mut segments = Vec::new();
+    let delta = 0.01;
+    for a in 0..8u32 {
+        tags.set_corner(a, SHARPNESS_INFINITE);
+        for bit in [1u32, 2, 4] {
+            let b = a | bit;
+            if b != a {
+                tags.set_crease(a, b, SHARPNESS_INFINITE);
+                // The edge moved by δ along an axis across it.
+                let off = if bit == 1 { 1 } else { 0 };
+                let shift = |p: [f64; 3]| {
+                    let mut q = p;
+                    q[off] += delta;
+                    q
+                };
+                segments.push([shift(positions[a as usize]), shift(positions[b as usize])]);
+            }
+        }
+    }
+    let opts = FitOptions {
+        coverage: 1.0,
+        feature_segments: Some(Arc::new(segments)),
+        tags: tags.clone(),
+        ..FitOptions::default()
+    };
+    let mut term = FootPointTerm::from_options(&target, &opts);
+    assert_eq!(term.coverage().unwrap().num_feature_points(), 12);
+    let op = sampling_operator(&faces, 8, &tags, &Options::new(Scheme::Loop), 2).unwrap();
+    term.prepare(&op);
+    let crease_rows = term.coverage().unwrap().num_crease_samples();
+    assert_eq!(
+        crease_rows,
+        12 * 3 + 8,
+        "level 2: 3 new samples per cube edge"
+    );
+    let xs = op.position.apply(&positions);
+    let state = term.project(None, &xs);
+    let mut energy = 0.0;
+    let mut crease_sample = vec![false; xs.len()];
+    for ((a, b), _) in op.tags.creases() {
+        crease_sample[a as usize] = true;
+        crease_sample[b as usize] = true;
+    }
+    for (k, (s, &x)) in state.iter().zip(&xs).enumerate() {
+        if let Some(c) = &s.cover {
+            assert!(crease_sample[k], "sample {k} off the creases has a pair");
+            energy += c.energy(x);
+        }
+    }
+    let expected = FEATURE_WEIGHT * xs.len() as f64 * delta * delta;
+    assert!(
+        (energy - expected).abs() < 1e-9 * expected,
+        "{energy} vs {expected}"
+    );
+}

@@ -181,6 +181,10 @@ pub struct InitReport {
     pub tags: Tags,
     /// The sharp features detected on a mesh target with [`InitOptions::features`].
     pub features: Option<FeatureCounts>,
+    /// The sharp feature edges the cage was built along, as segments (normalized units): what
+    /// the creases of the fitted surface should follow (`subfit_fit::FitOptions::feature_segments`).
+    /// Empty without features.
+    pub feature_segments: Vec<[[f64; 3]; 2]>,
     /// Step times.
     pub timings: InitTimings,
 }
@@ -367,6 +371,11 @@ pub fn initial_control_mesh(
                 corners: f.corners.len(),
                 darts: f.darts.len(),
             });
+            report.feature_segments = f
+                .edges
+                .iter()
+                .map(|&[a, b]| [dense.positions[a as usize], dense.positions[b as usize]])
+                .collect();
             FeatureLock {
                 edges: f.edges,
                 corners: f.corners,

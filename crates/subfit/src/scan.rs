@@ -9,6 +9,7 @@
 //! callback.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use subfit_fit::{
@@ -294,6 +295,7 @@ pub fn fit_scan(
     step(Step::Init, &mut progress);
     let t_init = Instant::now();
     let budget = options.stages.max_control_points;
+    let mut feature_segments = None;
     let (control, tags, init) = match &options.init {
         InitialCage::Given {
             mesh: c,
@@ -398,7 +400,10 @@ pub fn fit_scan(
                 );
             }
             let summary = init_summary(&r, n, &m, init_options.features.as_ref());
-            (m, r.tags.clone(), summary)
+            if !r.feature_segments.is_empty() {
+                feature_segments = Some(Arc::new(r.feature_segments));
+            }
+            (m, r.tags, summary)
         }
     };
     let init_time = t_init.elapsed().as_secs_f64();
@@ -411,6 +416,7 @@ pub fn fit_scan(
     let fit = FitOptions {
         scheme,
         tags,
+        feature_segments: feature_segments.or_else(|| options.fit.feature_segments.clone()),
         cancel: options.cancel.clone(),
         ..options.fit.clone()
     };
