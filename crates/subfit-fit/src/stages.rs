@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 
 use std::collections::HashSet;
 
-use subfit_mesh::{PolyMesh, Polygons, Tags};
+use subfit_mesh::{PolyMesh, Polygons, Tags, SHARPNESS_INFINITE};
 use subfit_report::data_samples::SampleKind;
 use subfit_report::{data_samples, TwoSided};
 use subfit_subdiv::{sampling_operator, Options, Scheme};
@@ -773,8 +773,15 @@ impl Splitter {
     }
 }
 
-/// Marks the faces scoring above 1, worst first, within the growth and control-point budget
-/// and the refinement depth, and refines them with `how`. Returns the new mesh, what was done,
+/// How much a face along a crease is preferred when refinement cannot split every face above
+/// the tolerance (the growth or control-point budget): its score counts this many times for
+/// the order (not for whether it is above the tolerance). A sharp feature is where a smooth
+/// patch misses most and where a split buys most (issue 15: "refinement prefers feature
+/// regions").
+const FEATURE_PRIORITY: f64 = 2.0;
+
+/// Marks the faces scoring above 1, worst first (crease faces preferred: [`FEATURE_PRIORITY`]),
+/// within the growth and control-point budget and the refinement depth, and refines them with `how`. Returns the new mesh, what was done,
 /// the depth of every new face and the carried tags.
 fn refine_step(
     mesh: &PolyMesh,
@@ -790,12 +797,19 @@ fn refine_step(
     if allowed == 0 {
         return Ok(None);
     }
+    // Faces above the tolerance, those along a crease first (by FEATURE_PRIORITY).
     let mut order: Vec<(f64, usize)> = score
         .iter()
         .enumerate()
-        .filter(|&(f, _)| depth[f] < stages.max_depth)
-        .map(|(f, &s)| (s, f))
-        .filter(|(s, _)| *s > 1.0)
+        .filter(|&(f, &s)| depth[f] < stages.max_depth && s > 1.0)
+        .map(|(f, &s)| {
+            let face = mesh.faces.face(subfit_mesh::FaceId(f as u32));
+            let creased = !tags.is_empty()
+                && (0..face.len()).any(|i| {
+                    tags.crease(face[i], face[(i + 1) % face.len()]) >= SHARPNESS_INFINITE
+                });
+            (if creased { FEATURE_PRIORITY * s } else { s }, f)
+        })
         .collect();
     order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     if order.is_empty() {
@@ -933,5 +947,50 @@ mod tests {
         // Nothing split: the tags as they were.
         let same = carry_tags(&tags, n, &mesh.faces);
         assert_eq!(same.creases(), tags.creases());
+    }
+
+    /// With room for one split, a face along a crease goes before a smooth face that scores
+    /// higher, but less than [`FEATURE_PRIORITY`] times higher; without the crease the worse
+    /// face goes first.
+    #[test]
+    fn refinement_prefers_crease_faces() {
+        let mesh = octahedron_mesh(1.0, 1.0, 1.0);
+        let faces: Vec<Vec<u32>> = mesh.faces.iter().map(<[u32]>::to_vec).collect();
+        // Face 1 shares no edge with face 0's crease edge (f0[0], f0[1]) unless it must.
+        let f0 = &faces[0];
+        let other = (1..faces.len())
+            .find(|&g| {
+                let e = &faces[g];
+                !(e.contains(&f0[0]) && e.contains(&f0[1]))
+            })
+            .unwrap();
+        let mut score = vec![0.0; faces.len()];
+        score[0] = 1.2;
+        score[other] = 1.2 * FEATURE_PRIORITY * 0.9;
+        let depth = vec![0u8; faces.len()];
+        let stages = StageOptions {
+            growth: 1e-6,
+            max_control_points: 1000,
+            ..StageOptions::default()
+        };
+        // Which face was split shows in the crease edge: split (two halves) only when face 0,
+        // the face along it, was.
+        let creases_after = |sharpness: f64| {
+            let mut tags = Tags::new();
+            tags.set_crease(f0[0], f0[1], sharpness);
+            let r = refine_step(&mesh, &tags, &score, &depth, &stages, &Splitter::RedGreen)
+                .unwrap()
+                .unwrap();
+            // One red split (4 children) and its green closure (3 neighbours, 2 each).
+            assert_eq!(r.per_face.iter().filter(|&&d| d == 1).count(), 10);
+            r.tags.creases().len()
+        };
+        assert_eq!(
+            creases_after(SHARPNESS_INFINITE),
+            2,
+            "the crease face first"
+        );
+        // A semi-sharp tag is no sharp feature: the worse face first, the tagged edge kept.
+        assert_eq!(creases_after(2.0), 1);
     }
 }
