@@ -322,8 +322,8 @@ pub struct FitArgs {
     /// Sharp features of a mesh target.
     #[command(flatten)]
     pub features: FeatureArgs,
-    /// Output directory (control.obj, control.usda, limit.ply, error.ply, log.csv,
-    /// report.json).
+    /// Output directory (control.obj, control.usda, control.tags.json, limit.ply, error.ply,
+    /// log.csv, preview.png, report.html, report.json).
     #[arg(short, long, default_value = "subfit-fit")]
     pub output: PathBuf,
 }

@@ -504,6 +504,7 @@ fn fit_writes_cage_limit_log_and_report() {
         "report.json",
         "control.obj",
         "control.usda",
+        "control.tags.json",
         "limit.ply",
         "error.ply",
         "log.csv",

@@ -86,6 +86,27 @@ fn boxes_fit_with_creased_cages_of_few_control_points() {
             obj.contains("\nt crease 2/1/0 "),
             "{name}: control.obj has no crease"
         );
+        // The sidecar holds the same tags as the OBJ's `t` lines.
+        let sidecar: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("control.tags.json")).unwrap()).unwrap();
+        let tags = subfit::io::read_tags_file(&out.join("control.obj"), cp as usize).unwrap();
+        assert_eq!(sidecar["vertex_count"].as_u64(), Some(cp));
+        let creases: Vec<((u32, u32), f64)> = sidecar["creases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| {
+                let v = c["vertices"].as_array().unwrap();
+                let a = v[0].as_u64().unwrap() as u32;
+                let b = v[1].as_u64().unwrap() as u32;
+                ((a, b), c["sharpness"].as_f64().unwrap())
+            })
+            .collect();
+        assert_eq!(creases, tags.creases(), "{name}");
+        assert_eq!(
+            sidecar["corners"].as_array().unwrap().len(),
+            tags.corners().len()
+        );
     }
     // Without features: a smooth cage, no tags, and a rounded box.
     let model = d.path().join("box.obj");

@@ -17,9 +17,10 @@ use subfit::io::{Encoding, WriteOptions};
 use subfit::mesh::shapes::Shape;
 use subfit::mesh::PolyMesh;
 
-const OUTPUTS: [&str; 8] = [
+const OUTPUTS: [&str; 9] = [
     "control.obj",
     "control.usda",
+    "control.tags.json",
     "limit.ply",
     "error.ply",
     "log.csv",

@@ -13,6 +13,7 @@ pub mod obj;
 pub mod off;
 pub mod ply;
 pub mod stl;
+pub mod tags_json;
 mod text;
 pub mod usda;
 pub mod xyz;
@@ -417,6 +418,16 @@ pub fn write_obj_with_tags_file(
     let mut out = Vec::new();
     obj::write_with_tags(mesh, tags, &mut out).map_err(|e| Error::file(path, ErrorKind::Io(e)))?;
     write_atomic(path, &out)
+}
+
+/// Writes the crease and corner tags of a cage of `vertex_count` vertices as the JSON sidecar
+/// of [`tags_json`] (`control.tags.json`), atomically.
+pub fn write_tags_json_file(
+    path: &Path,
+    tags: &subfit_mesh::Tags,
+    vertex_count: usize,
+) -> Result<()> {
+    write_atomic(path, tags_json::write(tags, vertex_count).as_bytes())
 }
 
 /// The crease and corner tags stored with a control mesh of `num_vertices` vertices: an OBJ

@@ -359,8 +359,9 @@ impl NativeFit {
         self.with(|f| f.summary())
     }
 
-    /// Writes every output into the existing directory `dir` (control.obj, control.usda,
-    /// limit.ply, error.ply, log.csv, report.json), interpreter detached.
+    /// Writes every output into the existing directory `dir` (`subfit::OUTPUTS`: control.obj,
+    /// control.usda, control.tags.json, limit.ply, error.ply, log.csv, preview.png, report.html,
+    /// report.json), interpreter detached.
     fn write_into(&self, py: Python<'_>, dir: std::path::PathBuf) -> PyResult<()> {
         py.detach(|| {
             self.fitted

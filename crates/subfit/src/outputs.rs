@@ -1,6 +1,7 @@
 //! The files a fit writes, in the input's coordinates ([`OUTPUTS`], in the order a front end
 //! moves them into place, the report last): the cage as OBJ (crease and corner tags as
-//! OpenSubdiv `t` statements) and as a UsdGeom Mesh with its scheme and tags, the limit tessellation with normals, the same coloured by the distance to
+//! OpenSubdiv `t` statements, and again as `control.tags.json` for OBJ readers that skip them:
+//! [`subfit_io::tags_json`]) and as a UsdGeom Mesh with its scheme and tags, the limit tessellation with normals, the same coloured by the distance to
 //! the target (Cheng 2007 §IV-D colours), the per-iteration log, the page a person looks at
 //! (`report.html`, [`crate::html_report`]) and the report.
 
@@ -20,9 +21,10 @@ use crate::error::Error;
 use crate::scan::Fitted;
 
 /// The files [`Fitted::write_into`] writes, in the order to move them into place.
-pub const OUTPUTS: [&str; 8] = [
+pub const OUTPUTS: [&str; 9] = [
     "control.obj",
     "control.usda",
+    "control.tags.json",
     "limit.ply",
     "error.ply",
     "log.csv",
@@ -53,6 +55,12 @@ impl Fitted {
             &self.tags,
             usd_scheme,
             usd_boundary,
+        )?;
+        check()?;
+        subfit_io::write_tags_json_file(
+            &dir.join("control.tags.json"),
+            &self.tags,
+            self.cage.num_vertices(),
         )?;
         let last = self.stages.report.last;
         let limit = self.limit.clone();

@@ -79,7 +79,8 @@ class Fit:
     def save(self, directory: PathLike) -> Path:
         """Writes the outputs of ``subfit fit`` into ``directory`` (created if missing).
 
-        control.obj, control.usda (scheme and creases, for Blender/USD), limit.ply (the limit
+        control.obj, control.usda (scheme and creases, for Blender/USD), control.tags.json (the
+        creases for OBJ readers that skip OpenSubdiv's tags), limit.ply (the limit
         tessellation with normals), error.ply (coloured by the distance to the scan), log.csv
         and report.json. A Fit that was pickled into another process no longer holds the scan:
         there only control.obj, control.usda and report.json are written (with a warning).
