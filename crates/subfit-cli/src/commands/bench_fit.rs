@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use serde_json::json;
+use subfit::fit::Method;
 use subfit::{FitScanOptions, Input};
 
 use crate::cli::BenchFitArgs;
@@ -24,6 +25,11 @@ struct Model {
     max_error: Option<f64>,
     /// Control-point budget, if not the default.
     max_control_points: Option<usize>,
+    /// Start from exactly the budget (`control_points = max_control_points`: a fixed count, no
+    /// refinement), as Xie et al. 2023's fixed templates.
+    fixed: bool,
+    /// The data term.
+    method: Method,
     paper: &'static str,
 }
 
@@ -38,7 +44,11 @@ impl Model {
         o.stages.tolerance_max = self.max_error.unwrap_or(0.0);
         if let Some(n) = self.max_control_points {
             o.stages.max_control_points = n;
+            if self.fixed {
+                o.control_points = Some(n);
+            }
         }
+        o.fit.method = self.method;
         o.stages.two_sided = !one_sided;
         o
     }
@@ -52,6 +62,8 @@ const MODELS: &[Model] = &[
         tolerance: 0.0005,
         max_error: Some(0.0036),
         max_control_points: Some(2385),
+        fixed: false,
+        method: Method::Sdm,
         paper: "Cheng 2007 Tab. IV: 526 → 2,385 cp, E_max 0.0036, E_rms 0.0005, 152 s + 252 s",
     },
     // The same scan fitted to its triangles: the points leave a hole at the bottom of a pit
@@ -65,6 +77,8 @@ const MODELS: &[Model] = &[
         tolerance: 0.0005,
         max_error: Some(0.0036),
         max_control_points: Some(2385),
+        fixed: false,
+        method: Method::Sdm,
         paper: "as igea (E_max 0.0036 also required), foot points on the scan's triangles",
     },
     Model {
@@ -74,6 +88,8 @@ const MODELS: &[Model] = &[
         tolerance: 0.0003,
         max_error: Some(0.0029),
         max_control_points: Some(950),
+        fixed: false,
+        method: Method::Sdm,
         paper: "Cheng 2007 Tab. IV: 870 → 950 cp, E_max 0.0029, E_rms 0.0003, 78 s + 85 s",
     },
     Model {
@@ -83,6 +99,8 @@ const MODELS: &[Model] = &[
         tolerance: 0.0009,
         max_error: None,
         max_control_points: Some(996),
+        fixed: false,
+        method: Method::Sdm,
         paper: "Cheng 2007 Tab. IV (bunny): 919 → 996 cp, E_max 0.0082, E_rms 0.0009, 77 s + 361 s",
     },
     Model {
@@ -92,6 +110,8 @@ const MODELS: &[Model] = &[
         tolerance: 0.001,
         max_error: None,
         max_control_points: None,
+        fixed: false,
+        method: Method::Sdm,
         paper: "genus 4 kept, E_rms ≤ 0.001 (our own target)",
     },
     Model {
@@ -101,7 +121,45 @@ const MODELS: &[Model] = &[
         tolerance: 0.001,
         max_error: None,
         max_control_points: None,
+        fixed: false,
+        method: Method::Sdm,
         paper: "Cheng 2004 Tab. 2: 9,602 cp, E_max 0.0212, E_rms 0.0020, 624 s",
+    },
+    // Xie et al. 2023 Fig. 6 and 13: the bunny's points (no normals used from the file: the
+    // OBJ has none) fitted with the IMLS term at a fixed 314 and 4,667 control points, and SDM
+    // at 4,667 beside it. Goals (issue 16): two-sided RMS ≤ 3e-3 / 1e-3 of the diagonal.
+    Model {
+        name: "bunny-imls-314",
+        file: "stanford-bunny.obj",
+        as_points: true,
+        tolerance: 0.003,
+        max_error: None,
+        max_control_points: Some(314),
+        fixed: true,
+        method: Method::Imls,
+        paper: "Xie 2023 Fig. 13: 314 cp, 4.06 s per fit (0.03 s Jacobian + 3.19 s optimization), GPU",
+    },
+    Model {
+        name: "bunny-imls-4667",
+        file: "stanford-bunny.obj",
+        as_points: true,
+        tolerance: 0.001,
+        max_error: None,
+        max_control_points: Some(4667),
+        fixed: true,
+        method: Method::Imls,
+        paper: "Xie 2023 Fig. 13: 4,667 cp, 42.74 s per fit (6.37 s Jacobian + 35.44 s optimization), GPU",
+    },
+    Model {
+        name: "bunny-sdm-4667",
+        file: "stanford-bunny.obj",
+        as_points: true,
+        tolerance: 0.001,
+        max_error: None,
+        max_control_points: Some(4667),
+        fixed: true,
+        method: Method::Sdm,
+        paper: "SDM at Xie's 4,667 cp, for the IMLS row above",
     },
 ];
 
@@ -181,6 +239,8 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
             "tolerance": m.tolerance,
             "max_error": m.max_error,
             "max_control_points": m.max_control_points,
+            "fixed_control_points": m.fixed,
+            "method": format!("{:?}", m.method),
             "two_sided": !a.one_sided,
             "paper": m.paper,
             "tolerance_reached": fitted.reached(),
