@@ -15,7 +15,9 @@
 use std::time::{Duration, Instant};
 
 use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Tags, TopologyError};
-use subfit_target::{detect_features, FeatureOptions, Target};
+use subfit_target::{detect_features, fillet_widths, FeatureOptions, Target};
+
+use crate::semi_sharp::semi_sharp_tags;
 
 use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
@@ -61,6 +63,10 @@ pub struct InitOptions {
     /// corner tags of a feature-aligned cage. Default `None` (no tags). Ignored for point
     /// clouds.
     pub features: Option<FeatureOptions>,
+    /// With [`Self::features`]: give each crease a finite OpenSubdiv sharpness from the data's
+    /// fillet width along its curve ([`crate::semi_sharp`]), instead of infinitely sharp.
+    /// Default `false`.
+    pub semi_sharp: bool,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
     /// level and per batch of cells, evaluations and edge collapses; once cancelled,
@@ -81,6 +87,7 @@ impl Default for InitOptions {
             quad_dominant: false,
             pairing: PairOptions::default(),
             features: None,
+            semi_sharp: false,
             cancel: Cancel::default(),
         }
     }
@@ -185,6 +192,9 @@ pub struct InitReport {
     /// the creases of the fitted surface should follow (`subfit_fit::FitOptions::feature_segments`).
     /// Empty without features.
     pub feature_segments: Vec<[[f64; 3]; 2]>,
+    /// With [`InitOptions::semi_sharp`]: the fillet width of each feature curve (normalized
+    /// units; 0 for a sharp crease, `None` where it could not be measured). Empty otherwise.
+    pub fillet_widths: Vec<Option<f64>>,
     /// Step times.
     pub timings: InitTimings,
 }
@@ -362,6 +372,7 @@ pub fn initial_control_mesh(
         cancel: options.cancel.clone(),
         ..options.simplify.clone()
     };
+    let mut features = None;
     let lock = match (&options.features, report.source) {
         (Some(fo), InitSource::Mesh) => {
             let f = detect_features(&dense.positions, &dense.faces, fo);
@@ -376,14 +387,20 @@ pub fn initial_control_mesh(
                 .iter()
                 .map(|&[a, b]| [dense.positions[a as usize], dense.positions[b as usize]])
                 .collect();
-            FeatureLock {
-                edges: f.edges,
-                corners: f.corners,
-            }
+            let lock = FeatureLock {
+                edges: f.edges.clone(),
+                corners: f.corners.clone(),
+            };
+            features = Some(f);
+            lock
         }
         _ => FeatureLock::default(),
     };
-    let (mut out, tags, srep) = simplify_with_features(&dense, &lock, &sopt)?;
+    let (mut out, mut tags, srep) = simplify_with_features(&dense, &lock, &sopt)?;
+    if let (true, Some(f)) = (options.semi_sharp, &features) {
+        report.fillet_widths = fillet_widths(&dense.positions, &dense.faces, f);
+        tags = semi_sharp_tags(&out, &tags, &dense, f, &report.fillet_widths);
+    }
     report.timings.simplify = t.elapsed();
     report.simplify = srep;
     report.tags = tags;

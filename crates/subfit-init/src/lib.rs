@@ -29,6 +29,7 @@ pub mod init;
 mod march;
 mod octree;
 pub mod quads;
+pub mod semi_sharp;
 pub mod simplify;
 pub mod trim;
 
