@@ -6,6 +6,14 @@
 //! (1/6, 2/3, 1/6) on creases and boundaries (Hoppe et al. 1994); corners are fixed. Tangent masks
 //! follow OpenSubdiv 3.5 (`sdc/*Scheme.h`, `Far::PrimvarRefiner::Limit`), see [`crate::mask`].
 //!
+//! Semi-sharp features (finite sharpness, [`crate::crease`]): the closed-form masks hold only
+//! once no finite sharpness is left at a vertex or its incident edges. The rows of such a vertex
+//! are those of its vertex point after one refinement step (the same limit point), composed with
+//! that step, recursively — `⌈s⌉` steps for the largest sharpness `s` around it; the whole mesh
+//! is refined for it (cost about `4^⌈s⌉` times the mesh, only when such vertices exist).
+//! Tangents are scaled by 2 per step as below. OpenSubdiv's `PrimvarRefiner::Limit` applies the
+//! crease or corner masks there instead, which is not the limit.
+//!
 //! Exactness: limit positions are exact everywhere except at darts (an interior vertex with one
 //! sharp edge), where the smooth mask is used as in OpenSubdiv; tangent directions are exact at
 //! smooth vertices and regular boundaries, and at irregular creases and corners they are
@@ -28,8 +36,8 @@ use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
 use crate::refine::{
-    classify, face_kinds, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
-    VertexMaskCache,
+    classify, face_kinds, has_semi_sharp, neighborhoods, refine_topology, semi_sharp_edges,
+    semi_sharp_vertices, sharp_edges, topology_for, RefineRows, VertexMaskCache,
 };
 use crate::regular::{is_regular, Regular, Tables};
 use crate::scheme::{FaceKinds, Neighborhood};
@@ -187,6 +195,19 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     let sharp = sharp_edges(topo, tags);
     let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
     let nv = topo.num_vertices();
+    // Vertices with finite sharpness at them or on an incident edge have no closed-form limit
+    // mask yet: their rows come from one refinement step, recursively, until it has decayed
+    // (module docs). Their neighbourhood's evolution depends only on those sharpnesses.
+    let semi = semi_sharp_edges(topo, tags);
+    let vsemi = semi_sharp_vertices(nv, tags);
+    let affected = |v: u32| {
+        !semi.is_empty()
+            && (vsemi[v as usize] > 0.0
+                || topo.vertex_edges(v).iter().any(|&e| semi[e as usize] > 0.0))
+    };
+    let refined = (0..nv as u32)
+        .any(affected)
+        .then(|| limit_rows_via_refinement(topo, tags, options));
     let mut rows = MultiRows {
         ncols: nv,
         offsets: Vec::with_capacity(nv + 1),
@@ -198,7 +219,15 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     let mut row = Vec::new();
     for (v, hood) in hoods.iter().enumerate() {
         row.clear();
-        push_topology_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
+        match &refined {
+            Some(r) if affected(v as u32) => {
+                let (a, b) = (r.offsets[v], r.offsets[v + 1]);
+                row.extend((a..b).map(|e| (r.cols[e], r.weights[e])));
+            }
+            _ => {
+                push_topology_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row)
+            }
+        }
         for &(c, w) in &row {
             rows.cols.push(c);
             rows.weights.push(w);
@@ -258,9 +287,14 @@ fn limit_refine_compose_with(
         )),
         s => ChildView::Closed(ChildCorners::new(parent, s)),
     };
+    debug_assert!(
+        !has_semi_sharp(child_tags),
+        "the child's limit masks need no finite sharpness"
+    );
     let refine = RefineRows::new(parent, parent_tags, options);
     let regular = match options.scheme {
-        Scheme::CatmullClark | Scheme::QuadTriangle if tables => {
+        // The tables assume the rules of the parent's infinitely sharp tags only.
+        Scheme::CatmullClark | Scheme::QuadTriangle if tables && !refine.semi_sharp() => {
             Some(Regular::new(parent, refine.hoods(), refine.face_points()))
         }
         _ => None,

@@ -1,0 +1,114 @@
+//! Semi-sharp creases and corners against OpenSubdiv 3.5 (`tests/golden_semisharp`, made by
+//! `tools/osd-golden`): limit positions and normals of the tagged meshes refined 0–3 levels
+//! match as point sets to 1e-12 of the diagonal and 1e-9 rad, through the sampling operator, the
+//! limit stencils and exact evaluation; and the limit of a vertex is the limit of its vertex
+//! point one level down.
+#![allow(
+    clippy::print_stdout,
+    reason = "the test reports the errors it measured"
+)]
+
+mod common;
+
+use common::{angle, compare, diag, dist, read_lim, read_obj, ANGLE_TOL, POS_TOL};
+use std::path::{Path, PathBuf};
+use subfit_mesh::{Polygons, Tags};
+use subfit_subdiv::{limit_stencils, normals_from_tangents, sampling_operator, Options, Scheme};
+
+const MESHES: [&str; 3] = [
+    "quad_cube_semisharp",
+    "tri_icosahedron_semisharp",
+    "tri_open_patch_semisharp",
+];
+
+fn dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden_semisharp")
+}
+
+/// The control mesh, its `t` tags and its native scheme.
+fn load(name: &str) -> (Vec<[f64; 3]>, Polygons, Tags, Scheme) {
+    let path = dir().join(format!("{name}.obj"));
+    let (pts, faces) = read_obj(&path);
+    let tags = subfit_io::read_tags_file(&path, pts.len()).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!tags.is_empty(), "{name}: no tags");
+    let scheme = if name.starts_with("tri_") {
+        Scheme::Loop
+    } else {
+        Scheme::CatmullClark
+    };
+    (pts, faces, tags, scheme)
+}
+
+fn reference(name: &str, level: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    read_lim(Path::new(&dir().join(format!("{name}.L{level}.lim"))))
+}
+
+#[test]
+fn sampling_operator_matches_opensubdiv_on_semi_sharp_meshes() {
+    let mut failures = Vec::new();
+    println!("{:<28} lvl  max |dp|/diag   max angle (rad)", "mesh");
+    for name in MESHES {
+        let (pts, faces, tags, native) = load(name);
+        let scale = diag(&pts);
+        // Quad/triangle is Loop on triangles only and Catmull-Clark without triangles.
+        for scheme in [native, Scheme::QuadTriangle] {
+            let options = Options::new(scheme);
+            for level in 0..=3 {
+                let what = format!("{name} L{level} ({})", scheme.name());
+                let (refp, ref_n) = reference(name, level);
+                let s = sampling_operator(&faces, pts.len(), &tags, &options, level)
+                    .unwrap()
+                    .evaluate(&pts);
+                let (d, a) = compare(&s.positions, &s.normals, &refp, &ref_n, scale, &what);
+                println!(
+                    "{name:<28} L{level}   {d:.3e}      {a:.3e}   {}",
+                    scheme.name()
+                );
+                if d > POS_TOL || a > ANGLE_TOL {
+                    failures.push(what);
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "beyond tolerance: {failures:?}");
+}
+
+#[test]
+fn limit_stencils_match_opensubdiv_at_level_0() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let l = limit_stencils(&faces, pts.len(), &tags, &Options::new(scheme)).unwrap();
+        let p = l.position.apply(&pts);
+        let n = normals_from_tangents(&l.tangent1.apply(&pts), &l.tangent2.apply(&pts));
+        let (refp, ref_n) = reference(name, 0);
+        let (d, a) = compare(&p, &n, &refp, &ref_n, diag(&pts), name);
+        assert!(d <= POS_TOL && a <= ANGLE_TOL, "{name}: {d:e} {a:e}");
+    }
+}
+
+/// The limit of vertex `v` at level `k` is the limit of its vertex point (the same id) at level
+/// `k + 1`: positions to round-off, and normals where the closed-form masks are exact.
+#[test]
+fn limit_of_a_vertex_is_the_limit_of_its_vertex_point() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let options = Options::new(scheme);
+        let scale = diag(&pts);
+        let ops: Vec<_> = (0..=3)
+            .map(|l| {
+                sampling_operator(&faces, pts.len(), &tags, &options, l)
+                    .unwrap()
+                    .evaluate(&pts)
+            })
+            .collect();
+        for k in 0..3 {
+            let (a, b) = (&ops[k], &ops[k + 1]);
+            for v in 0..a.positions.len() {
+                let d = dist(&a.positions[v], &b.positions[v]) / scale;
+                assert!(d < 1e-13, "{name} level {k} vertex {v}: {d:e}");
+                let ang = angle(&a.normals[v], &b.normals[v]);
+                assert!(ang < 1e-6, "{name} level {k} vertex {v}: normal {ang:e}");
+            }
+        }
+    }
+}
