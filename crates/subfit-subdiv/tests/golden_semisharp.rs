@@ -13,7 +13,10 @@ mod common;
 use common::{angle, compare, diag, dist, read_lim, read_obj, ANGLE_TOL, POS_TOL};
 use std::path::{Path, PathBuf};
 use subfit_mesh::{Polygons, Tags};
-use subfit_subdiv::{limit_stencils, normals_from_tangents, sampling_operator, Options, Scheme};
+use subfit_subdiv::{
+    limit_stencils, normals_from_tangents, sampling_operator, Evaluator, Options, Scheme,
+    SurfaceParam,
+};
 
 const MESHES: [&str; 3] = [
     "quad_cube_semisharp",
@@ -109,6 +112,103 @@ fn limit_of_a_vertex_is_the_limit_of_its_vertex_point() {
                 let ang = angle(&a.normals[v], &b.normals[v]);
                 assert!(ang < 1e-6, "{name} level {k} vertex {v}: normal {ang:e}");
             }
+        }
+    }
+}
+/// Exact evaluation at the corners of every face gives the limit points of the control
+/// vertices, and inside faces it lies on the limit surface of the refined mesh (the evaluation
+/// at a face's centre equals the limit of the level-1 face point, Catmull-Clark).
+#[test]
+fn exact_evaluation_matches_opensubdiv_at_vertices() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let scale = diag(&pts);
+        let ev = Evaluator::new(&faces, pts.len(), &tags, &Options::new(scheme)).unwrap();
+        let (refp, ref_n) = reference(name, 0);
+        let tri = scheme == Scheme::Loop;
+        let corners: &[(f64, f64)] = if tri {
+            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+        } else {
+            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        };
+        let (mut pos, mut nrm) = (vec![[f64::NAN; 3]; pts.len()], vec![[0.0; 3]; pts.len()]);
+        for (f, face) in faces.iter().enumerate() {
+            for (k, &(u, v)) in corners.iter().enumerate() {
+                let p = ev
+                    .evaluate(&pts, SurfaceParam::new(f as u32, u, v))
+                    .unwrap_or_else(|e| panic!("{name} face {f} corner {k}: {e}"));
+                let x = face[k] as usize;
+                if !pos[x][0].is_nan() {
+                    let d = dist(&pos[x], &p.position) / scale;
+                    assert!(d < 1e-13, "{name} vertex {x} from two faces: {d:e}");
+                }
+                pos[x] = p.position;
+                nrm[x] = p.normal;
+            }
+        }
+        let (d, a) = compare(&pos, &nrm, &refp, &ref_n, scale, name);
+        println!("{name:<28} eval at vertices {d:.3e} {a:.3e}");
+        assert!(d <= POS_TOL && a <= ANGLE_TOL, "{name}: {d:e} {a:e}");
+        if !tri {
+            // Face centres: the limit of the level-1 face points (Catmull-Clark ids V + E + f).
+            let s1 = sampling_operator(&faces, pts.len(), &tags, &Options::new(scheme), 1)
+                .unwrap()
+                .evaluate(&pts);
+            let ne = s1.positions.len() - pts.len() - faces.len();
+            for f in 0..faces.len() {
+                let p = ev
+                    .evaluate(&pts, SurfaceParam::new(f as u32, 0.5, 0.5))
+                    .unwrap();
+                let q = s1.positions[pts.len() + ne + f];
+                let d = dist(&p.position, &q) / scale;
+                assert!(d < 1e-12, "{name} face {f} centre: {d:e}");
+            }
+        }
+    }
+}
+
+/// Exact evaluation at the dyadic parameters `(i/2^l, j/2^l)` of every control face lands on
+/// OpenSubdiv's limit points of the level-`l` vertices (nearest reference point, not
+/// one-to-one: vertices shared by faces are evaluated from each), with matching normals. Away
+/// from the control vertices these points are inside patches that become regular only after the
+/// sharpness around them has decayed, so this checks the blended local refinement and the
+/// patches below it.
+#[test]
+fn exact_evaluation_at_dyadic_parameters_matches_opensubdiv() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let scale = diag(&pts);
+        let ev = Evaluator::new(&faces, pts.len(), &tags, &Options::new(scheme)).unwrap();
+        let tri = scheme == Scheme::Loop;
+        for level in [2usize, 3] {
+            let (refp, ref_n) = reference(name, level);
+            let n = 1usize << level;
+            let (mut max_d, mut max_a) = (0.0f64, 0.0f64);
+            for f in 0..faces.len() {
+                for i in 0..=n {
+                    for j in 0..=n {
+                        if tri && i + j > n {
+                            continue;
+                        }
+                        let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                        let p = ev
+                            .evaluate(&pts, SurfaceParam::new(f as u32, u, v))
+                            .unwrap_or_else(|e| panic!("{name} face {f} ({u}, {v}): {e}"));
+                        let k = (0..refp.len())
+                            .min_by(|&a, &b| {
+                                dist(&p.position, &refp[a]).total_cmp(&dist(&p.position, &refp[b]))
+                            })
+                            .unwrap();
+                        max_d = max_d.max(dist(&p.position, &refp[k]) / scale);
+                        max_a = max_a.max(angle(&p.normal, &ref_n[k]));
+                    }
+                }
+            }
+            println!("{name:<28} eval L{level} dyadic {max_d:.3e} {max_a:.3e}");
+            assert!(
+                max_d <= POS_TOL && max_a <= ANGLE_TOL,
+                "{name} L{level}: {max_d:e} {max_a:e}"
+            );
         }
     }
 }

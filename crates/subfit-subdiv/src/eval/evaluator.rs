@@ -36,7 +36,12 @@ pub struct Evaluator {
     vf: Vec<u32>,
     /// Per face corner: flags of the edge to the next corner.
     flags: Vec<u8>,
+    /// Per face corner: finite sharpness of the edge to the next corner (empty without
+    /// semi-sharp tags).
+    semi: Vec<f32>,
     corner: Vec<bool>,
+    /// Per vertex: finite corner sharpness (empty without semi-sharp tags).
+    vsemi: Vec<f32>,
     /// First patch of each face (`#F + 1` entries).
     patch_start: Vec<u32>,
     /// Memoised local-refinement tree of each patch (built on first use; regular level-0
@@ -83,6 +88,15 @@ impl Evaluator {
         let corner = (0..num_vertices as u32)
             .map(|v| !tags.is_empty() && tags.is_corner(v))
             .collect();
+        let (semi, vsemi) = if crate::refine::has_semi_sharp(tags) {
+            let edges = crate::refine::semi_sharp_edges(&topo, tags);
+            let semi = (0..nf)
+                .flat_map(|f| topo.face_edges(f).iter().map(|&e| edges[e as usize]))
+                .collect();
+            (semi, crate::refine::semi_sharp_vertices(num_vertices, tags))
+        } else {
+            (Vec::new(), Vec::new())
+        };
         let mut vf_off = vec![0u32; num_vertices + 1];
         for &v in faces.indices() {
             vf_off[v as usize + 1] += 1;
@@ -117,7 +131,9 @@ impl Evaluator {
             vf_off,
             vf,
             flags,
+            semi,
             corner,
+            vsemi,
             patch_start,
             roots: Vec::new(),
             memo: MemoBudget {
@@ -336,6 +352,11 @@ impl Evaluator {
             fo: vec![0],
             fv: Vec::new(),
             fe: Vec::new(),
+            fs: Vec::new(),
+            vs: verts
+                .iter()
+                .map(|&v| self.vsemi.get(v as usize).copied().unwrap_or(0.0))
+                .collect(),
             nfaces: verts
                 .iter()
                 .map(|&v| self.vf_off[v as usize + 1] - self.vf_off[v as usize])
@@ -352,6 +373,8 @@ impl Evaluator {
                 mesh.fv
                     .push(verts.binary_search(&v).expect("vertex of the two-ring") as u32);
                 mesh.fe.push(self.flags[start + j]);
+                mesh.fs
+                    .push(self.semi.get(start + j).copied().unwrap_or(0.0));
             }
             mesh.fo.push(mesh.fv.len() as u32);
         }
