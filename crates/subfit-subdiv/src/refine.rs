@@ -3,8 +3,9 @@
 //!
 //! Loop 1987 (1→4 triangle split); Catmull & Clark 1978 (an `n`-gon becomes `n` quads); Stam &
 //! Loop 2003 (triangles split as Loop's, other faces as Catmull-Clark's);
-//! Hoppe et al. 1994 sharp creases and corners; OpenSubdiv 3.5 `Far::TopologyRefiner` for the
-//! vertex rules and boundary interpolation. The masks come from [`crate::mask`].
+//! Hoppe et al. 1994 sharp creases and corners; DeRose, Kass & Truong 1998 semi-sharp creases
+//! (OpenSubdiv's uniform creasing, [`crate::crease`]); OpenSubdiv 3.5 `Far::TopologyRefiner`
+//! for the vertex rules and boundary interpolation. The masks come from [`crate::mask`].
 //!
 //! # Child vertex order (stable, documented)
 //! With `V`, `E`, `F` the parent's vertex, edge and face counts, child vertex

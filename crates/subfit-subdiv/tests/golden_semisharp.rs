@@ -14,8 +14,8 @@ use common::{angle, compare, diag, dist, read_lim, read_obj, ANGLE_TOL, POS_TOL}
 use std::path::{Path, PathBuf};
 use subfit_mesh::{Polygons, Tags};
 use subfit_subdiv::{
-    limit_stencils, normals_from_tangents, sampling_operator, Evaluator, Options, Scheme,
-    SurfaceParam,
+    limit_stencils, normals_from_tangents, random_samples, sampling_operator, ClosestOptions,
+    ClosestPointFinder, Evaluator, Options, Scheme, SurfaceParam,
 };
 
 const MESHES: [&str; 3] = [
@@ -210,5 +210,74 @@ fn exact_evaluation_at_dyadic_parameters_matches_opensubdiv() {
                 "{name} L{level}: {max_d:e} {max_a:e}"
             );
         }
+    }
+}
+
+/// Closest points: a query offset from an OpenSubdiv limit point along its normal (by 1e-4 of
+/// the diagonal, well inside the radius of curvature of the rounded creases) has that limit
+/// point as its closest point on our limit surface, at the offset distance.
+#[test]
+fn closest_points_find_opensubdiv_limit_points() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let scale = diag(&pts);
+        let ev = Evaluator::new(&faces, pts.len(), &tags, &Options::new(scheme)).unwrap();
+        let finder = ClosestPointFinder::new(&ev, &pts, ClosestOptions::default()).unwrap();
+        let (refp, ref_n) = reference(name, 3);
+        let h = 1e-4 * scale;
+        let (mut max_d, mut max_h) = (0.0f64, 0.0f64);
+        // Every 7th point: a few hundred queries per mesh, spread over the surface.
+        for k in (0..refp.len()).step_by(7) {
+            let q = [0, 1, 2].map(|c| refp[k][c] + h * ref_n[k][c]);
+            let c = finder.closest(q).unwrap();
+            max_d = max_d.max(dist(&c.position, &refp[k]) / scale);
+            max_h = max_h.max((c.distance - h).abs() / scale);
+        }
+        println!("{name:<28} closest {max_d:.3e} {max_h:.3e}");
+        assert!(max_d < 1e-9 && max_h < 1e-12, "{name}: {max_d:e} {max_h:e}");
+    }
+}
+
+/// Derivatives of exact evaluation at seeded random parameters agree with central differences
+/// of the positions (semi-sharp regions included: every patch touches a tag or is near one).
+#[test]
+fn derivatives_match_finite_differences_on_semi_sharp_meshes() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let scale = diag(&pts);
+        let ev = Evaluator::new(&faces, pts.len(), &tags, &Options::new(scheme)).unwrap();
+        let (params, points) = random_samples(&ev, &pts, 300, 7).unwrap();
+        let h = 1e-6;
+        let mut worst = 0.0f64;
+        for (p, s) in params.iter().zip(&points) {
+            // Keep the stencil inside the patch.
+            let tri = ev.triangle_patch(p.face);
+            let inside = |u: f64, v: f64| {
+                u >= 0.0
+                    && v >= 0.0
+                    && if tri {
+                        u + v <= 1.0
+                    } else {
+                        u <= 1.0 && v <= 1.0
+                    }
+            };
+            if !inside(p.u - h, p.v - h) || !inside(p.u + h, p.v + h) {
+                continue;
+            }
+            let at = |u: f64, v: f64| {
+                ev.evaluate(&pts, SurfaceParam { u, v, ..*p })
+                    .unwrap()
+                    .position
+            };
+            for (d, (a, b)) in [
+                (s.du, (at(p.u + h, p.v), at(p.u - h, p.v))),
+                (s.dv, (at(p.u, p.v + h), at(p.u, p.v - h))),
+            ] {
+                let fd = [0, 1, 2].map(|c| (a[c] - b[c]) / (2.0 * h));
+                worst = worst.max(dist(&fd, &d) / scale);
+            }
+        }
+        println!("{name:<28} derivatives vs differences {worst:.3e}");
+        assert!(worst < 1e-6, "{name}: {worst:e}");
     }
 }
