@@ -15,6 +15,7 @@
 //!   eigenvectors.
 //! * `regular` (internal) — tabulated limit rows of regular Catmull-Clark neighbourhoods.
 //! * [`limit`] — limit position and tangent stencils at every vertex.
+//! * `semi_limit` (internal) — limit rows where semi-sharpness is left, by local refinement.
 //! * [`sample`] — the sampling operator `C = L_l · M_l ⋯ M_1` (DESIGN §3.1).
 //!
 //! Topology never owns positions: functions take a [`subfit_mesh::Polygons`] face list, a vertex
@@ -34,6 +35,7 @@ pub mod topology;
 mod child;
 mod mixed;
 mod regular;
+mod semi_limit;
 
 pub use error::SubdivError;
 pub use limit::{limit_stencils, LimitStencils};

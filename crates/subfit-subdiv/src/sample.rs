@@ -14,17 +14,15 @@
 //! above (module `child`) — for levels `1 … l − 1` as a [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so no adjacency with
 //! one entry per corner of the finest mesh is built, and no intermediate face list.
 //!
-//! Semi-sharp tags ([`crate::crease`]): the refinement rows blend the sharp and smooth rules. If
-//! finite sharpness is left at level `l`, the fused last product is not used: `P_l` and the
-//! level-`l` adjacency are formed and `L_l` (which refines further where the sharpness has not
-//! decayed, [`crate::limit`]) is composed with `P_l`.
+//! Semi-sharp tags ([`crate::crease`]): the refinement rows blend the sharp and smooth rules.
+//! Where finite sharpness is left around a level-`l` vertex its limit row is computed by local
+//! refinement of its one-ring until the sharpness has decayed ([`crate::limit`]), then expanded
+//! like any other row.
 
 use crate::child::refined_topology;
 use crate::error::SubdivError;
 use crate::limit::{limit_refine_compose, limit_rows};
-use crate::refine::{
-    child_faces, child_tags, has_semi_sharp, refine_compose, refine_matrix, topology_for,
-};
+use crate::refine::{child_faces, child_tags, refine_compose, refine_matrix, topology_for};
 use crate::scheme::Options;
 use crate::stencil::StencilMatrix;
 use subfit_mesh::{Polygons, Tags};
@@ -74,9 +72,9 @@ pub struct LimitSamples {
 /// of them). Measured (`benches/stencils.rs`, 2 threads, quiet machine): a 10k-face
 /// Catmull-Clark control mesh at level 3 (686k rows, 30M entries) in ≈ 0.37 s, the first build
 /// of a process included. Most of the time is the last product (scattered reads of `P_{l−1}`
-/// rows and scattered accumulation) and the page faults on the ~0.4 GB output. With finite
-/// sharpness left at level `l`, `P_l` is stored and the mesh is refined further for the limit
-/// rows (module docs).
+/// rows and scattered accumulation) and the page faults on the ~0.4 GB output. Each level-`l`
+/// vertex with finite sharpness left around it costs one local refinement of its one-ring per
+/// remaining unit of sharpness (module docs).
 pub fn sampling_operator(
     faces: &Polygons,
     num_vertices: usize,
@@ -110,27 +108,6 @@ pub fn sampling_operator(
         topo = refined_topology(&topo, options.scheme)?;
     }
     let child_tags = child_tags(&topo, &level_tags);
-    if has_semi_sharp(&child_tags) {
-        // Finite sharpness left at level l: its limit rows need further refinement
-        // ([`crate::limit`]), so form P_l and the level-l adjacency and compose L_l · P_l.
-        let product = if level == 1 {
-            refine_matrix(&topo, &level_tags, options)
-        } else {
-            refine_compose(&topo, &level_tags, options, &product)
-        };
-        let fine = refined_topology(&topo, options.scheme)?;
-        let [position, tangent1, tangent2] =
-            limit_rows(&fine, &child_tags, options).compose(&product);
-        return Ok(SamplingOperator {
-            level,
-            faces: child_faces(&topo, options.scheme),
-            num_vertices: position.nrows(),
-            tags: child_tags,
-            position,
-            tangent1,
-            tangent2,
-        });
-    }
     // The last level: C = L_l · M_l · P_{l−1}, with neither M_l nor its product stored and the
     // level-l adjacency read off level l − 1.
     let [position, tangent1, tangent2] =
