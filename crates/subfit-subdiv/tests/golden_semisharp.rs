@@ -14,8 +14,8 @@ use common::{angle, compare, diag, dist, read_lim, read_obj, ANGLE_TOL, POS_TOL}
 use std::path::{Path, PathBuf};
 use subfit_mesh::{Polygons, Tags};
 use subfit_subdiv::{
-    limit_stencils, normals_from_tangents, random_samples, sampling_operator, ClosestOptions,
-    ClosestPointFinder, Evaluator, Options, Scheme, SurfaceParam,
+    limit_stencils, normals_from_tangents, random_samples, refine, sampling_operator,
+    ClosestOptions, ClosestPointFinder, Evaluator, Options, Scheme, SurfaceParam,
 };
 
 const MESHES: [&str; 3] = [
@@ -279,5 +279,94 @@ fn derivatives_match_finite_differences_on_semi_sharp_meshes() {
         }
         println!("{name:<28} derivatives vs differences {worst:.3e}");
         assert!(worst < 1e-6, "{name}: {worst:e}");
+    }
+}
+
+/// A crease of integer sharpness `k` is subdivided exactly as an infinitely sharp one for `k`
+/// levels (the last one blends with weight 1): the refinement matrices are bit for bit equal.
+#[test]
+fn integer_sharpness_refines_as_infinite_for_that_many_levels() {
+    for name in MESHES {
+        let (pts, faces, tags, scheme) = load(name);
+        let options = Options::new(scheme);
+        let with = |s: f64| {
+            let mut t = Tags::new();
+            for ((a, b), _) in tags.creases() {
+                t.set_crease(a, b, s);
+            }
+            t
+        };
+        let (mut fa, mut ta, mut na) = (faces.clone(), with(3.0), pts.len());
+        let mut tb = with(subfit_mesh::SHARPNESS_INFINITE);
+        for level in 0..3 {
+            let a = refine(&fa, na, &ta, &options).unwrap();
+            let b = refine(&fa, na, &tb, &options).unwrap();
+            assert_eq!(a.matrix, b.matrix, "{name} level {level}");
+            (fa, ta, tb, na) = (a.faces, a.tags, b.tags, a.num_vertices);
+        }
+        // Sharpness 3 has decayed: the next level differs (smooth there).
+        let a = refine(&fa, na, &ta, &options).unwrap();
+        let b = refine(&fa, na, &tb, &options).unwrap();
+        assert!(ta.is_empty() && a.matrix != b.matrix, "{name}");
+    }
+}
+
+/// Quad/triangle meshes with semi-sharp tags (mixed vertices on the creases): the limit of a
+/// vertex equals the limit of its vertex point one level down (positions to round-off), and
+/// exact evaluation at the control vertices gives the level-0 limit points.
+#[test]
+fn mixed_quad_triangle_semi_sharp_limits_are_consistent() {
+    // A cube with one side split into two triangles.
+    let (pts, _, _, _) = load("quad_cube_semisharp");
+    let mut faces = Polygons::new();
+    for f in [
+        [0, 3, 2, 1],
+        [4, 5, 6, 7],
+        [1, 2, 6, 5],
+        [2, 3, 7, 6],
+        [3, 0, 4, 7],
+    ] {
+        faces.push(&f);
+    }
+    faces.push(&[0, 1, 5]);
+    faces.push(&[0, 5, 4]);
+    let mut tags = Tags::new();
+    tags.set_crease(0, 1, 0.5);
+    tags.set_crease(1, 5, 2.3);
+    tags.set_crease(0, 5, 1.5);
+    tags.set_crease(2, 6, 1.0);
+    tags.set_corner(5, 0.7);
+    let options = Options::new(Scheme::QuadTriangle);
+    let scale = diag(&pts);
+    let ops: Vec<_> = (0..=3)
+        .map(|l| {
+            sampling_operator(&faces, pts.len(), &tags, &options, l)
+                .unwrap()
+                .evaluate(&pts)
+        })
+        .collect();
+    for k in 0..3 {
+        for v in 0..ops[k].positions.len() {
+            let d = dist(&ops[k].positions[v], &ops[k + 1].positions[v]) / scale;
+            assert!(d < 1e-13, "level {k} vertex {v}: {d:e}");
+        }
+    }
+    let ev = Evaluator::new(&faces, pts.len(), &tags, &options).unwrap();
+    for (f, face) in faces.iter().enumerate() {
+        let corners: &[(f64, f64)] = if face.len() == 3 {
+            &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]
+        } else {
+            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+        };
+        for (k, &(u, v)) in corners.iter().enumerate() {
+            let p = ev
+                .evaluate(&pts, SurfaceParam::new(f as u32, u, v))
+                .unwrap();
+            let x = face[k] as usize;
+            let d = dist(&p.position, &ops[0].positions[x]) / scale;
+            assert!(d < 1e-13, "face {f} corner {k}: {d:e}");
+            let a = angle(&p.normal, &ops[0].normals[x]);
+            assert!(a < 1e-9, "face {f} corner {k}: normal {a:e}");
+        }
     }
 }
