@@ -90,7 +90,9 @@ fn limit_stencils_match_opensubdiv_at_level_0() {
 }
 
 /// The limit of vertex `v` at level `k` is the limit of its vertex point (the same id) at level
-/// `k + 1`: positions to round-off, and normals where the closed-form masks are exact.
+/// `k + 1`: positions and normals to round-off. (Normals would not be invariant at infinitely
+/// sharp irregular creases and corners, where OpenSubdiv's tangent masks are approximations;
+/// these meshes have none, their sharp features are semi-sharp or regular boundaries.)
 #[test]
 fn limit_of_a_vertex_is_the_limit_of_its_vertex_point() {
     for name in MESHES {
@@ -104,17 +106,21 @@ fn limit_of_a_vertex_is_the_limit_of_its_vertex_point() {
                     .evaluate(&pts)
             })
             .collect();
+        let (mut max_d, mut max_a) = (0.0f64, 0.0f64);
         for k in 0..3 {
             let (a, b) = (&ops[k], &ops[k + 1]);
             for v in 0..a.positions.len() {
                 let d = dist(&a.positions[v], &b.positions[v]) / scale;
                 assert!(d < 1e-13, "{name} level {k} vertex {v}: {d:e}");
                 let ang = angle(&a.normals[v], &b.normals[v]);
-                assert!(ang < 1e-6, "{name} level {k} vertex {v}: normal {ang:e}");
+                assert!(ang < 1e-12, "{name} level {k} vertex {v}: normal {ang:e}");
+                (max_d, max_a) = (max_d.max(d), max_a.max(ang));
             }
         }
+        println!("{name:<28} level k vs k + 1: {max_d:.3e} {max_a:.3e}");
     }
 }
+
 /// Exact evaluation at the corners of every face gives the limit points of the control
 /// vertices, and inside faces it lies on the limit surface of the refined mesh (the evaluation
 /// at a face's centre equals the limit of the level-1 face point, Catmull-Clark).
