@@ -1,5 +1,8 @@
 //! Build time of the sampling operator `C = L_3 · M_3 M_2 M_1` for 1k- and 10k-face control
 //! meshes (Loop, Catmull-Clark and quad/triangle), on torus grids with extraordinary vertices.
+//! `TAGS=semi` (or `TAGS=sharp`, `TAGS=<sharpness>`) tags every 10th meridian of the torus as a
+//! crease of sharpness 2.5 (infinite, the given value), to measure the cost of semi-sharp
+//! creases (with sharpness > 3, some is left at level 3 and the limit rows refine locally).
 #![allow(missing_docs, clippy::print_stdout, reason = "benchmark program")]
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -46,6 +49,28 @@ fn torus(n: usize, m: usize, loop_mesh: bool) -> (Vec<[f64; 3]>, Polygons) {
     (pts, faces)
 }
 
+/// Crease tags from `TAGS` (`semi`: sharpness 2.5, `sharp`: infinite, a number: that sharpness,
+/// else none) on every
+/// 10th meridian `i = 0, 10, …` of the `n × m` torus grid.
+fn meridian_tags(n: usize, m: usize) -> Tags {
+    let s = match std::env::var("TAGS").as_deref() {
+        Ok("semi") => 2.5,
+        Ok("sharp") => subfit_mesh::SHARPNESS_INFINITE,
+        Ok(x) => match x.parse::<f64>() {
+            Ok(s) => s,
+            Err(_) => return Tags::new(),
+        },
+        _ => return Tags::new(),
+    };
+    let mut tags = Tags::new();
+    for i in (0..n).step_by(10) {
+        for j in 0..m {
+            tags.set_crease((i * m + j) as u32, (i * m + (j + 1) % m) as u32, s);
+        }
+    }
+    tags
+}
+
 /// Process CPU time (user + system, all threads) in seconds, from `/proc/self/stat` (Linux; 0
 /// elsewhere). Reported beside wall time because the benchmark machine may be shared.
 fn cpu_seconds() -> f64 {
@@ -86,8 +111,9 @@ fn bench(c: &mut Criterion) {
             continue;
         }
         let (pts, faces) = torus(n, m, scheme == Scheme::Loop);
+        let tags = meridian_tags(n, m);
         let o = Options::new(scheme);
-        let build = || sampling_operator(&faces, pts.len(), &Tags::new(), &o, 3).unwrap();
+        let build = || sampling_operator(&faces, pts.len(), &tags, &o, 3).unwrap();
         // The first build of the process is timed on its own: it pays for fresh pages from the
         // kernel and the thread pool's start, which a user building the operator once sees.
         let (wall, cpu) = (std::time::Instant::now(), cpu_seconds());
@@ -125,7 +151,7 @@ fn bench(c: &mut Criterion) {
             continue;
         }
         g.bench_function(name, |b| {
-            b.iter(|| sampling_operator(black_box(&faces), pts.len(), &Tags::new(), &o, 3).unwrap())
+            b.iter(|| sampling_operator(black_box(&faces), pts.len(), &tags, &o, 3).unwrap())
         });
     }
     g.finish();

@@ -5,6 +5,8 @@
 //!   storage-free [`Neighborhood`] a scheme reads (OpenSubdiv `Sdc` vocabulary).
 //! * [`mask`] — refinement and limit masks (Loop 1987; Catmull & Clark 1978; Hoppe et al. 1994;
 //!   Halstead et al. 1993; OpenSubdiv 3.5 tangent masks).
+//! * [`crease`] — semi-sharp creases and corners: decay, fractional weights and blended masks
+//!   (DeRose, Kass & Truong 1998; OpenSubdiv 3.5 `Sdc::Crease`).
 //! * [`stencil`] — [`StencilMatrix`], CSR rows of weights over control points.
 //! * [`topology`] — the edge and vertex-ring adjacency the rules need.
 //! * [`mod@refine`] — one level of uniform refinement as a matrix, with a documented child order.
@@ -13,12 +15,14 @@
 //!   eigenvectors.
 //! * `regular` (internal) — tabulated limit rows of regular Catmull-Clark neighbourhoods.
 //! * [`limit`] — limit position and tangent stencils at every vertex.
+//! * `semi_limit` (internal) — limit rows where semi-sharpness is left, by local refinement.
 //! * [`sample`] — the sampling operator `C = L_l · M_l ⋯ M_1` (DESIGN §3.1).
 //!
 //! Topology never owns positions: functions take a [`subfit_mesh::Polygons`] face list, a vertex
 //! count and [`subfit_mesh::Tags`], and return matrices to apply to `#V by 3` positions.
 //! Everything is checked against OpenSubdiv's limit values (`tests/golden.rs`).
 
+pub mod crease;
 pub mod error;
 pub mod limit;
 pub mod mask;
@@ -31,6 +35,7 @@ pub mod topology;
 mod child;
 mod mixed;
 mod regular;
+mod semi_limit;
 
 pub use error::SubdivError;
 pub use limit::{limit_stencils, LimitStencils};

@@ -6,6 +6,14 @@
 //! (1/6, 2/3, 1/6) on creases and boundaries (Hoppe et al. 1994); corners are fixed. Tangent masks
 //! follow OpenSubdiv 3.5 (`sdc/*Scheme.h`, `Far::PrimvarRefiner::Limit`), see [`crate::mask`].
 //!
+//! Semi-sharp features (finite sharpness, [`crate::crease`]): the closed-form masks hold only
+//! once no finite sharpness is left at a vertex or its incident edges. The rows of such a vertex
+//! are those of its vertex point after one refinement step (the same limit point), composed with
+//! that step, recursively — `⌈s⌉` steps for the largest sharpness `s` around it — on its
+//! one-ring faces only (module `semi_limit`). Tangents are scaled by 2 per step as below.
+//! OpenSubdiv's `PrimvarRefiner::Limit` applies the crease or corner masks there instead, which
+//! is not the limit.
+//!
 //! Exactness: limit positions are exact everywhere except at darts (an interior vertex with one
 //! sharp edge), where the smooth mask is used as in OpenSubdiv; tangent directions are exact at
 //! smooth vertices and regular boundaries, and at irregular creases and corners they are
@@ -28,12 +36,13 @@ use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
 use crate::refine::{
-    classify, face_kinds, neighborhoods, refine_topology, sharp_edges, topology_for, RefineRows,
-    VertexMaskCache,
+    classify, face_kinds, has_semi_sharp, neighborhoods, refine_topology, sharp_edges,
+    topology_for, RefineRows, VertexMaskCache,
 };
 use crate::regular::{is_regular, Regular, Tables};
 use crate::scheme::{FaceKinds, Neighborhood};
 use crate::scheme::{Options, Scheme};
+use crate::semi_limit::{ring_faces, semi_sharp_at, semi_sharp_limit_row};
 use crate::stencil::{compose_rows, MultiRows, SparseSum, Stacked, StencilMatrix};
 use crate::topology::Topology;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -122,6 +131,32 @@ fn push_limit_row(
     row.extend((0..nf).map(diagonal).zip(w[1 + ne..].iter().copied()));
 }
 
+/// [`push_limit_row`] for vertex `v` of `topo`, its rule classified from `tags` (boundary and
+/// infinitely sharp edges, corner tags; finite sharpness is not looked at). Cost O(valence).
+pub(crate) fn push_topology_limit_row_for(
+    topo: &Topology,
+    tags: &Tags,
+    options: &Options,
+    v: u32,
+    row: &mut Vec<(u32, [f64; 3])>,
+) {
+    let tagged = !tags.is_empty();
+    let sharp = topo
+        .vertex_edges(v)
+        .iter()
+        .zip(topo.vertex_ring(v))
+        .map(|(&e, &u)| topo.is_boundary_edge(e) || (tagged && tags.is_sharp_edge(v, u)));
+    let hood = classify(
+        sharp,
+        topo.vertex_corners(v).len(),
+        face_kinds(topo, v),
+        tagged && tags.is_corner(v),
+        options.boundary,
+    );
+    let mut masks = LimitMasks::default();
+    push_topology_limit_row(topo, options.scheme, &hood, &mut masks, v, row);
+}
+
 /// [`push_limit_row`] for vertex `v` of `topo`.
 fn push_topology_limit_row(
     topo: &Topology,
@@ -159,6 +194,43 @@ impl ChildView<'_> {
         }
     }
 
+    /// Whether child vertex `w` (ring `ring`) has a finite sharpness at it or on a ring edge in
+    /// `tags`. Cost O(valence) hash lookups.
+    fn semi_sharp_at(&self, w: u32, ring: &ChildRing, tags: &Tags) -> bool {
+        let semi = |s: f64| crate::crease::is_semi_sharp(crate::crease::sharpness(s));
+        semi(tags.corner(w))
+            || ring
+                .verts
+                .iter()
+                .zip(&ring.boundary)
+                .any(|(&u, &b)| !b && semi(tags.crease(w, u)))
+    }
+
+    /// The faces of the child mesh around a child vertex whose ring is `ring` (child ids).
+    fn ring_faces(&self, ring: &ChildRing) -> Polygons {
+        let mut out = Polygons::new();
+        let mut face = Vec::new();
+        for &c in &ring.corners {
+            face.clear();
+            let mut x = c;
+            loop {
+                face.push(match self {
+                    ChildView::Closed(k) => k.vertex(x),
+                    ChildView::Built(t) => t.corner_vertex(x),
+                });
+                x = match self {
+                    ChildView::Closed(k) => k.next(x),
+                    ChildView::Built(t) => t.corner_next(x),
+                };
+                if x == c {
+                    break;
+                }
+            }
+            out.push(&face);
+        }
+        out
+    }
+
     /// The ring of child vertex `w` and the kinds of its faces.
     fn ring(&self, w: u32, ring: &mut ChildRing) -> FaceKinds {
         match self {
@@ -187,6 +259,10 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     let sharp = sharp_edges(topo, tags);
     let hoods = neighborhoods(topo, &sharp, tags, options.boundary);
     let nv = topo.num_vertices();
+    // Vertices with finite sharpness at them or on an incident edge have no closed-form limit
+    // mask yet: their rows come from local refinement until it has decayed (module docs).
+    let semi = has_semi_sharp(tags);
+    let affected = |v: u32| semi && semi_sharp_at(topo, tags, v);
     let mut rows = MultiRows {
         ncols: nv,
         offsets: Vec::with_capacity(nv + 1),
@@ -198,7 +274,11 @@ pub(crate) fn limit_rows(topo: &Topology, tags: &Tags, options: &Options) -> Mul
     let mut row = Vec::new();
     for (v, hood) in hoods.iter().enumerate() {
         row.clear();
-        push_topology_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
+        if affected(v as u32) {
+            row = semi_sharp_limit_row(&ring_faces(topo, v as u32), v as u32, tags, options);
+        } else {
+            push_topology_limit_row(topo, options.scheme, hood, &mut masks, v as u32, &mut row);
+        }
         for &(c, w) in &row {
             rows.cols.push(c);
             rows.weights.push(w);
@@ -260,12 +340,14 @@ fn limit_refine_compose_with(
     };
     let refine = RefineRows::new(parent, parent_tags, options);
     let regular = match options.scheme {
-        Scheme::CatmullClark | Scheme::QuadTriangle if tables => {
+        // The tables assume the rules of the parent's infinitely sharp tags only.
+        Scheme::CatmullClark | Scheme::QuadTriangle if tables && !refine.semi_sharp() => {
             Some(Regular::new(parent, refine.hoods(), refine.face_points()))
         }
         _ => None,
     };
     let tagged = !child_tags.is_empty();
+    let child_semi = has_semi_sharp(child_tags);
     let nv = parent.num_vertices();
     compose_rows(
         child.num_vertices(),
@@ -282,6 +364,18 @@ fn limit_refine_compose_with(
                 tables,
             } = st;
             let mut hood = None;
+            if child_semi {
+                child.ring(w, ring);
+                if child.semi_sharp_at(w, ring, child_tags) {
+                    // Finite sharpness left around the child vertex: its limit row over the
+                    // child vertices comes from local refinement of its one-ring.
+                    let faces = child.ring_faces(ring);
+                    *child_row = semi_sharp_limit_row(&faces, w, child_tags, options);
+                    accumulate_child_row(parent, &refine, child_row, vertex_masks, sum);
+                    sum.drain_into(row);
+                    return;
+                }
+            }
             let child_hood = |ring: &mut ChildRing| {
                 let kinds = child.ring(w, ring);
                 // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
@@ -328,19 +422,32 @@ fn limit_refine_compose_with(
                 child_row,
             );
             // Face centres are summed as columns `nv + f` and expanded once per face.
-            for &(j, l) in child_row.iter() {
-                refine.row(vertex_masks, j as usize, Some(nv as u32), |k, m| {
-                    sum.add(k, [l[0] * m, l[1] * m, l[2] * m]);
-                });
-            }
-            let points = refine.face_points();
-            sum.expand_faces(nv as u32, |k| parent.face(points.face(k as usize)));
+            accumulate_child_row(parent, &refine, child_row, vertex_masks, sum);
             if fast {
                 tables.record(sum.entries());
             }
             sum.drain_into(row);
         },
     )
+}
+
+/// Expands a limit row over child vertices (`child_row`) by the refinement rows into `sum`, over
+/// the parent vertices (face centres summed as columns `nv + f` and expanded once per face).
+fn accumulate_child_row(
+    parent: &Topology,
+    refine: &RefineRows<'_>,
+    child_row: &[(u32, [f64; 3])],
+    vertex_masks: &mut VertexMaskCache,
+    sum: &mut SparseSum,
+) {
+    let nv = parent.num_vertices();
+    for &(j, l) in child_row {
+        refine.row(vertex_masks, j as usize, Some(nv as u32), |k, m| {
+            sum.add(k, [l[0] * m, l[1] * m, l[2] * m]);
+        });
+    }
+    let points = refine.face_points();
+    sum.expand_faces(nv as u32, |k| parent.face(points.face(k as usize)));
 }
 
 /// Per-worker state of [`limit_refine_compose`].

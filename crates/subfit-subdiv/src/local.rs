@@ -10,6 +10,11 @@
 //! face that contains the evaluation point, and composes the rows, so the final weights refer to
 //! the original control points.
 //!
+//! Semi-sharp creases and corners ([`crate::crease`]): face edges and vertices carry their
+//! finite sharpness, child vertices blend the rules as [`crate::refine`] does, and the sharpness
+//! decays by one per level; a corner with finite sharpness at it or on an incident edge is never
+//! regular (and has no closed-form limit), so evaluation refines until it has decayed.
+//!
 //! Regular patches are gathered by walking each corner's ring; across boundary and infinitely
 //! sharp crease edges the missing lattice points are phantoms: `2 b − i` (Catmull-Clark, linear
 //! extrapolation across the edge) and `a + b − c` (Loop, the parallelogram reflection of the
@@ -17,6 +22,7 @@
 //! rules exactly (boundary curve = cubic B-spline of the crease polygon, crease vertex rule
 //! 1/8, 3/4, 1/8, crease edge = midpoint), so boundary and crease patches are exact too.
 
+use crate::crease;
 use crate::mask::{FaceWeights, Mask};
 use crate::patch::{BSPLINE_PATCH_GRID, LOOP_PATCH_LATTICE};
 use crate::scheme::{BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Scheme, VertexRule};
@@ -39,6 +45,11 @@ pub(crate) struct LocalMesh {
     pub fv: Vec<u32>,
     /// Flags of face edge `corner → next corner`, parallel to `fv`.
     pub fe: Vec<u8>,
+    /// Finite (semi-sharp) sharpness of face edge `corner → next corner`, parallel to `fv`
+    /// (0 when smooth or infinitely sharp; see [`crate::crease`]).
+    pub fs: Vec<f32>,
+    /// Finite corner sharpness of each vertex (0 when none or infinite).
+    pub vs: Vec<f32>,
     /// Faces around each vertex in the whole mesh ([`UNKNOWN`] if not known).
     pub nfaces: Vec<u32>,
     /// Corner-tagged vertices.
@@ -58,6 +69,9 @@ pub(crate) struct Adjacency {
 pub(crate) struct Ring {
     pub verts: Vec<u32>,
     pub eflags: Vec<u8>,
+    /// Sharpness of each ring edge as [`crate::crease`] reads it: [`crease::INFINITE`] for
+    /// sharp (and boundary) edges, else the finite sharpness or 0.
+    pub sharpness: Vec<f32>,
     pub corners: Vec<u32>,
     pub boundary: bool,
 }
@@ -191,6 +205,7 @@ impl LocalMesh {
         let mut ring = Ring {
             verts: Vec::with_capacity(cs.len() + 1),
             eflags: Vec::with_capacity(cs.len() + 1),
+            sharpness: Vec::with_capacity(cs.len() + 1),
             corners: Vec::with_capacity(cs.len()),
             boundary,
         };
@@ -198,6 +213,7 @@ impl LocalMesh {
         loop {
             ring.verts.push(vert(self.next(adj, c)));
             ring.eflags.push(self.fe[c as usize]);
+            ring.sharpness.push(self.edge_sharpness(c));
             ring.corners.push(c);
             match ccw(c) {
                 Some(d) if d == start => break,
@@ -207,6 +223,7 @@ impl LocalMesh {
                     let p = self.prev(adj, c);
                     ring.verts.push(vert(p));
                     ring.eflags.push(self.fe[p as usize]);
+                    ring.sharpness.push(self.edge_sharpness(p));
                     break;
                 }
             }
@@ -214,7 +231,23 @@ impl LocalMesh {
         (ring.corners.len() == cs.len()).then_some(ring)
     }
 
-    /// The scheme's view of a complete vertex (rule as in [`crate::refine`]).
+    /// The sharpness of face edge `c` as [`crate::crease`] reads it.
+    fn edge_sharpness(&self, c: u32) -> f32 {
+        if self.fe[c as usize] & SHARP != 0 {
+            crease::INFINITE
+        } else {
+            self.fs[c as usize]
+        }
+    }
+
+    /// Whether vertex `v` (with ring `ring`) or one of its edges has a finite sharpness: its
+    /// rule may change at the next level, and no closed-form limit applies yet.
+    pub fn semi_sharp_at(&self, v: u32, ring: &Ring) -> bool {
+        self.vs[v as usize] > 0.0 || ring.sharpness.iter().any(|&s| crease::is_semi_sharp(s))
+    }
+
+    /// The scheme's view of a complete vertex (rule as in [`crate::refine`], from the boundary,
+    /// infinitely sharp edges and corner tags; finite sharpness is read by [`child_row`]).
     pub fn neighborhood(
         &self,
         adj: &Adjacency,
@@ -289,6 +322,9 @@ pub(crate) struct ChildFace {
     pub verts: Vec<ChildVertex>,
     /// Face-edge flags.
     pub flags: Vec<u8>,
+    /// Finite face-edge sharpness (the parent edge's, decremented, on the two halves of a parent
+    /// edge; 0 inside the parent face).
+    pub sharpness: Vec<f32>,
     /// Parent-domain parameters of the corners (only for triangles and quads).
     pub params: Vec<[f64; 2]>,
 }
@@ -337,6 +373,10 @@ pub(crate) fn children(mesh: &LocalMesh, scheme: Scheme, f: usize) -> Vec<ChildF
     let base = mesh.fo[f] as usize;
     let fl = &mesh.fe[base..base + face.len()];
     let n = face.len();
+    let sh: Vec<f32> = mesh.fs[base..base + n]
+        .iter()
+        .map(|&s| crease::decrement(s))
+        .collect();
     let e = |i: usize| edge_key(face[i % n], face[(i + 1) % n]);
     let vx = |i: usize| ChildVertex::Vertex(face[i % n]);
     match patch_scheme(scheme, n) {
@@ -347,21 +387,25 @@ pub(crate) fn children(mesh: &LocalMesh, scheme: Scheme, f: usize) -> Vec<ChildF
                 ChildFace {
                     verts: vec![vx(0), e(0), e(2)],
                     flags: vec![fl[0], 0, fl[2]],
+                    sharpness: vec![sh[0], 0.0, sh[2]],
                     params: vec![p[0], ab, ca],
                 },
                 ChildFace {
                     verts: vec![vx(1), e(1), e(0)],
                     flags: vec![fl[1], 0, fl[0]],
+                    sharpness: vec![sh[1], 0.0, sh[0]],
                     params: vec![p[1], bc, ab],
                 },
                 ChildFace {
                     verts: vec![vx(2), e(2), e(1)],
                     flags: vec![fl[2], 0, fl[1]],
+                    sharpness: vec![sh[2], 0.0, sh[1]],
                     params: vec![p[2], ca, bc],
                 },
                 ChildFace {
                     verts: vec![e(0), e(1), e(2)],
                     flags: vec![0, 0, 0],
+                    sharpness: vec![0.0; 3],
                     params: vec![ab, bc, ca],
                 },
             ]
@@ -382,6 +426,7 @@ pub(crate) fn children(mesh: &LocalMesh, scheme: Scheme, f: usize) -> Vec<ChildF
                 ChildFace {
                     verts: vec![vx(i), e(i), ChildVertex::Face(f as u32), e(i + n - 1)],
                     flags: vec![fl[i], 0, 0, fl[(i + n - 1) % n]],
+                    sharpness: vec![sh[i], 0.0, 0.0, sh[(i + n - 1) % n]],
                     params,
                 }
             })
@@ -402,6 +447,7 @@ pub(crate) fn child_row(
     boundary: BoundaryRule,
     cv: ChildVertex,
     mask: &mut Mask,
+    scratch: &mut Mask,
     out: &mut [f64],
 ) -> bool {
     match cv {
@@ -410,7 +456,23 @@ pub(crate) fn child_row(
                 return false;
             };
             let hood = mesh.neighborhood(adj, v, &ring, boundary);
-            scheme.vertex_point_mask(&hood, mask);
+            if mesh.semi_sharp_at(v, &ring) {
+                let vs = if hood.rule == VertexRule::Corner {
+                    crease::INFINITE
+                } else {
+                    mesh.vs[v as usize]
+                };
+                scheme.semi_sharp_vertex_point_mask(
+                    &hood,
+                    vs,
+                    &ring.sharpness,
+                    boundary,
+                    mask,
+                    scratch,
+                );
+            } else {
+                scheme.vertex_point_mask(&hood, mask);
+            }
             mesh.apply_mask(adj, v, &ring, mask, out);
             true
         }
@@ -434,11 +496,13 @@ pub(crate) fn child_row(
                 cs.get(k)
                     .is_some_and(|&c| mesh.face(adj.cface[c as usize] as usize).len() == 3)
             };
-            let em = scheme.edge_point_mask(&EdgeNeighborhood {
+            let semi = mesh.fs[c0 as usize];
+            let mut em = scheme.edge_point_mask(&EdgeNeighborhood {
                 num_faces: cs.len(),
-                sharp: flags & SHARP != 0,
+                sharp: flags & SHARP != 0 || semi > 1.0,
                 triangles: [tri(0), tri(1)],
             });
+            crease::blend_edge_mask(&mut em, semi);
             mesh.axpy(out, a, em.end);
             mesh.axpy(out, b, em.end);
             for (k, &c) in cs.iter().enumerate() {
@@ -606,6 +670,10 @@ pub(crate) fn corner_points(
     let Some(ring) = mesh.ring(adj, v) else {
         return false;
     };
+    if mesh.semi_sharp_at(v, &ring) {
+        // The rules change around `v` at a later level: not a polynomial patch yet.
+        return false;
+    }
     let nf = ring.corners.len();
     let ne = ring.verts.len();
     if ring

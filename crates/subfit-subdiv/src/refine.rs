@@ -3,8 +3,9 @@
 //!
 //! Loop 1987 (1→4 triangle split); Catmull & Clark 1978 (an `n`-gon becomes `n` quads); Stam &
 //! Loop 2003 (triangles split as Loop's, other faces as Catmull-Clark's);
-//! Hoppe et al. 1994 sharp creases and corners; OpenSubdiv 3.5 `Far::TopologyRefiner` for the
-//! vertex rules and boundary interpolation. The masks come from [`crate::mask`].
+//! Hoppe et al. 1994 sharp creases and corners; DeRose, Kass & Truong 1998 semi-sharp creases
+//! (OpenSubdiv's uniform creasing, [`crate::crease`]); OpenSubdiv 3.5 `Far::TopologyRefiner`
+//! for the vertex rules and boundary interpolation. The masks come from [`crate::mask`].
 //!
 //! # Child vertex order (stable, documented)
 //! With `V`, `E`, `F` the parent's vertex, edge and face counts, child vertex
@@ -27,6 +28,7 @@
 //! face as Catmull-Clark's. Winding is preserved.
 
 use crate::child::ChildCorners;
+use crate::crease;
 use crate::error::SubdivError;
 use crate::mask::{FaceWeights, Mask};
 use crate::scheme::{
@@ -46,7 +48,9 @@ pub struct Refinement {
     /// the number of non-triangles for quad/triangle).
     pub num_vertices: usize,
     /// Tags carried to the child mesh: infinitely sharp creases on both child edges of a sharp
-    /// parent edge, finite sharpness decremented by one, corner tags on the same vertex ids.
+    /// parent edge, corner tags on the same vertex ids; finite sharpness (edges and corners) in
+    /// single precision and decremented by one, dropped once it reaches 0
+    /// ([`crate::crease::decrement`]).
     pub tags: Tags,
     /// The refinement operator, `num_vertices × parent vertices`: child positions =
     /// `matrix.apply(parent positions)`.
@@ -99,6 +103,68 @@ pub(crate) fn sharp_edges(topo: &Topology, tags: &Tags) -> Vec<bool> {
             }
         })
         .collect()
+}
+
+/// Whether `tags` hold a finite (semi-sharp) crease or corner sharpness. Cost O(#tags).
+pub(crate) fn has_semi_sharp(tags: &Tags) -> bool {
+    !tags.is_empty()
+        && (tags
+            .creases()
+            .iter()
+            .any(|&(_, s)| crease::is_semi_sharp(crease::sharpness(s)))
+            || tags
+                .corners()
+                .iter()
+                .any(|&(_, s)| crease::is_semi_sharp(crease::sharpness(s))))
+}
+
+/// The finite sharpness of every edge (0 for smooth, boundary and infinitely sharp edges), or
+/// an empty vector when `tags` hold no finite sharpness. Cost O(#E + #tags · valence).
+pub(crate) fn semi_sharp_edges(topo: &Topology, tags: &Tags) -> Vec<f32> {
+    if !has_semi_sharp(tags) {
+        return Vec::new();
+    }
+    let mut out = vec![0.0f32; topo.num_edges()];
+    for ((a, b), s) in tags.creases() {
+        let s = crease::sharpness(s);
+        if !crease::is_semi_sharp(s) || a as usize >= topo.num_vertices() {
+            continue;
+        }
+        if let Some(i) = topo.vertex_ring(a).iter().position(|&u| u == b) {
+            let e = topo.vertex_edges(a)[i];
+            if !topo.is_boundary_edge(e) {
+                out[e as usize] = s;
+            }
+        }
+    }
+    out
+}
+
+/// The finite corner sharpness of every vertex (0 where none or infinite), or an empty vector
+/// when `tags` hold no finite sharpness. Cost O(#V + #tags).
+pub(crate) fn semi_sharp_vertices(num_vertices: usize, tags: &Tags) -> Vec<f32> {
+    if !has_semi_sharp(tags) {
+        return Vec::new();
+    }
+    let mut out = vec![0.0f32; num_vertices];
+    for (v, s) in tags.corners() {
+        let s = crease::sharpness(s);
+        if crease::is_semi_sharp(s) && (v as usize) < num_vertices {
+            out[v as usize] = s;
+        }
+    }
+    out
+}
+
+/// The sharpness of ring edge `e` as [`crate::crease`] reads it: [`crease::INFINITE`] for
+/// boundary and infinitely sharp edges, else the finite sharpness (0 when smooth).
+#[inline]
+pub(crate) fn edge_sharpness(sharp: &[bool], semi: &[f32], e: u32) -> f32 {
+    if sharp[e as usize] {
+        crease::INFINITE
+    } else {
+        semi.get(e as usize).copied().unwrap_or(0.0)
+    }
 }
 
 /// The [`Neighborhood`] (rule and crease ends) of every vertex. Cost O(#corners).
@@ -248,6 +314,9 @@ pub(crate) fn refine_compose(
 pub(crate) struct VertexMaskCache {
     hood: Option<Neighborhood>,
     mask: Mask,
+    /// The child-rule mask and ring sharpnesses of semi-sharp vertices.
+    scratch: Mask,
+    ring: Vec<f32>,
 }
 
 /// The rows of one level of refinement (child vertex order in the module docs), generated on
@@ -256,6 +325,11 @@ pub(crate) struct RefineRows<'a> {
     topo: &'a Topology,
     scheme: Scheme,
     sharp: Vec<bool>,
+    /// Finite edge sharpness ([`semi_sharp_edges`]; empty without semi-sharp tags).
+    semi: Vec<f32>,
+    /// Finite vertex sharpness ([`semi_sharp_vertices`]; empty without semi-sharp tags).
+    vsemi: Vec<f32>,
+    boundary: BoundaryRule,
     hoods: Vec<Neighborhood>,
     points: FacePoints,
     smooth_triangles: bool,
@@ -346,6 +420,9 @@ impl<'a> RefineRows<'a> {
             topo,
             scheme: options.scheme,
             sharp,
+            semi: semi_sharp_edges(topo, tags),
+            vsemi: semi_sharp_vertices(topo.num_vertices(), tags),
+            boundary: options.boundary,
             hoods,
             points: FacePoints::new(topo, options.scheme),
             smooth_triangles: options.scheme == Scheme::CatmullClark
@@ -353,9 +430,28 @@ impl<'a> RefineRows<'a> {
         }
     }
 
-    /// The parent vertices' neighbourhoods (rule and crease ends, from the parent's tags).
+    /// The parent vertices' neighbourhoods (rule and crease ends, from the parent's infinitely
+    /// sharp tags; see [`Self::semi_sharp`]).
     pub(crate) fn hoods(&self) -> &[Neighborhood] {
         &self.hoods
+    }
+
+    /// Whether any edge or vertex has a finite sharpness (then [`Self::hoods`] do not give the
+    /// rules of the vertices it touches).
+    pub(crate) fn semi_sharp(&self) -> bool {
+        !self.semi.is_empty()
+    }
+
+    /// Whether vertex `v` or one of its edges has a finite sharpness. Cost O(valence).
+    #[inline]
+    pub(crate) fn semi_sharp_at(&self, v: u32) -> bool {
+        !self.semi.is_empty()
+            && (self.vsemi[v as usize] > 0.0
+                || self
+                    .topo
+                    .vertex_edges(v)
+                    .iter()
+                    .any(|&e| self.semi[e as usize] > 0.0))
     }
 
     /// Number of child vertices (`V + E`, plus the face points).
@@ -380,7 +476,27 @@ impl<'a> RefineRows<'a> {
         if i < nv {
             let v = i as u32;
             let hood = &self.hoods[i];
-            if cache.hood.as_ref() != Some(hood) {
+            if self.semi_sharp_at(v) {
+                cache.ring.clear();
+                let ring = topo.vertex_edges(v).iter();
+                cache
+                    .ring
+                    .extend(ring.map(|&e| edge_sharpness(&self.sharp, &self.semi, e)));
+                let vs = if hood.rule == VertexRule::Corner {
+                    crease::INFINITE
+                } else {
+                    self.vsemi[i]
+                };
+                self.scheme.semi_sharp_vertex_point_mask(
+                    hood,
+                    vs,
+                    &cache.ring,
+                    self.boundary,
+                    &mut cache.mask,
+                    &mut cache.scratch,
+                );
+                cache.hood = None;
+            } else if cache.hood.as_ref() != Some(hood) {
                 self.scheme.vertex_point_mask(hood, &mut cache.mask);
                 cache.hood = Some(*hood);
             }
@@ -403,9 +519,10 @@ impl<'a> RefineRows<'a> {
             let tri = |k: usize| {
                 k < num_faces && topo.face(topo.corner_face(corners[k]) as usize).len() == 3
             };
+            let semi = self.semi.get(e as usize).copied().unwrap_or(0.0);
             let mut em = self.scheme.edge_point_mask(&EdgeNeighborhood {
                 num_faces,
-                sharp: self.sharp[e as usize],
+                sharp: self.sharp[e as usize] || semi > 1.0,
                 triangles: [tri(0), tri(1)],
             });
             if self.smooth_triangles && num_faces == 2 && em.face[0] != 0.0 && (tri(0) || tri(1)) {
@@ -415,6 +532,7 @@ impl<'a> RefineRows<'a> {
                 em.face = [fw; 2];
                 em.end = 0.5 * (1.0 - 2.0 * fw);
             }
+            crease::blend_edge_mask(&mut em, semi);
             let [a, b] = topo.edge_vertices(e);
             push(a, em.end);
             push(b, em.end);
@@ -517,7 +635,11 @@ pub(crate) fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
     let mut out = Tags::new();
     let nv = topo.num_vertices() as u32;
     for ((a, b), s) in tags.creases() {
-        let child_s = if s >= SHARPNESS_INFINITE { s } else { s - 1.0 };
+        let child_s = if s >= SHARPNESS_INFINITE {
+            s
+        } else {
+            f64::from(crease::decrement(crease::sharpness(s)))
+        };
         if child_s <= 0.0 || a as usize >= topo.num_vertices() {
             continue;
         }
@@ -529,7 +651,11 @@ pub(crate) fn child_tags(topo: &Topology, tags: &Tags) -> Tags {
         }
     }
     for (v, s) in tags.corners() {
-        out.set_corner(v, s);
+        if s >= SHARPNESS_INFINITE {
+            out.set_corner(v, s);
+        } else {
+            out.set_corner(v, f64::from(crease::decrement(crease::sharpness(s))));
+        }
     }
     out
 }

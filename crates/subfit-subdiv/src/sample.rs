@@ -13,6 +13,11 @@
 //! ([`Topology::new`](crate::Topology::new)); that of each finer level is read off the level
 //! above (module `child`) — for levels `1 … l − 1` as a [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so no adjacency with
 //! one entry per corner of the finest mesh is built, and no intermediate face list.
+//!
+//! Semi-sharp tags ([`crate::crease`]): the refinement rows blend the sharp and smooth rules.
+//! Where finite sharpness is left around a level-`l` vertex its limit row is computed by local
+//! refinement of its one-ring until the sharpness has decayed ([`crate::limit`]), then expanded
+//! like any other row.
 
 use crate::child::refined_topology;
 use crate::error::SubdivError;
@@ -67,7 +72,9 @@ pub struct LimitSamples {
 /// of them). Measured (`benches/stencils.rs`, 2 threads, quiet machine): a 10k-face
 /// Catmull-Clark control mesh at level 3 (686k rows, 30M entries) in ≈ 0.37 s, the first build
 /// of a process included. Most of the time is the last product (scattered reads of `P_{l−1}`
-/// rows and scattered accumulation) and the page faults on the ~0.4 GB output.
+/// rows and scattered accumulation) and the page faults on the ~0.4 GB output. Each level-`l`
+/// vertex with finite sharpness left around it costs one local refinement of its one-ring per
+/// remaining unit of sharpness (module docs).
 pub fn sampling_operator(
     faces: &Polygons,
     num_vertices: usize,
@@ -100,9 +107,9 @@ pub fn sampling_operator(
         level_tags = child_tags(&topo, &level_tags);
         topo = refined_topology(&topo, options.scheme)?;
     }
+    let child_tags = child_tags(&topo, &level_tags);
     // The last level: C = L_l · M_l · P_{l−1}, with neither M_l nor its product stored and the
     // level-l adjacency read off level l − 1.
-    let child_tags = child_tags(&topo, &level_tags);
     let [position, tangent1, tangent2] =
         limit_refine_compose(&topo, &level_tags, &child_tags, options, &product);
     Ok(SamplingOperator {

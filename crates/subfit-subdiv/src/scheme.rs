@@ -89,11 +89,17 @@ pub enum BoundaryRule {
 
 /// Options for refinement and limit evaluation.
 ///
-/// Semi-sharp creases: a crease or corner tag counts as sharp when its sharpness is at least
-/// [`subfit_mesh::SHARPNESS_INFINITE`] (10, OpenSubdiv's infinite value); tags with a smaller,
-/// finite sharpness are treated as smooth (OpenSubdiv's decrementing semi-sharp rule is not
-/// implemented). Refinement still propagates finite sharpness to child edges decremented by one,
-/// as OpenSubdiv does, so the tags stay meaningful to other tools.
+/// Creases and corners follow OpenSubdiv's uniform creasing (`CREASE_UNIFORM`, DeRose, Kass &
+/// Truong 1998; see [`crate::crease`]). A crease or corner tag with sharpness at least
+/// [`subfit_mesh::SHARPNESS_INFINITE`] (10, OpenSubdiv's infinite value) is sharp at every level
+/// (Hoppe et al. 1994 rules). A finite sharpness `s > 0` is semi-sharp: it is held in single
+/// precision as OpenSubdiv holds it, the crease rules apply for `⌊s⌋` levels, the next level
+/// blends the sharp and smooth rules by the fractional part (edge points by `s`, vertex points by
+/// OpenSubdiv's fractional weight), and refinement passes `s − 1` to the child edges and
+/// vertices (dropped at 0). Limit stencils, the sampling operator, exact evaluation and closest
+/// points refine locally (or, for the stencils, the whole mesh) until no finite sharpness is
+/// left around a vertex before applying the closed-form limit masks, so the limit surface is
+/// exact there too; this costs up to `⌈s⌉` extra levels where finite sharpness exists.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Options {
     /// The subdivision scheme. Default: [`Scheme::Loop`].

@@ -1,6 +1,7 @@
 //! Evaluation below the memoised levels: repeated local refinement until the point lies in a
 //! regular patch (Stam 1998), reusing one local subdivision matrix once the neighbourhood is
-//! self-similar, and the limit masks exactly at an irregular vertex.
+//! self-similar, and the limit masks exactly at an irregular vertex (once no finite sharpness is
+//! left around it, [`crate::crease`]).
 
 use super::basis::{best_child, child_local, mul2, PatchCoef};
 use super::types::{EvalError, EvalKind, EvalWeights};
@@ -46,7 +47,12 @@ impl Evaluator {
             let at = corners.iter().position(|c| c[0] == u && c[1] == v);
             let limit_ok = scheme == Scheme::Loop || depth >= 1;
             if let (Some(k), true) = (at, limit_ok) {
-                if !corner_points(&mesh, &adj, scheme, t, k, &mut |_, _| {}) {
+                // With finite sharpness left at the corner vertex its limit needs more levels.
+                let x = mesh.face(t)[k];
+                let settled = mesh
+                    .ring(&adj, x)
+                    .is_some_and(|r| !mesh.semi_sharp_at(x, &r));
+                if settled && !corner_points(&mesh, &adj, scheme, t, k, &mut |_, _| {}) {
                     return self
                         .vertex_limit(&mesh, &adj, mesh.face(t)[k], depth, &mut mask)
                         .ok_or(err(depth));
@@ -164,6 +170,7 @@ impl Evaluator {
         // Child topology of every parent face.
         let mut cfaces: Vec<Vec<ChildVertex>> = Vec::new();
         let mut cflags: Vec<Vec<u8>> = Vec::new();
+        let mut csharp: Vec<Vec<f32>> = Vec::new();
         let mut target = usize::MAX;
         let mut target_which = 0;
         for f in 0..mesh.nf() {
@@ -175,6 +182,7 @@ impl Evaluator {
                 }
                 cfaces.push(c.verts);
                 cflags.push(c.flags);
+                csharp.push(c.sharpness);
             }
         }
         // Number the child vertices.
@@ -212,7 +220,7 @@ impl Evaluator {
         used.sort_unstable();
         used.dedup();
         let k = mesh.k();
-        let mut mask = Mask::default();
+        let (mut mask, mut scratch) = (Mask::default(), Mask::default());
         let mut rows = vec![0.0; used.len() * k];
         let mut ok = vec![true; used.len()];
         for (i, &cv) in used.iter().enumerate() {
@@ -223,6 +231,7 @@ impl Evaluator {
                 self.options.boundary,
                 keys[cv as usize],
                 &mut mask,
+                &mut scratch,
                 &mut rows[i * k..(i + 1) * k],
             );
         }
@@ -233,6 +242,8 @@ impl Evaluator {
             fo: vec![0],
             fv: Vec::new(),
             fe: Vec::new(),
+            fs: Vec::new(),
+            vs: Vec::new(),
             nfaces: Vec::new(),
             corner: Vec::new(),
         };
@@ -260,9 +271,14 @@ impl Evaluator {
                     out.nfaces.push(child_nfaces(mesh, &adj, scheme, key));
                     out.corner
                         .push(matches!(key, ChildVertex::Vertex(x) if mesh.corner[x as usize]));
+                    out.vs.push(match key {
+                        ChildVertex::Vertex(x) => crate::crease::decrement(mesh.vs[x as usize]),
+                        _ => 0.0,
+                    });
                 }
                 out.fv.push(remap[li]);
                 out.fe.push(cflags[f as usize][j]);
+                out.fs.push(csharp[f as usize][j]);
             }
             out.fo.push(out.fv.len() as u32);
         }
@@ -284,7 +300,13 @@ struct Step {
 impl Step {
     fn same_topology(&self, m: &LocalMesh) -> bool {
         let p = &self.parent;
-        p.fo == m.fo && p.fv == m.fv && p.fe == m.fe && p.nfaces == m.nfaces && p.corner == m.corner
+        p.fo == m.fo
+            && p.fv == m.fv
+            && p.fe == m.fe
+            && p.fs == m.fs
+            && p.vs == m.vs
+            && p.nfaces == m.nfaces
+            && p.corner == m.corner
     }
 
     /// The child of `m` (same topology as `parent`): rows = matrix · rows of `m`.

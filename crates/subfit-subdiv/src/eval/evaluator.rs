@@ -23,7 +23,8 @@ use subfit_mesh::{Polygons, Tags};
 /// two-ring (parallel); memory about 16–20 weights per cached patch point.
 ///
 /// Memory after construction: evaluations memoise the local refinements of irregular patches
-/// (up to [`CACHE_DEPTH`] levels, tens of kB per patch evaluated near an irregular vertex),
+/// (up to [`CACHE_DEPTH`] levels, or `⌈s⌉ + 1` for the largest finite sharpness `s` of the
+/// tags if more; tens of kB per patch evaluated near an irregular vertex),
 /// within a budget ([`Self::set_cache_budget`], default [`DEFAULT_CACHE_BYTES`]); past it,
 /// evaluation stays exact but is not memoised. [`Self::cache_bytes`] reports the memoised
 /// amount and [`Self::clear_cache`] drops it.
@@ -36,7 +37,15 @@ pub struct Evaluator {
     vf: Vec<u32>,
     /// Per face corner: flags of the edge to the next corner.
     flags: Vec<u8>,
+    /// Per face corner: finite sharpness of the edge to the next corner (empty without
+    /// semi-sharp tags).
+    semi: Vec<f32>,
     corner: Vec<bool>,
+    /// Per vertex: finite corner sharpness (empty without semi-sharp tags).
+    vsemi: Vec<f32>,
+    /// Levels memoised per patch: [`CACHE_DEPTH`], or more with semi-sharp tags (one more than
+    /// the levels their sharpness takes to decay, after which patches next to them are regular).
+    cache_depth: u32,
     /// First patch of each face (`#F + 1` entries).
     patch_start: Vec<u32>,
     /// Memoised local-refinement tree of each patch (built on first use; regular level-0
@@ -83,6 +92,15 @@ impl Evaluator {
         let corner = (0..num_vertices as u32)
             .map(|v| !tags.is_empty() && tags.is_corner(v))
             .collect();
+        let (semi, vsemi) = if crate::refine::has_semi_sharp(tags) {
+            let edges = crate::refine::semi_sharp_edges(&topo, tags);
+            let semi = (0..nf)
+                .flat_map(|f| topo.face_edges(f).iter().map(|&e| edges[e as usize]))
+                .collect();
+            (semi, crate::refine::semi_sharp_vertices(num_vertices, tags))
+        } else {
+            (Vec::new(), Vec::new())
+        };
         let mut vf_off = vec![0u32; num_vertices + 1];
         for &v in faces.indices() {
             vf_off[v as usize + 1] += 1;
@@ -117,7 +135,16 @@ impl Evaluator {
             vf_off,
             vf,
             flags,
+            cache_depth: CACHE_DEPTH.max(
+                semi.iter()
+                    .chain(&vsemi)
+                    .fold(0.0f32, |a, &b| a.max(b))
+                    .ceil() as u32
+                    + 1,
+            ),
+            semi,
             corner,
+            vsemi,
             patch_start,
             roots: Vec::new(),
             memo: MemoBudget {
@@ -336,6 +363,11 @@ impl Evaluator {
             fo: vec![0],
             fv: Vec::new(),
             fe: Vec::new(),
+            fs: Vec::new(),
+            vs: verts
+                .iter()
+                .map(|&v| self.vsemi.get(v as usize).copied().unwrap_or(0.0))
+                .collect(),
             nfaces: verts
                 .iter()
                 .map(|&v| self.vf_off[v as usize + 1] - self.vf_off[v as usize])
@@ -352,6 +384,8 @@ impl Evaluator {
                 mesh.fv
                     .push(verts.binary_search(&v).expect("vertex of the two-ring") as u32);
                 mesh.fe.push(self.flags[start + j]);
+                mesh.fs
+                    .push(self.semi.get(start + j).copied().unwrap_or(0.0));
             }
             mesh.fo.push(mesh.fv.len() as u32);
         }
@@ -364,7 +398,8 @@ impl Evaluator {
     /// smaller excursions are clamped). Cost: one small dense product for a regular patch
     /// (a few µs); in an irregular patch about one local refinement per halving of the distance
     /// to the irregular vertex (`log2(1/distance)` levels of a ~30–60-vertex neighbourhood). The
-    /// first [`CACHE_DEPTH`] levels are memoised per patch, so only the first evaluation near a
+    /// first [`CACHE_DEPTH`] levels (more with semi-sharp tags, see the type's docs) are memoised
+    /// per patch, so only the first evaluation near a
     /// given corner pays for them; deeper levels reuse one local subdivision matrix once the
     /// neighbourhood is self-similar. Thread-safe (`&self`; memoisation uses `OnceLock`).
     pub fn weights(&self, p: SurfaceParam) -> Result<EvalWeights, EvalError> {
@@ -396,7 +431,7 @@ impl Evaluator {
                 Node::Failed => return Err(err(depth)),
                 Node::Regular(pc) => return Ok(pc.eval(scheme, u, v, a, depth)),
                 Node::Irregular { mesh, t, kids } => {
-                    if depth >= CACHE_DEPTH || self.irregular_corner(mesh, *t, u, v) {
+                    if depth >= self.cache_depth || self.irregular_corner(mesh, *t, u, v) {
                         return self.descend(mesh.clone(), *t, u, v, a, depth, p.face);
                     }
                     let ch = children(mesh, scheme, *t);

@@ -68,6 +68,7 @@ impl Node {
                     + mesh.rows.len() * 8
                     + (mesh.fo.len() + mesh.fv.len() + mesh.nfaces.len()) * 4
                     + mesh.fe.len()
+                    + (mesh.fs.len() + mesh.vs.len()) * 4
                     + mesh.corner.len()
                     + size_of::<[OnceLock<Node>; 4]>()
             }

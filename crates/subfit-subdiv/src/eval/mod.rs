@@ -33,7 +33,10 @@
 //! Boundary edges and infinitely sharp creases (sharpness ≥ [`subfit_mesh::SHARPNESS_INFINITE`])
 //! follow [`mod@crate::refine`]'s rules exactly (`EdgeOnly` and `EdgeAndCorner`); regular patches
 //! along them use phantom points (module `local`), so they are exact as well. Semi-sharp tags
-//! are treated as smooth, as in the rest of the crate.
+//! (finite sharpness, [`crate::crease`]) blend the rules in local refinement as
+//! [`mod@crate::refine`] does; a patch corner with finite sharpness at it or on an incident edge
+//! is never regular and never given the closed-form limit masks, so evaluation refines until
+//! the sharpness has decayed (at most `⌈s⌉` extra levels), and is exact there too.
 //!
 //! # Modules
 //! * `types` — [`SurfaceParam`], [`EvalWeights`], [`SurfacePoint`], [`EvalKind`], [`EvalError`].
