@@ -340,6 +340,11 @@ pub struct FeatureArgs {
     /// A smooth cage for a mesh target: no feature detection, no crease or corner tags.
     #[arg(long)]
     pub no_features: bool,
+    /// Semi-sharp creases: each crease gets a finite OpenSubdiv sharpness from the data's
+    /// fillet width along its curve (a rounded edge rounds in the limit too; a designed crease
+    /// stays infinitely sharp), instead of all infinitely sharp.
+    #[arg(long, conflicts_with = "no_features")]
+    pub semi_sharp: bool,
 }
 
 impl FeatureArgs {

@@ -224,3 +224,49 @@ fn a_washer_keeps_its_sharp_rims_with_fewer_control_points() {
         "{hausdorff} vs {fit_max}"
     );
 }
+
+/// `--semi-sharp`: the rounded long edges of a filleted prism become finite creases (the limit
+/// rounds them too), the sharp rims of its flat caps stay infinitely sharp, and a sharp box
+/// keeps only infinite creases. The fit reaches the default tolerance either way.
+#[test]
+fn semi_sharp_creases_follow_the_fillets() {
+    let d = tempfile::tempdir().unwrap();
+    let prism = d.path().join("rounded.obj");
+    subfit::io::write_file(
+        &prism,
+        &subfit::mesh::shapes::rounded_prism(0.08, 40),
+        &Default::default(),
+    )
+    .unwrap();
+    let out = d.path().join("semi");
+    let (report, cmp) = fit_and_compare(&prism, &out, &["--semi-sharp"], 0);
+    let cp = report["control_points"].as_u64().unwrap() as usize;
+    let tags = subfit::io::read_tags_file(&out.join("control.obj"), cp).unwrap();
+    let sharp = |s: f64| s >= subfit::mesh::SHARPNESS_INFINITE;
+    let finite = tags.creases().iter().filter(|c| !sharp(c.1)).count();
+    let infinite = tags.creases().iter().filter(|c| sharp(c.1)).count();
+    println!(
+        "rounded prism, --semi-sharp: {cp} control points, {finite} semi-sharp and {infinite} sharp creases, two-sided RMS {:.2e}, Hausdorff {:.2e} of the diagonal",
+        cmp["two_sided_rms_fraction"].as_f64().unwrap(),
+        cmp["hausdorff_fraction"].as_f64().unwrap()
+    );
+    assert!(finite >= 4, "{finite} semi-sharp creases");
+    assert!(infinite >= 8, "{infinite} sharp creases (the caps' rims)");
+    assert!(cmp["hausdorff_fraction"].as_f64().unwrap() <= 5e-3);
+    // The sidecar and the USD carry the finite values.
+    let usda = std::fs::read_to_string(out.join("control.usda")).unwrap();
+    assert!(usda.contains("creaseSharpnesses"));
+
+    let sharp_box = d.path().join("box.obj");
+    subfit::io::write_file(&sharp_box, &gridded_box(24, false), &Default::default()).unwrap();
+    let out = d.path().join("box");
+    let (report, _) = fit_and_compare(&sharp_box, &out, &["--semi-sharp"], 0);
+    let cp = report["control_points"].as_u64().unwrap() as usize;
+    let tags = subfit::io::read_tags_file(&out.join("control.obj"), cp).unwrap();
+    assert!(!tags.creases().is_empty());
+    assert!(
+        tags.creases().iter().all(|c| sharp(c.1)),
+        "{:?}",
+        tags.creases()
+    );
+}

@@ -70,8 +70,8 @@ pub struct PolyRefinement {
     /// edge points follow in edge order (first appearance over faces and corners), then new face
     /// points in face order. Winding is preserved.
     pub mesh: PolyMesh,
-    /// The tags carried over: a split crease edge gives two crease edges of the same sharpness
-    /// through its edge point; corners keep theirs.
+    /// The tags carried over: a split crease edge gives two crease edges through its edge point
+    /// (infinitely sharp stays so, a finite sharpness drops by one); corners keep theirs.
     pub tags: Tags,
     /// Faces marked, split fully (`red`), split by a transition template (`green`), and the
     /// points added (edge and face points).
@@ -402,7 +402,19 @@ fn split_transition(face: &[u32], mids: &[Option<u32>], out: &mut Out<'_>) {
     }
 }
 
-/// `tags` with every split crease edge replaced by its two halves (same sharpness).
+/// The sharpness of each half of a split cage edge of sharpness `s`: infinite stays infinite; a
+/// finite one drops by one, as OpenSubdiv's uniform creasing does per level — a semi-sharp
+/// crease rounds over about `L / 2^s` of its edge length `L`, so halving `L` and keeping the
+/// rounding width takes `s − 1` (0 removes the tag).
+pub(crate) fn split_sharpness(s: f64) -> f64 {
+    if s >= subfit_mesh::SHARPNESS_INFINITE {
+        s
+    } else {
+        (s - 1.0).max(0.0)
+    }
+}
+
+/// `tags` with every split crease edge replaced by its two halves ([`split_sharpness`]).
 fn carry(tags: &Tags, edge_points: &[((u32, u32), u32)]) -> Tags {
     if tags.is_empty() {
         return Tags::new();
@@ -412,8 +424,8 @@ fn carry(tags: &Tags, edge_points: &[((u32, u32), u32)]) -> Tags {
     for ((a, b), s) in tags.creases() {
         match by_edge.get(&(a.min(b), a.max(b))) {
             Some(&m) => {
-                out.set_crease(a, m, s);
-                out.set_crease(m, b, s);
+                out.set_crease(a, m, split_sharpness(s));
+                out.set_crease(m, b, split_sharpness(s));
             }
             None => out.set_crease(a, b, s),
         }

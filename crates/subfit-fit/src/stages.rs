@@ -868,7 +868,8 @@ fn refine_step(
 
 /// The tags of a cage carried to its refinement (`faces`, whose first `old_n` points are the
 /// cage's): a tagged edge that is still an edge keeps its tag; a split one passes it to both
-/// halves, through its new midpoint (the new point joined to both ends). Corners keep theirs.
+/// halves, through its new midpoint (the new point joined to both ends), with
+/// [`crate::refine_polygons::split_sharpness`]. Corners keep theirs.
 fn carry_tags(tags: &Tags, old_n: usize, faces: &Polygons) -> Tags {
     if tags.is_empty() {
         return Tags::new();
@@ -907,8 +908,9 @@ fn carry_tags(tags: &Tags, old_n: usize, faces: &Polygons) -> Tags {
         if has(a, b) {
             out.set_crease(a, b, s);
         } else if let Some(&m) = by_ends.get(&(a.min(b), a.max(b))) {
-            out.set_crease(a, m, s);
-            out.set_crease(m, b, s);
+            let half = crate::refine_polygons::split_sharpness(s);
+            out.set_crease(a, m, half);
+            out.set_crease(m, b, half);
         }
     }
     for (v, s) in tags.corners() {
@@ -939,7 +941,7 @@ mod tests {
         let creases = out.creases();
         assert_eq!(creases.len(), 2, "{creases:?}");
         for ((a, b), s) in creases {
-            assert_eq!(s, 2.0);
+            assert_eq!(s, 1.0, "a finite sharpness drops by one per split");
             let (old, new) = if (a as usize) < n { (a, b) } else { (b, a) };
             assert!([f0[0], f0[1]].contains(&old) && new as usize >= n);
         }

@@ -21,7 +21,7 @@ use subfit_target::{Features, PointIndex};
 
 /// The width, in cage edge lengths, over which the limit surface rounds a crease of sharpness
 /// 0 (see the module docs).
-pub const ROUNDING_WIDTH: f64 = 1.0;
+pub const ROUNDING_WIDTH: f64 = 0.6;
 
 /// The OpenSubdiv sharpness of a crease edge of length `edge_length` standing for a fillet of
 /// width `width` (same units): infinite for `width ≤ 0`, else `log2(ROUNDING_WIDTH · L / w)`

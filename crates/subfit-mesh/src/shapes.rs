@@ -432,6 +432,63 @@ pub fn gridded_box(n: usize, open_top: bool) -> PolyMesh {
     PolyMesh::new(pos, Polygons::from_triangles(&tris))
 }
 
+/// A closed prism over the unit square `[0, 1]²`, height 1, whose four long edges are rounded
+/// with radius `r` by quarter arcs of two segments each (a filleted CAD part: each fillet is two
+/// rows of triangles, 2·r·sin 45° = r·√2 wide across the edge), the sides gridded in `nz` rows
+/// and 16 columns per straight side, the flat caps fanned from their centres (sharp rims).
+///
+/// # Panics
+/// If `nz` is 0 or `r` is not in `(0, 0.5)`.
+pub fn rounded_prism(r: f64, nz: usize) -> PolyMesh {
+    assert!(
+        nz > 0 && r > 0.0 && r < 0.5,
+        "rounded_prism: nz > 0, 0 < r < 0.5"
+    );
+    use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+    let centres = [[1.0 - r, 1.0 - r], [r, 1.0 - r], [r, r], [1.0 - r, r]];
+    let mut profile: Vec<[f64; 2]> = Vec::new();
+    for (c, centre) in centres.iter().enumerate() {
+        let a0 = c as f64 * FRAC_PI_2;
+        for k in 0..3 {
+            let a = a0 + k as f64 * FRAC_PI_4;
+            profile.push([centre[0] + r * a.cos(), centre[1] + r * a.sin()]);
+        }
+        let end = profile[profile.len() - 1];
+        let next = centres[(c + 1) % 4];
+        let a1 = a0 + FRAC_PI_2;
+        let start = [next[0] + r * a1.cos(), next[1] + r * a1.sin()];
+        for k in 1..16 {
+            let t = k as f64 / 16.0;
+            profile.push([
+                end[0] + t * (start[0] - end[0]),
+                end[1] + t * (start[1] - end[1]),
+            ]);
+        }
+    }
+    let m = profile.len();
+    let mut pos = Vec::with_capacity((nz + 1) * m + 2);
+    for j in 0..=nz {
+        let z = j as f64 / nz as f64;
+        pos.extend(profile.iter().map(|q| [q[0], q[1], z]));
+    }
+    let mut tris = Vec::new();
+    let id = |j: usize, i: usize| (j * m + i % m) as u32;
+    for j in 0..nz {
+        for i in 0..m {
+            tris.push([id(j, i), id(j, i + 1), id(j + 1, i + 1)]);
+            tris.push([id(j, i), id(j + 1, i + 1), id(j + 1, i)]);
+        }
+    }
+    let (bottom, top) = (pos.len() as u32, pos.len() as u32 + 1);
+    pos.push([0.5, 0.5, 0.0]);
+    pos.push([0.5, 0.5, 1.0]);
+    for i in 0..m {
+        tris.push([bottom, id(0, i + 1), id(0, i)]);
+        tris.push([top, id(nz, i), id(nz, i + 1)]);
+    }
+    PolyMesh::new(pos, Polygons::from_triangles(&tris))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

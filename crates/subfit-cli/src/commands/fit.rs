@@ -95,6 +95,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         error_scale: a.error_scale,
         init_options: InitOptions {
             features: a.features.options(),
+            semi_sharp: a.features.semi_sharp,
             ..FitScanOptions::default().init_options
         },
         ..FitScanOptions::default()

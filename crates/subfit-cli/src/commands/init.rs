@@ -90,6 +90,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
             )),
         cancel: crate::interrupt::token(),
         features: a.features.options(),
+        semi_sharp: a.features.semi_sharp,
         ..InitOptions::default()
     };
     let sp = crate::progress::spinner(if use_mesh {
