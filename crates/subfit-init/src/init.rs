@@ -10,7 +10,9 @@
 //! [`InitOptions::features`], a mesh target's sharp features
 //! ([`subfit_target::detect_features`]) are kept by the simplification as cage edges and come
 //! back as crease and corner tags ([`InitReport::tags`]): a feature-aligned cage (Lavoué et al.
-//! §6 mark patch boundaries as sharp control edges).
+//! §6 mark patch boundaries as sharp control edges); a point cloud's crease curves
+//! ([`subfit_target::detect_cloud_features`]) are traced on its contour first
+//! ([`crate::snap`](mod@crate::snap)).
 
 use std::time::{Duration, Instant};
 
@@ -57,9 +59,10 @@ pub struct InitOptions {
     pub quad_dominant: bool,
     /// Options of the pairing (used with [`Self::quad_dominant`]).
     pub pairing: PairOptions,
-    /// Mesh targets: detect sharp features with these options and keep them as crease and
-    /// corner tags of a feature-aligned cage. Default `None` (no tags). Ignored for point
-    /// clouds.
+    /// Detect sharp features with these options and keep them as crease and corner tags of a
+    /// feature-aligned cage: a mesh target's sharp edges, or a point cloud's crease curves with
+    /// the contour snapped to them ([`crate::snap`](mod@crate::snap)). Default `None` (no
+    /// tags).
     pub features: Option<FeatureOptions>,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
@@ -325,7 +328,7 @@ pub fn initial_control_mesh(
         return Err(InitError::TooFewVertices(n_vertices));
     }
     let mut report = InitReport::default();
-    let dense = match mesh {
+    let mut dense = match mesh {
         Some(m) if !m.faces.is_empty() => {
             report.source = InitSource::Mesh;
             normalized_mesh(target, m)?
@@ -371,6 +374,9 @@ pub fn initial_control_mesh(
                 edges: f.edges,
                 corners: f.corners,
             }
+        }
+        (Some(fo), InitSource::Contour) => {
+            crate::snap::cloud_feature_lock(target, &mut dense, fo, &mut report)
         }
         _ => FeatureLock::default(),
     };
