@@ -17,8 +17,12 @@
 //!    consecutive anchors are joined by a Dijkstra shortest edge path that avoids the vertices
 //!    of paths already traced (except at corners), so the chains stay simple and meet only at
 //!    corners. A piece that cannot be joined is skipped.
-//! 3. **Snapping**: every path vertex is moved to the nearest point of its curve, unless the
-//!    move would flip or nearly collapse one of its triangles (then it stays).
+//! 3. **Snapping**: the contour vertices within two curve steps of a curve (away from corners)
+//!    are projected onto their side of the crease — the plane through the nearest curve point
+//!    spanned by the curve's tangent and the mean direction, across the curve, of the cloud
+//!    points on that side — so the contour's rounded strip becomes a sharp dihedral; then the
+//!    corner vertices go to the corners and every path vertex to the nearest point of its
+//!    curve. A move that would flip or nearly collapse a triangle is not made.
 //!
 //! Positions move, connectivity does not: genus, boundary loops and manifoldness are kept.
 //! Cost: `O(F)` for the adjacency, `O(S log V)` for the `S` curve samples, and the Dijkstra
@@ -27,7 +31,7 @@
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, HashSet};
 
-use subfit_mesh::vec3::{cross, dot, norm, norm2, sub};
+use subfit_mesh::vec3::{add, cross, dot, norm, norm2, normalize, scale, sub};
 use subfit_mesh::PolyMesh;
 use subfit_target::{detect_cloud_features, CloudFeatures, FeatureOptions, PointIndex, Target};
 
@@ -45,7 +49,7 @@ pub(crate) fn cloud_feature_lock(
     report: &mut InitReport,
 ) -> FeatureLock {
     let f = detect_cloud_features(target, options);
-    let (lock, snap) = snap_to_features(dense, &f);
+    let (lock, snap) = snap_to_features(dense, &f, Some((target.points(), target.index())));
     report.features = Some(FeatureCounts {
         edges: snap.edges,
         curves: f.curves.len(),
@@ -74,9 +78,13 @@ pub struct SnapReport {
 /// and moves the traced vertices onto them (see the module docs). Returns the lock for
 /// [`crate::simplify_with_features`] (edges and corners in `mesh`'s vertex ids) and a report.
 /// Faces that are not triangles are fan-triangulated for the adjacency and the fold test.
+/// With `cloud` (the cloud's points and their kd-tree, same units), the contour vertices
+/// within two curve steps of a curve are first flattened onto their side of the crease
+/// (step 3 of the module docs).
 pub fn snap_to_features(
     mesh: &mut PolyMesh,
     features: &CloudFeatures,
+    cloud: Option<(&[[f64; 3]], &PointIndex)>,
 ) -> (FeatureLock, SnapReport) {
     let mut report = SnapReport::default();
     let nv = mesh.positions.len();
@@ -151,13 +159,22 @@ pub fn snap_to_features(
                 // The previous piece failed: restart the path here.
                 flush(&mut path, &mut lock_edges);
                 path.push(from);
+                on_path.insert(from);
             }
             let closing = to == first;
-            let piece = shortest_path(&mesh.positions, &adj, from, to, |v| {
+            let allowed = |v: u32| {
                 v == to
                     || (!blocked[v as usize] && !on_path.contains(&v))
                     || (closing && v == first)
-            });
+            };
+            // Edges are dearer away from the curve, so the path hugs it and its vertices can
+            // move onto it without passing over others.
+            let weight = |v: u32| {
+                let p = mesh.positions[v as usize];
+                let d2 = norm2(sub(closest_on_polyline(&curve.points, curve.closed, p), p));
+                1.0 + 4.0 * d2 / (features.step * features.step)
+            };
+            let piece = shortest_path(&mesh.positions, &adj, from, to, allowed, weight);
             let Some(piece) = piece else { continue };
             for &v in &piece[1..] {
                 on_path.insert(v);
@@ -176,12 +193,26 @@ pub fn snap_to_features(
             report.curves += 1;
         }
     }
-    // 3. Snapping (corners first, then the path vertices).
-    let mut targets: Vec<(u32, [f64; 3])> = corner_vertex
-        .iter()
-        .zip(&features.corners)
-        .map(|(&v, &c)| (v, c))
-        .collect();
+    // 3. Snapping: the sides next to the curves flattened, then the corners, then the paths.
+    let mut targets: Vec<(u32, [f64; 3])> = Vec::new();
+    if let Some((points, cloud_index)) = cloud {
+        let reach = 2.0 * features.step;
+        for w in 0..nv as u32 {
+            if blocked[w as usize] || is_corner[w as usize] {
+                continue;
+            }
+            let p = mesh.positions[w as usize];
+            if let Some(to) = flatten_target(p, features, points, cloud_index, reach) {
+                targets.push((w, to));
+            }
+        }
+    }
+    targets.extend(
+        corner_vertex
+            .iter()
+            .zip(&features.corners)
+            .map(|(&v, &c)| (v, c)),
+    );
     moves.sort_unstable();
     for &(v, ci) in &moves {
         let c = &features.curves[ci];
@@ -190,11 +221,45 @@ pub fn snap_to_features(
             closest_on_polyline(&c.points, c.closed, mesh.positions[v as usize]),
         ));
     }
-    for (v, to) in targets {
-        if try_move(&mut mesh.positions, &tris, &vert_tris[v as usize], v, to) {
-            report.moved += 1;
-        } else {
-            report.kept += 1;
+    // A move blocked by a neighbour that has not moved yet may pass once it has; one still
+    // blocked gets its free neighbours (neither on a path nor a corner) relaxed to the mean of
+    // theirs, to untangle the strip. A few rounds.
+    for round in 0..6 {
+        if round > 0 {
+            for &(v, _) in &targets {
+                for &w in &adj[v as usize] {
+                    let wi = w as usize;
+                    if blocked[wi] || is_corner[wi] || adj[wi].is_empty() {
+                        continue;
+                    }
+                    let m = scale(
+                        adj[wi]
+                            .iter()
+                            .fold([0.0; 3], |acc, &x| add(acc, mesh.positions[x as usize])),
+                        1.0 / adj[wi].len() as f64,
+                    );
+                    try_move(&mut mesh.positions, &tris, &vert_tris[wi], w, m);
+                }
+            }
+        }
+        let before = targets.len();
+        targets.retain(|&(v, to)| {
+            !try_move(&mut mesh.positions, &tris, &vert_tris[v as usize], v, to)
+        });
+        report.moved += before - targets.len();
+        if targets.is_empty() {
+            break;
+        }
+    }
+    report.kept = targets.len();
+    // What still cannot move all the way goes as far as it can (halving the step).
+    for &(v, to) in &targets {
+        let from = mesh.positions[v as usize];
+        for f in [0.75, 0.5, 0.25] {
+            let p = add(from, scale(sub(to, from), f));
+            if try_move(&mut mesh.positions, &tris, &vert_tris[v as usize], v, p) {
+                break;
+            }
         }
     }
     for e in &mut lock_edges {
@@ -216,23 +281,122 @@ pub fn snap_to_features(
     )
 }
 
+/// Where a contour vertex `w` within `reach` of a curve (and not within `2 reach` of a
+/// corner) goes to lie on its side of the crease: the cloud points within `2 reach` of the
+/// nearest curve point `c` are split into the crease's two sides by the direction of their
+/// offsets from `c` across the curve tangent `t` (2-means, seeded by the most opposed pair); the
+/// side `w` lies on is the plane through `c` spanned by `t` and that side's mean direction,
+/// and `w` is projected onto it. `None` when `w` is farther, the sides are not clear, or the
+/// move would exceed `reach`.
+fn flatten_target(
+    w: [f64; 3],
+    features: &CloudFeatures,
+    points: &[[f64; 3]],
+    index: &PointIndex,
+    reach: f64,
+) -> Option<[f64; 3]> {
+    if features
+        .corners
+        .iter()
+        .any(|c| norm2(sub(*c, w)) < 4.0 * reach * reach)
+    {
+        return None;
+    }
+    let (c, t) = features
+        .curves
+        .iter()
+        .filter_map(|cv| closest_with_tangent(&cv.points, cv.closed, w))
+        .min_by(|a, b| norm2(sub(a.0, w)).total_cmp(&norm2(sub(b.0, w))))?;
+    if norm2(sub(c, w)) > reach * reach {
+        return None;
+    }
+    let across = |q: [f64; 3]| {
+        let d = sub(q, c);
+        let a = sub(d, scale(t, dot(d, t)));
+        normalize(a).filter(|_| norm(a) > 0.25 * reach)
+    };
+    let dirs: Vec<[f64; 3]> = index
+        .within(&c, 2.0 * reach)
+        .iter()
+        .filter_map(|n| across(points[n.index as usize]))
+        .collect();
+    if dirs.len() < 6 {
+        return None;
+    }
+    let mut best = (f64::INFINITY, 0, 0);
+    for (i, a) in dirs.iter().enumerate() {
+        for (j, b) in dirs.iter().enumerate().skip(i + 1) {
+            let d = dot(*a, *b);
+            if d < best.0 {
+                best = (d, i, j);
+            }
+        }
+    }
+    let mut centre = [dirs[best.1], dirs[best.2]];
+    for _ in 0..3 {
+        let mut sum = [[0.0; 3]; 2];
+        for d in &dirs {
+            let k = usize::from(dot(*d, centre[1]) > dot(*d, centre[0]));
+            sum[k] = add(sum[k], *d);
+        }
+        centre = [normalize(sum[0])?, normalize(sum[1])?];
+    }
+    // The two sides' directions are opposite where the surface is flat: no crease to sharpen
+    // (less than ~25°).
+    if dot(centre[0], centre[1]) < -0.9 {
+        return None;
+    }
+    let u = across(w)?;
+    let side = centre[usize::from(dot(u, centre[1]) > dot(u, centre[0]))];
+    let n = normalize(cross(t, side))?;
+    let to = sub(w, scale(n, dot(sub(w, c), n)));
+    (norm2(sub(to, w)) <= reach * reach).then_some(to)
+}
+
+/// The nearest point to `p` on the polyline and the unit tangent there. `O(n)`.
+fn closest_with_tangent(
+    points: &[[f64; 3]],
+    closed: bool,
+    p: [f64; 3],
+) -> Option<([f64; 3], [f64; 3])> {
+    let n = points.len();
+    let segs = if closed { n } else { n.saturating_sub(1) };
+    let mut best: Option<(f64, [f64; 3], [f64; 3])> = None;
+    for i in 0..segs {
+        let (a, b) = (points[i], points[(i + 1) % n]);
+        let ab = sub(b, a);
+        let l2 = norm2(ab);
+        if !(l2 > 0.0) {
+            continue;
+        }
+        let s = (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0);
+        let q = add(a, scale(ab, s));
+        let d = norm2(sub(p, q));
+        if best.is_none_or(|b| d < b.0) {
+            best = Some((d, q, ab));
+        }
+    }
+    let (_, q, ab) = best?;
+    Some((q, normalize(ab)?))
+}
+
 /// Appends the edges of `path` to `edges` and clears it.
 fn flush(path: &mut Vec<u32>, edges: &mut Vec<[u32; 2]>) {
     edges.extend(path.windows(2).map(|w| [w[0], w[1]]));
     path.clear();
 }
 
-/// Dijkstra shortest edge path from `from` to `to` through vertices `allowed` accepts; `None`
-/// when unreachable within 64 settled vertices' worth of search radius (anchors are a curve
-/// step apart, so paths are short).
+/// Dijkstra shortest edge path from `from` to `to` through vertices `allowed` accepts, an edge
+/// costing its length times `weight` of its far end; `None` when unreachable within 4096
+/// settled vertices (anchors are a curve step apart, so paths are short).
 fn shortest_path(
     pos: &[[f64; 3]],
     adj: &[Vec<u32>],
     from: u32,
     to: u32,
     allowed: impl Fn(u32) -> bool,
+    weight: impl Fn(u32) -> f64,
 ) -> Option<Vec<u32>> {
-    let limit = 4.0 * norm(sub(pos[to as usize], pos[from as usize])).max(f64::MIN_POSITIVE);
     let mut dist: HashMap<u32, (f64, u32)> = HashMap::new();
     let mut heap = BinaryHeap::new();
     dist.insert(from, (0.0, from));
@@ -253,14 +417,14 @@ fn shortest_path(
             return Some(path);
         }
         settled += 1;
-        if settled > 4096 || d > limit + 1e-12 {
-            continue;
+        if settled > 4096 {
+            return None;
         }
         for &w in &adj[v as usize] {
             if !allowed(w) {
                 continue;
             }
-            let nd = d + norm(sub(pos[w as usize], pos[v as usize]));
+            let nd = d + norm(sub(pos[w as usize], pos[v as usize])) * weight(w);
             if dist.get(&w).is_none_or(|&(best, _)| nd < best) {
                 dist.insert(w, (nd, v));
                 heap.push(Reverse((Ordered(nd), w)));
@@ -323,7 +487,7 @@ fn try_move(pos: &mut [[f64; 3]], tris: &[[u32; 3]], around: &[u32], v: u32, to:
     pos[v as usize] = to;
     let ok = around.iter().zip(&before).all(|(&t, n0)| {
         let n1 = area_normal(pos, tris[t as usize]);
-        dot(*n0, n1) > 0.0 && norm(n1) >= 0.1 * norm(*n0)
+        dot(*n0, n1) > 0.0 && norm(n1) >= 0.01 * norm(*n0)
     });
     if !ok {
         pos[v as usize] = old;
