@@ -340,6 +340,10 @@ pub struct FeatureArgs {
     /// A smooth cage for a mesh target: no feature detection, no crease or corner tags.
     #[arg(long)]
     pub no_features: bool,
+    /// Point clouds (experimental): trace the cloud's crease curves (normal discontinuities)
+    /// and build the cage along them, with crease and corner tags, as for meshes.
+    #[arg(long, conflicts_with = "no_features")]
+    pub cloud_features: bool,
 }
 
 impl FeatureArgs {

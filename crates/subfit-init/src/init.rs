@@ -60,10 +60,14 @@ pub struct InitOptions {
     /// Options of the pairing (used with [`Self::quad_dominant`]).
     pub pairing: PairOptions,
     /// Detect sharp features with these options and keep them as crease and corner tags of a
-    /// feature-aligned cage: a mesh target's sharp edges, or a point cloud's crease curves with
-    /// the contour snapped to them ([`crate::snap`](mod@crate::snap)). Default `None` (no
-    /// tags).
+    /// feature-aligned cage: a mesh target's sharp edges, or (with [`Self::cloud_features`]) a
+    /// point cloud's crease curves with the contour snapped to them
+    /// ([`crate::snap`](mod@crate::snap)). Default `None` (no tags).
     pub features: Option<FeatureOptions>,
+    /// Point clouds: apply [`Self::features`] too (trace the cloud's crease curves and snap the
+    /// contour to them). Default `false`: experimental — on a box and a capped cylinder sampled
+    /// as clouds the fitted surfaces were not yet closer to the shapes than without it.
+    pub cloud_features: bool,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
     /// level and per batch of cells, evaluations and edge collapses; once cancelled,
@@ -84,6 +88,7 @@ impl Default for InitOptions {
             quad_dominant: false,
             pairing: PairOptions::default(),
             features: None,
+            cloud_features: false,
             cancel: Cancel::default(),
         }
     }
@@ -375,7 +380,7 @@ pub fn initial_control_mesh(
                 corners: f.corners,
             }
         }
-        (Some(fo), InitSource::Contour) => {
+        (Some(fo), InitSource::Contour) if options.cloud_features => {
             crate::snap::cloud_feature_lock(target, &mut dense, fo, &mut report)
         }
         _ => FeatureLock::default(),

@@ -50,6 +50,7 @@ fn a_box_cloud_gives_a_cage_with_creases_along_its_edges() {
     let t = Target::from_points(&pts, None, &opts).unwrap();
     let options = InitOptions {
         features: Some(FeatureOptions::default()),
+        cloud_features: true,
         ..InitOptions::default()
     };
     let (cage, rep) = initial_control_mesh(&t, None, 200, &options).unwrap();

@@ -902,8 +902,10 @@ mod tests {
         assert_eq!(r.len(), 21);
         assert_eq!(r[0], pts[0]);
         assert_eq!(*r.last().unwrap(), pts[2]);
+        // A loop: uniform in arclength, so its three corners are cut by less than a step each.
         let closed = resample(&pts, true, 0.1);
-        assert!((polyline_length(&closed, true) - (2.0 + 2f64.sqrt())).abs() < 1e-2);
+        let l = polyline_length(&closed, true);
+        assert!(l <= 2.0 + 2f64.sqrt() + 1e-12 && l > 2.0 + 2f64.sqrt() - 0.15, "{l}");
     }
 
     #[test]

@@ -95,6 +95,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         error_scale: a.error_scale,
         init_options: InitOptions {
             features: a.features.options(),
+            cloud_features: a.features.cloud_features,
             ..FitScanOptions::default().init_options
         },
         ..FitScanOptions::default()
