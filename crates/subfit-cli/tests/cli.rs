@@ -585,11 +585,9 @@ fn compare_measures_two_sided_distances_between_concentric_cubes() {
     assert!(c["a_to_b"]["max"].as_f64().unwrap() < 1e-15);
 }
 
-#[test]
-fn analyze_traces_the_sharp_features_of_a_point_cloud() {
-    let d = tempfile::tempdir().unwrap();
-    // The unit cube's faces as 60 × 60 grids, each point nudged off the grid (a fixed,
-    // aperiodic pattern) so the cloud is not a lattice: 12 crease curves, 8 corners.
+/// The unit cube's faces as 60 × 60 grids, each point nudged off the grid (a fixed,
+/// aperiodic pattern) so the cloud is not a lattice: 12 crease curves, 8 corners. XYZ text.
+fn cube_cloud() -> String {
     let mut text = String::new();
     let m = 60;
     for face in 0..6 {
@@ -607,7 +605,53 @@ fn analyze_traces_the_sharp_features_of_a_point_cloud() {
             }
         }
     }
-    let cloud = write(d.path(), "cube.xyz", text.as_bytes());
+    text
+}
+
+#[test]
+fn init_with_cloud_features_tags_the_creases_of_a_point_cloud() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = write(d.path(), "cube.xyz", cube_cloud().as_bytes());
+    let out = d.path().join("cage.obj");
+    let r = subfit(&[
+        "init",
+        cloud.to_str().unwrap(),
+        "--control-points",
+        "200",
+        "--cloud-features",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let obj = std::fs::read_to_string(&out).unwrap();
+    let creases = obj.lines().filter(|l| l.starts_with("t crease")).count();
+    let corners = obj.lines().filter(|l| l.starts_with("t corner")).count();
+    assert!(
+        creases >= 1 && corners >= 1,
+        "{creases} crease, {corners} corner lines"
+    );
+    // Without the flag a cloud's cage is smooth.
+    let plain = d.path().join("plain.obj");
+    let r = subfit(&[
+        "init",
+        cloud.to_str().unwrap(),
+        "--control-points",
+        "200",
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let obj = std::fs::read_to_string(&plain).unwrap();
+    assert!(
+        !obj.lines().any(|l| l.starts_with("t ")),
+        "tags without --cloud-features"
+    );
+}
+
+#[test]
+fn analyze_traces_the_sharp_features_of_a_point_cloud() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = write(d.path(), "cube.xyz", cube_cloud().as_bytes());
     let out = d.path().join("features.ply");
     let r = subfit(&[
         "analyze",
