@@ -345,6 +345,10 @@ pub struct FeatureArgs {
     /// stays infinitely sharp), instead of all infinitely sharp.
     #[arg(long, conflicts_with = "no_features")]
     pub semi_sharp: bool,
+    /// Point clouds (experimental): trace the cloud's crease curves (normal discontinuities)
+    /// and build the cage along them, with crease and corner tags, as for meshes.
+    #[arg(long, conflicts_with = "no_features")]
+    pub cloud_features: bool,
 }
 
 impl FeatureArgs {
@@ -501,9 +505,10 @@ pub struct AnalyzeArgs {
     /// Degree of the local polynomial fitted per point (2: quadric as in the papers; 3: cubic).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u8).range(2..=3))]
     pub jet_degree: u8,
-    /// Detect sharp features of a mesh target (crease curves, corners, darts) and write them
-    /// to this PLY (vertices with a `kind`: 0 curve, 1 corner, 2 dart; feature edges as an
-    /// `edge` element), in the input's coordinates.
+    /// Detect sharp features (crease curves, corners, darts) and write them to this PLY
+    /// (vertices with a `kind`: 0 curve, 1 corner, 2 dart; feature edges as an `edge`
+    /// element), in the input's coordinates. Meshes: sharp mesh edges; point clouds: curves
+    /// traced along normal discontinuities.
     #[arg(long, value_name = "FILE.ply")]
     pub features: Option<PathBuf>,
     /// Dihedral angle (degrees) from which a mesh edge is sharp.

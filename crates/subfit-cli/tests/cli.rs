@@ -586,6 +586,112 @@ fn compare_measures_two_sided_distances_between_concentric_cubes() {
     assert!(c["a_to_b"]["max"].as_f64().unwrap() < 1e-15);
 }
 
+/// The unit cube's faces as 60 × 60 grids, each point nudged off the grid (a fixed,
+/// aperiodic pattern) so the cloud is not a lattice: 12 crease curves, 8 corners. XYZ text.
+fn cube_cloud() -> String {
+    let mut text = String::new();
+    let m = 60;
+    for face in 0..6 {
+        let (axis, side) = (face / 2, (face % 2) as f64);
+        for i in 0..m {
+            for j in 0..m {
+                let k = (face * m * m + i * m + j) as f64;
+                let u = (i as f64 + 0.5 + 0.3 * (k * 0.618).sin()) / m as f64;
+                let v = (j as f64 + 0.5 + 0.3 * (k * 1.414).cos()) / m as f64;
+                let mut p = [0.0; 3];
+                p[axis] = side;
+                p[(axis + 1) % 3] = u;
+                p[(axis + 2) % 3] = v;
+                text.push_str(&format!("{} {} {}\n", p[0], p[1], p[2]));
+            }
+        }
+    }
+    text
+}
+
+#[test]
+fn init_with_cloud_features_tags_the_creases_of_a_point_cloud() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = write(d.path(), "cube.xyz", cube_cloud().as_bytes());
+    let out = d.path().join("cage.obj");
+    let r = subfit(&[
+        "init",
+        cloud.to_str().unwrap(),
+        "--control-points",
+        "200",
+        "--cloud-features",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let obj = std::fs::read_to_string(&out).unwrap();
+    let creases = obj.lines().filter(|l| l.starts_with("t crease")).count();
+    let corners = obj.lines().filter(|l| l.starts_with("t corner")).count();
+    assert!(
+        creases >= 1 && corners >= 1,
+        "{creases} crease, {corners} corner lines"
+    );
+    // Without the flag a cloud's cage is smooth.
+    let plain = d.path().join("plain.obj");
+    let r = subfit(&[
+        "init",
+        cloud.to_str().unwrap(),
+        "--control-points",
+        "200",
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let obj = std::fs::read_to_string(&plain).unwrap();
+    assert!(
+        !obj.lines().any(|l| l.starts_with("t ")),
+        "tags without --cloud-features"
+    );
+}
+
+#[test]
+fn analyze_traces_the_sharp_features_of_a_point_cloud() {
+    let d = tempfile::tempdir().unwrap();
+    let cloud = write(d.path(), "cube.xyz", cube_cloud().as_bytes());
+    let out = d.path().join("features.ply");
+    let r = subfit(&[
+        "analyze",
+        cloud.to_str().unwrap(),
+        "--features",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    let f = &s["features"];
+    assert_eq!(f["source"], "cloud", "{s}");
+    assert_eq!(
+        (&f["curves"], &f["corners"], &f["darts"]),
+        (&12.into(), &8.into(), &0.into()),
+        "{s}"
+    );
+    assert!(f["feature_points"].as_u64().unwrap() > 100, "{s}");
+    let ply = std::fs::read_to_string(&out).unwrap();
+    let edges = f["sharp_edges"].as_u64().unwrap();
+    assert!(ply.contains(&format!("element edge {edges}\n")), "{ply}");
+    // The corners come first (kind 1), at the cube's corners.
+    let body = ply.split("end_header\n").nth(1).unwrap();
+    for l in body.lines().take(8) {
+        let w: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+        assert_eq!(w[3], 1.0, "{l}");
+        assert!(w[..3].iter().all(|&x| x.min(1.0 - x).abs() < 0.02), "{l}");
+    }
+    // The text summary names the curves.
+    let r = subfit(&[
+        "analyze",
+        cloud.to_str().unwrap(),
+        "--features",
+        out.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert!(text.contains("features      12 curves"), "{text}");
+}
+
 #[test]
 fn analyze_writes_the_sharp_features_of_a_mesh() {
     let d = tempfile::tempdir().unwrap();
@@ -639,18 +745,6 @@ fn analyze_writes_the_sharp_features_of_a_mesh() {
         .collect();
     assert_eq!(kinds, vec!["1"; 8], "every feature vertex is a corner");
 
-    // A point cloud has no faces: a clear error before any work, no file.
-    let cloud = write(d.path(), "c.xyz", b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n");
-    let bad = d.path().join("none.ply");
-    let r = subfit(&[
-        "analyze",
-        cloud.to_str().unwrap(),
-        "--features",
-        bad.to_str().unwrap(),
-    ]);
-    assert_eq!(r.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&r.stderr).contains("needs a mesh target"));
-    assert!(!bad.exists());
     let r = subfit(&["analyze", cube.to_str().unwrap(), "--feature-angle", "200"]);
     assert_eq!(r.status.code(), Some(2));
 }

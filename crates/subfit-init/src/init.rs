@@ -10,7 +10,9 @@
 //! [`InitOptions::features`], a mesh target's sharp features
 //! ([`subfit_target::detect_features`]) are kept by the simplification as cage edges and come
 //! back as crease and corner tags ([`InitReport::tags`]): a feature-aligned cage (Lavoué et al.
-//! §6 mark patch boundaries as sharp control edges).
+//! §6 mark patch boundaries as sharp control edges); a point cloud's crease curves
+//! ([`subfit_target::detect_cloud_features`]) are traced on its contour first
+//! ([`crate::snap`](mod@crate::snap)).
 
 use std::time::{Duration, Instant};
 
@@ -59,14 +61,19 @@ pub struct InitOptions {
     pub quad_dominant: bool,
     /// Options of the pairing (used with [`Self::quad_dominant`]).
     pub pairing: PairOptions,
-    /// Mesh targets: detect sharp features with these options and keep them as crease and
-    /// corner tags of a feature-aligned cage. Default `None` (no tags). Ignored for point
-    /// clouds.
+    /// Detect sharp features with these options and keep them as crease and corner tags of a
+    /// feature-aligned cage: a mesh target's sharp edges, or (with [`Self::cloud_features`]) a
+    /// point cloud's crease curves with the contour snapped to them
+    /// ([`crate::snap`](mod@crate::snap)). Default `None` (no tags).
     pub features: Option<FeatureOptions>,
     /// With [`Self::features`]: give each crease a finite OpenSubdiv sharpness from the data's
     /// fillet width along its curve ([`crate::semi_sharp`]), instead of infinitely sharp.
     /// Default `false`.
     pub semi_sharp: bool,
+    /// Point clouds: apply [`Self::features`] too (trace the cloud's crease curves and snap the
+    /// contour to them). Default `false`: experimental — on a box and a capped cylinder sampled
+    /// as clouds the fitted surfaces were not yet closer to the shapes than without it.
+    pub cloud_features: bool,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
     /// level and per batch of cells, evaluations and edge collapses; once cancelled,
@@ -88,6 +95,7 @@ impl Default for InitOptions {
             pairing: PairOptions::default(),
             features: None,
             semi_sharp: false,
+            cloud_features: false,
             cancel: Cancel::default(),
         }
     }
@@ -339,7 +347,7 @@ pub fn initial_control_mesh(
         return Err(InitError::TooFewVertices(n_vertices));
     }
     let mut report = InitReport::default();
-    let dense = match mesh {
+    let mut dense = match mesh {
         Some(m) if !m.faces.is_empty() => {
             report.source = InitSource::Mesh;
             normalized_mesh(target, m)?
@@ -382,11 +390,6 @@ pub fn initial_control_mesh(
                 corners: f.corners.len(),
                 darts: f.darts.len(),
             });
-            report.feature_segments = f
-                .edges
-                .iter()
-                .map(|&[a, b]| [dense.positions[a as usize], dense.positions[b as usize]])
-                .collect();
             let lock = FeatureLock {
                 edges: f.edges.clone(),
                 corners: f.corners.clone(),
@@ -394,8 +397,22 @@ pub fn initial_control_mesh(
             features = Some(f);
             lock
         }
+        (Some(fo), InitSource::Contour) if options.cloud_features => {
+            crate::snap::cloud_feature_lock(target, &mut dense, fo, &mut report)
+        }
         _ => FeatureLock::default(),
     };
+    // The feature edges as segments, for the fit's crease-curve term.
+    report.feature_segments = lock
+        .edges
+        .iter()
+        .filter_map(|&[a, b]| {
+            Some([
+                *dense.positions.get(a as usize)?,
+                *dense.positions.get(b as usize)?,
+            ])
+        })
+        .collect();
     let (mut out, mut tags, srep) = simplify_with_features(&dense, &lock, &sopt)?;
     if let (true, Some(f)) = (options.semi_sharp, &features) {
         report.fillet_widths = fillet_widths(&dense.positions, &dense.faces, f);

@@ -14,6 +14,8 @@
 //!   cloud (a single-view scan) gives an open surface with its boundary loops.
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
 //!   contoured then simplified; the genus is checked against the target's and reported.
+//! * [`snap`](mod@snap): a point cloud's crease curves traced on its contour, for
+//!   feature-aligned cages.
 //! * [`quads`](mod@quads): [`pair_triangles`] turns a triangle cage into a quad-dominant one,
 //!   pairing triangles along the principal curvature directions (Lavoué et al. 2007 §4.3).
 //!
@@ -31,6 +33,7 @@ mod octree;
 pub mod quads;
 pub mod semi_sharp;
 pub mod simplify;
+pub mod snap;
 pub mod trim;
 
 pub use carve::carve;
@@ -43,4 +46,5 @@ pub use quads::{coherency_score, pair_triangles, PairOptions, PairReport};
 pub use simplify::{
     simplify, simplify_with_features, FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport,
 };
+pub use snap::{snap_to_features, SnapReport};
 pub use trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};

@@ -33,6 +33,7 @@
 mod blend;
 pub mod boundary_corners;
 pub mod closest;
+pub mod cloud_features;
 pub mod cloud_rim;
 mod error;
 pub mod estimate;
@@ -54,6 +55,9 @@ mod winding;
 
 pub use boundary_corners::{boundary_corners, BoundaryCorners};
 pub use closest::{MeshClosestPoint, TriangleBvh};
+pub use cloud_features::{
+    detect_cloud_features, detect_cloud_features_in, CloudFeatures, FeaturePolyline,
+};
 pub use cloud_rim::{cloud_boundary_points, RIM_GAP, RIM_NEIGHBORS};
 pub use error::TargetError;
 pub use estimate::Neighborhood;

@@ -1,6 +1,8 @@
 //! `subfit analyze TARGET [-o OUT.ply]`: build the target (normalization, kd-tree, normals,
 //! principal curvatures and directions), print timings per phase and summary statistics, and
-//! optionally write the per-point results as a binary PLY.
+//! optionally write the per-point results as a binary PLY; with `--features`, the sharp features
+//! (of a mesh: `detect_features`; of a point cloud: `detect_cloud_features`) as a PLY of
+//! vertices and edges.
 
 use std::process::ExitCode;
 
@@ -44,15 +46,19 @@ struct Summary {
     k2_quantiles: [f64; 5],
     /// Normalized units → original units: multiply lengths by this.
     scale_to_original: f64,
-    /// Sharp features of a mesh target (none for a point cloud).
+    /// Sharp features (mesh targets always; point clouds with `--features`).
     features: Option<FeatureSummary>,
     /// Seconds per phase.
     timings: Timings,
 }
 
-/// Counts of [`subfit::target::detect_features`].
+/// Counts of [`subfit::target::detect_features`] (meshes) or
+/// [`subfit::target::detect_cloud_features`] (point clouds: the curves' polyline segments are
+/// the "sharp edges").
 #[derive(Serialize)]
 struct FeatureSummary {
+    /// "mesh" or "cloud".
+    source: &'static str,
     angle_deg: f64,
     sharp_edges: usize,
     sharp_edges_before_cleaning: usize,
@@ -60,7 +66,16 @@ struct FeatureSummary {
     closed_curves: usize,
     corners: usize,
     darts: usize,
+    /// Point clouds: points that passed the per-point test (before tracing and cleaning).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    feature_points: Option<usize>,
     seconds: f64,
+}
+
+/// The features found, with the seconds they took.
+enum Found {
+    Mesh(subfit::target::Features, f64),
+    Cloud(subfit::target::CloudFeatures, f64),
 }
 
 #[derive(Serialize)]
@@ -142,22 +157,15 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     let (mut mesh, _) = crate::progress::load(&a.target)?;
     crate::commands::reorient_target(&mut mesh, &a.target);
     let read = t_read.elapsed().as_secs_f64();
-    let features = (!mesh.faces.is_empty()).then(|| {
+    let feature_options = subfit::target::FeatureOptions {
+        angle_deg: a.feature_angle,
+        ..Default::default()
+    };
+    let mut features = (!mesh.faces.is_empty()).then(|| {
         let t = std::time::Instant::now();
-        let o = subfit::target::FeatureOptions {
-            angle_deg: a.feature_angle,
-            ..Default::default()
-        };
-        let f = subfit::target::detect_features(&mesh.positions, &mesh.faces, &o);
-        (f, t.elapsed().as_secs_f64())
+        let f = subfit::target::detect_features(&mesh.positions, &mesh.faces, &feature_options);
+        Found::Mesh(f, t.elapsed().as_secs_f64())
     });
-    if let (Some(out), None) = (&a.features, &features) {
-        bail!(
-            "{}: feature detection needs a mesh target (faces); {} is a point cloud",
-            out.display(),
-            a.target.display()
-        );
-    }
 
     let bar = crate::progress::bar(1, "analysing");
     let on_progress = |p: Progress| {
@@ -171,6 +179,12 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     let target = Target::build(&mesh, &options, Some(&on_progress))
         .with_context(|| format!("{}: cannot analyse", a.target.display()))?;
     bar.finish_and_clear();
+    if features.is_none() && a.features.is_some() {
+        crate::progress::phase("tracing sharp features");
+        let t = std::time::Instant::now();
+        let f = subfit::target::detect_cloud_features(&target, &feature_options);
+        features = Some(Found::Cloud(f, t.elapsed().as_secs_f64()));
+    }
 
     let attrs = target.point_attributes();
     let s = target.stats();
@@ -205,15 +219,31 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         k1_quantiles: quantiles(&attrs.k1),
         k2_quantiles: quantiles(&attrs.k2),
         scale_to_original: target.normalization().length_to_original(1.0),
-        features: features.as_ref().map(|(f, seconds)| FeatureSummary {
-            angle_deg: a.feature_angle,
-            sharp_edges: f.edges.len(),
-            sharp_edges_before_cleaning: f.raw_edges,
-            curves: f.curves.len(),
-            closed_curves: f.curves.iter().filter(|c| c.closed).count(),
-            corners: f.corners.len(),
-            darts: f.darts.len(),
-            seconds: *seconds,
+        features: features.as_ref().map(|found| match found {
+            Found::Mesh(f, seconds) => FeatureSummary {
+                source: "mesh",
+                angle_deg: a.feature_angle,
+                sharp_edges: f.edges.len(),
+                sharp_edges_before_cleaning: f.raw_edges,
+                curves: f.curves.len(),
+                closed_curves: f.curves.iter().filter(|c| c.closed).count(),
+                corners: f.corners.len(),
+                darts: f.darts.len(),
+                feature_points: None,
+                seconds: *seconds,
+            },
+            Found::Cloud(f, seconds) => FeatureSummary {
+                source: "cloud",
+                angle_deg: a.feature_angle,
+                sharp_edges: f.segments().len(),
+                sharp_edges_before_cleaning: f.segments().len(),
+                curves: f.curves.len(),
+                closed_curves: f.curves.iter().filter(|c| c.closed).count(),
+                corners: f.corners.len(),
+                darts: f.darts,
+                feature_points: Some(f.feature_points),
+                seconds: *seconds,
+            },
         }),
         timings: Timings {
             read,
@@ -235,8 +265,10 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     if let Some(out) = &a.output {
         write_points(out, &attrs)?;
     }
-    if let (Some(out), Some((f, _))) = (&a.features, &features) {
-        write_features(out, &mesh.positions, f)?;
+    match (&a.features, &features) {
+        (Some(out), Some(Found::Mesh(f, _))) => write_features(out, &mesh.positions, f)?,
+        (Some(out), Some(Found::Cloud(f, _))) => write_cloud_features(out, &target, f)?,
+        _ => {}
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
@@ -309,6 +341,44 @@ fn write_features(
     Ok(())
 }
 
+/// The curves of a point cloud as polylines (vertices with kinds 0 curve, 1 corner, 2 dart;
+/// consecutive points joined by edges), in the input's coordinates. Corners are shared by the
+/// curves that meet there.
+fn write_cloud_features(
+    out: &std::path::Path,
+    target: &Target,
+    f: &subfit::target::CloudFeatures,
+) -> anyhow::Result<()> {
+    let mut pts: Vec<[f64; 3]> = f.corners.iter().map(|&c| target.to_original(c)).collect();
+    let mut kinds = vec![1u8; pts.len()];
+    let mut edges = Vec::new();
+    for c in &f.curves {
+        let n = c.points.len();
+        let ids: Vec<u32> = (0..n)
+            .map(|i| {
+                let corner = match (i, c.closed) {
+                    (0, false) => c.ends[0],
+                    (i, false) if i + 1 == n => c.ends[1],
+                    _ => None,
+                };
+                corner.unwrap_or_else(|| {
+                    pts.push(target.to_original(c.points[i]));
+                    let free_end = !c.closed && (i == 0 || i + 1 == n);
+                    kinds.push(if free_end { 2 } else { 0 });
+                    (pts.len() - 1) as u32
+                })
+            })
+            .collect();
+        edges.extend(ids.windows(2).map(|w| [w[0], w[1]]));
+        if c.closed && n > 2 {
+            edges.push([ids[n - 1], ids[0]]);
+        }
+    }
+    crate::interrupt::watch_dir(out);
+    subfit::io::write_ply_edges(out, &pts, &kinds, &edges)?;
+    Ok(())
+}
+
 fn print_text(s: &Summary, out: Option<&std::path::Path>) {
     println!("file          {}", s.file);
     println!(
@@ -360,10 +430,16 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
         s.scale_to_original
     );
     if let Some(f) = &s.features {
-        println!(
-            "features      {} sharp edges (≥ {}°; {} before cleaning) in {} curves ({} closed), {} corners, {} darts",
-            f.sharp_edges, f.angle_deg, f.sharp_edges_before_cleaning, f.curves, f.closed_curves, f.corners, f.darts
-        );
+        match f.feature_points {
+            None => println!(
+                "features      {} sharp edges (≥ {}°; {} before cleaning) in {} curves ({} closed), {} corners, {} darts",
+                f.sharp_edges, f.angle_deg, f.sharp_edges_before_cleaning, f.curves, f.closed_curves, f.corners, f.darts
+            ),
+            Some(p) => println!(
+                "features      {} curves ({} closed, {} segments; normals ≥ {}° apart at {} points), {} corners, {} darts",
+                f.curves, f.closed_curves, f.sharp_edges, f.angle_deg, p, f.corners, f.darts
+            ),
+        }
     }
     let t = &s.timings;
     println!(

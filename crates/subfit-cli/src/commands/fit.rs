@@ -96,6 +96,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         init_options: InitOptions {
             features: a.features.options(),
             semi_sharp: a.features.semi_sharp,
+            cloud_features: a.features.cloud_features,
             ..FitScanOptions::default().init_options
         },
         ..FitScanOptions::default()

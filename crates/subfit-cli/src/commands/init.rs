@@ -91,6 +91,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         cancel: crate::interrupt::token(),
         features: a.features.options(),
         semi_sharp: a.features.semi_sharp,
+        cloud_features: a.features.cloud_features,
         ..InitOptions::default()
     };
     let sp = crate::progress::spinner(if use_mesh {
