@@ -9,7 +9,6 @@ mod common;
 mod noisy;
 
 use std::f64::consts::PI;
-use std::path::PathBuf;
 
 use common::{Ellipsoid, Shape, Sphere};
 use rand::Rng;
@@ -167,20 +166,6 @@ fn scaling_does_not_change_the_features() {
     assert_eq!(a.corners.len(), b.corners.len());
 }
 
-fn data_dir() -> Option<PathBuf> {
-    match std::env::var_os("SUBFIT_DATA") {
-        Some(d) => Some(PathBuf::from(d)),
-        None => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
-            );
-            println!("notice: SUBFIT_DATA not set, skipping the real-data feature test");
-            None
-        }
-    }
-}
-
 fn read_points(path: &std::path::Path) -> Vec<[f64; 3]> {
     let (mesh, _): (PolyMesh, _) = subfit_io::read_file(path, &subfit_io::ReadOptions::default())
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -193,7 +178,9 @@ fn read_points(path: &std::path::Path) -> Vec<[f64; 3]> {
 /// level the sharpness test allows for); its figures are printed.
 #[test]
 fn smooth_scans_have_no_features() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::data_dir("the real-data cloud feature tests") else {
+        return;
+    };
     for (name, most) in [
         ("igea.ply", 0),
         ("bun000_points.ply", 3),
@@ -207,7 +194,9 @@ fn smooth_scans_have_no_features() {
 
 #[test]
 fn fandisk_points_have_its_main_curves() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::data_dir("the real-data cloud feature tests") else {
+        return;
+    };
     let (_, f) = features(&read_points(&dir.join("fandisk.obj")));
     println!("fandisk: {}", summary(&f));
     assert!(f.curves.len() >= 10, "{}", summary(&f));

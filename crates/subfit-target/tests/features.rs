@@ -4,6 +4,8 @@
 //! shapes (a torus; Igea and, but for a few fair creases, the bunny from `$SUBFIT_DATA`).
 #![allow(clippy::print_stdout)]
 
+mod common;
+
 use std::collections::HashMap;
 
 use rand::{Rng, SeedableRng};
@@ -250,23 +252,9 @@ fn a_short_gap_in_a_crease_is_bridged() {
     assert!(f.darts.is_empty());
 }
 
-fn data_dir() -> Option<std::path::PathBuf> {
-    match std::env::var_os("SUBFIT_DATA") {
-        Some(d) => Some(d.into()),
-        None => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
-            );
-            println!("notice: SUBFIT_DATA not set, skipping the real-data feature test");
-            None
-        }
-    }
-}
-
 #[test]
 fn real_smooth_models_have_no_features_and_fandisk_has_many() {
-    let Some(dir) = data_dir() else {
+    let Some(dir) = common::data_dir("the real-data feature test") else {
         return;
     };
     for (name, smooth) in [

@@ -5,24 +5,10 @@
 //! Without `SUBFIT_DATA`: fails when `CI=true`, else prints a notice and passes.
 #![allow(clippy::print_stdout)]
 
-use std::path::PathBuf;
+mod common;
 
 use subfit_mesh::PolyMesh;
 use subfit_target::{NormalSource, Target, TargetOptions};
-
-fn data_dir() -> Option<PathBuf> {
-    match std::env::var_os("SUBFIT_DATA") {
-        Some(d) => Some(PathBuf::from(d)),
-        None => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
-            );
-            println!("notice: SUBFIT_DATA not set, skipping the real-data orientation test");
-            None
-        }
-    }
-}
 
 /// Closed models listed in shared/data/SOURCES.md. The hard one is lucy.ply (7.5k points, a
 /// sparse decimation with thin parts; 94.5 % after the winding check alone): the field
@@ -62,7 +48,9 @@ fn face_normals(mesh: &PolyMesh) -> Vec<[f64; 3]> {
 
 #[test]
 fn estimated_normals_agree_with_closed_meshes() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = common::data_dir("the real-data orientation test") else {
+        return;
+    };
     let mut failures = Vec::new();
     for name in CLOSED {
         let path = dir.join(name);

@@ -2,6 +2,8 @@
 //! curvatures (Cheng 2007 §II-D3 signs for outward normals: convex ⇒ negative) and closest points.
 #![allow(dead_code)]
 
+use std::path::PathBuf;
+
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
@@ -194,4 +196,21 @@ pub fn jitter(p: &[[f64; 3]], sigma: f64, seed: u64) -> Vec<[f64; 3]> {
 /// Fraction of entries satisfying `pred`.
 pub fn fraction<T>(v: &[T], pred: impl Fn(&T) -> bool) -> f64 {
     v.iter().filter(|x| pred(x)).count() as f64 / v.len() as f64
+}
+
+/// `$SUBFIT_DATA` (the directory of shared/data), for the tests on real models. Without it:
+/// fails when `CI=true` (CI must run them), else prints a notice naming `what` and skips.
+#[allow(clippy::print_stdout)]
+pub fn data_dir(what: &str) -> Option<PathBuf> {
+    match std::env::var_os("SUBFIT_DATA") {
+        Some(d) => Some(PathBuf::from(d)),
+        None => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
+            );
+            println!("notice: SUBFIT_DATA not set, skipping {what}");
+            None
+        }
+    }
 }
