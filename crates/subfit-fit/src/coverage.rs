@@ -531,6 +531,19 @@ fn vertex_normals(faces: &Polygons, xs: &[[f64; 3]]) -> Vec<[f64; 3]> {
 mod tests {
     use super::*;
 
+    /// The model's residual is half the gradient of the energy at `x`, by central differences.
+    fn assert_half_gradient(s: &CoverSum, x: [f64; 3]) {
+        let (_, r) = s.model(x);
+        for a in 0..3 {
+            let h = 1e-6;
+            let (mut xp, mut xm) = (x, x);
+            xp[a] += h;
+            xm[a] -= h;
+            let fd = (s.energy(xp) - s.energy(xm)) / (4.0 * h);
+            assert!((fd - r[a]).abs() < 1e-6, "{a}: {fd} vs {}", r[a]);
+        }
+    }
+
     #[test]
     fn cover_sum_is_the_sum_of_its_parts() {
         let x0 = [0.1, -0.2, 0.3];
@@ -545,16 +558,7 @@ mod tests {
             + 0.5 * dot(sub(x, pts[1]), n).powi(2)
             + subfit_mesh::vec3::dist2(x, pts[2]);
         assert!((s.energy(x) - direct).abs() < 1e-12 * direct);
-        // Half the gradient, by central differences.
-        let (_, r) = s.model(x);
-        for a in 0..3 {
-            let h = 1e-6;
-            let (mut xp, mut xm) = (x, x);
-            xp[a] += h;
-            xm[a] -= h;
-            let fd = (s.energy(xp) - s.energy(xm)) / (4.0 * h);
-            assert!((fd - r[a]).abs() < 1e-6, "{a}: {fd} vs {}", r[a]);
-        }
+        assert_half_gradient(&s, x);
         assert_eq!(s.count(), 3);
     }
 
@@ -573,15 +577,7 @@ mod tests {
         // Moving along the line costs nothing.
         let y = std::array::from_fn(|k| x[k] + 0.8 * t[k]);
         assert!((s.energy(y) - s.energy(x)).abs() < 1e-12);
-        let (_, r) = s.model(x);
-        for a in 0..3 {
-            let h = 1e-6;
-            let (mut xp, mut xm) = (x, x);
-            xp[a] += h;
-            xm[a] -= h;
-            let fd = (s.energy(xp) - s.energy(xm)) / (4.0 * h);
-            assert!((fd - r[a]).abs() < 1e-6, "{a}: {fd} vs {}", r[a]);
-        }
+        assert_half_gradient(&s, x);
     }
 
     #[test]
