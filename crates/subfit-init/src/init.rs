@@ -16,7 +16,10 @@
 
 use std::time::{Duration, Instant};
 
-use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Tags, TopologyError};
+use subfit_mesh::{
+    split_concave_corners, Cancel, Cancelled, ConcaveSplits, HalfEdgeMesh, PolyMesh, Tags,
+    TopologyError,
+};
 use subfit_target::{detect_features, fillet_widths, FeatureOptions, Target};
 
 use crate::semi_sharp::semi_sharp_tags;
@@ -74,6 +77,10 @@ pub struct InitOptions {
     /// contour to them). Default `false`: experimental — on a box and a capped cylinder sampled
     /// as clouds the fitted surfaces were not yet closer to the shapes than without it.
     pub cloud_features: bool,
+    /// The most control points the cage may have after its concave corners are split
+    /// ([`subfit_mesh::concave`]: a corner whose concave sector has no interior vertex gets one
+    /// inserted); splits that would go beyond it are skipped. Default `usize::MAX`.
+    pub max_control_points: usize,
     /// Cancellation token for every step (contouring, the carving fallback, simplification;
     /// it replaces the tokens in [`Self::contour`] and [`Self::simplify`]), polled per octree
     /// level and per batch of cells, evaluations and edge collapses; once cancelled,
@@ -96,6 +103,7 @@ impl Default for InitOptions {
             features: None,
             semi_sharp: false,
             cloud_features: false,
+            max_control_points: usize::MAX,
             cancel: Cancel::default(),
         }
     }
@@ -196,6 +204,9 @@ pub struct InitReport {
     pub tags: Tags,
     /// The sharp features detected on a mesh target with [`InitOptions::features`].
     pub features: Option<FeatureCounts>,
+    /// Concave corners split by a crease into their sector so the limit surface does not fold
+    /// there ([`subfit_mesh::concave`]); zero without tags.
+    pub concave: ConcaveSplits,
     /// The sharp feature edges the cage was built along, as segments (normalized units): what
     /// the creases of the fitted surface should follow (`subfit_fit::FitOptions::feature_segments`).
     /// Empty without features.
@@ -418,6 +429,10 @@ pub fn initial_control_mesh(
         report.fillet_widths = fillet_widths(&dense.positions, &dense.faces, f);
         tags = semi_sharp_tags(&out, &tags, &dense, f, &report.fillet_widths);
     }
+    let room = options
+        .max_control_points
+        .saturating_sub(out.num_vertices());
+    report.concave = split_concave_corners(&mut out, &mut tags, room);
     report.timings.simplify = t.elapsed();
     report.simplify = srep;
     report.tags = tags;

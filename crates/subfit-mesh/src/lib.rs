@@ -5,7 +5,8 @@
 //! bundles it with positions and optional attributes. [`HalfEdgeMesh`] is a derived view for
 //! navigating manifold meshes; [`diagnose()`] reports on any polygon soup (boundary loops,
 //! manifoldness, orientation, components, Euler characteristic, genus); [`reorient_faces`] repairs
-//! inconsistently oriented faces. [`Cancel`] is the cancellation token that the long phases of
+//! inconsistently oriented faces; [`split_concave_corners`] keeps a tagged cage from folding at
+//! its concave corners. [`Cancel`] is the cancellation token that the long phases of
 //! the other crates poll. [`vec3`] holds the small `[f64; 3]` helpers every crate uses; [`bvh`]
 //! the exact closest point on triangles; [`deforming`] generates deforming test sequences with
 //! known correspondence.
@@ -13,6 +14,7 @@
 pub mod bvh;
 pub mod cancel;
 pub mod components;
+pub mod concave;
 pub mod deforming;
 pub mod diagnose;
 mod edges;
@@ -26,6 +28,7 @@ pub mod vec3;
 
 pub use cancel::{Cancel, Cancelled};
 pub use components::{euler_characteristic, face_components, genus, Components};
+pub use concave::{split_concave_corners, ConcaveSplits, CONCAVE_ANGLE};
 pub use diagnose::{diagnose, diagnose_mesh, ComponentReport, IssueExamples, MeshReport};
 pub use halfedge::{HalfEdgeMesh, Outgoing, TopologyError};
 pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};

@@ -394,9 +394,7 @@ pub fn cube_mesh(h: f64) -> PolyMesh {
 /// If `n` is 0.
 pub fn gridded_box(n: usize, open_top: bool) -> PolyMesh {
     assert!(n > 0, "a grid needs at least one cell per side");
-    let mut index: std::collections::HashMap<[u64; 3], u32> = std::collections::HashMap::new();
-    let mut pos = Vec::new();
-    let mut tris = Vec::new();
+    let mut grid = Grid::new(n);
     // (origin, u, v) with u × v outward.
     let mut sides = vec![
         ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
@@ -408,28 +406,93 @@ pub fn gridded_box(n: usize, open_top: bool) -> PolyMesh {
     if !open_top {
         sides.push(([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]));
     }
-    let k = n as f64;
     for (o, u, v) in sides {
+        grid.patch(o, u, v);
+    }
+    grid.mesh()
+}
+
+/// A closed L-shaped prism (an angle bracket): the profile (0,0) (2,0) (2,1) (1,1) (1,2) (0,2),
+/// height 1, every side an `n`-per-unit grid of triangle pairs (outward orientation, shared
+/// vertices). The CAD-like shape of concave features: 18 crease curves, 12 corners, one concave
+/// edge (x = y = 1) whose two ends are concave corners of the top and bottom faces.
+///
+/// # Panics
+/// If `n` is 0.
+pub fn l_prism(n: usize) -> PolyMesh {
+    assert!(n > 0, "a grid needs at least one cell per unit");
+    let mut grid = Grid::new(n);
+    let (x, y, z) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    let (x2, y2) = ([2.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+    // (origin, u, v) with u × v outward.
+    let sides = [
+        ([0.0, 0.0, 0.0], y, x2), // bottom, y ∈ [0, 1]
+        ([0.0, 1.0, 0.0], y, x),  // bottom, y ∈ [1, 2]
+        ([0.0, 0.0, 1.0], x2, y), // top, y ∈ [0, 1]
+        ([0.0, 1.0, 1.0], x, y),  // top, y ∈ [1, 2]
+        ([0.0, 0.0, 0.0], x2, z), // y = 0
+        ([2.0, 0.0, 0.0], y, z),  // x = 2
+        ([1.0, 1.0, 0.0], z, x),  // y = 1, x ∈ [1, 2]
+        ([1.0, 1.0, 0.0], y, z),  // x = 1, y ∈ [1, 2]
+        ([0.0, 2.0, 0.0], z, x),  // y = 2
+        ([0.0, 0.0, 0.0], z, y2), // x = 0
+    ];
+    for (o, u, v) in sides {
+        grid.patch(o, u, v);
+    }
+    grid.mesh()
+}
+
+/// Rectangles gridded in triangle pairs at `1/n`, sharing the vertices on their common edges
+/// (keyed by grid coordinates, which are exact multiples of `1/n`).
+struct Grid {
+    n: usize,
+    index: std::collections::HashMap<[i64; 3], u32>,
+    positions: Vec<[f64; 3]>,
+    tris: Vec<[u32; 3]>,
+}
+
+impl Grid {
+    fn new(n: usize) -> Self {
+        Self {
+            n,
+            index: std::collections::HashMap::new(),
+            positions: Vec::new(),
+            tris: Vec::new(),
+        }
+    }
+
+    /// The rectangle `o + s·u + t·v`, `s, t ∈ [0, 1]` (`|u|`, `|v|` whole units), faces
+    /// wound so that `u × v` is outward.
+    fn patch(&mut self, o: [f64; 3], u: [f64; 3], v: [f64; 3]) {
+        let k = self.n as f64;
+        let cells = |w: [f64; 3]| (dot(w, w).sqrt() * k).round() as usize;
+        let (nu, nv) = (cells(u), cells(v));
         let mut vertex = |i: usize, j: usize| {
-            let p: [f64; 3] =
-                std::array::from_fn(|c| o[c] + u[c] * i as f64 / k + v[c] * j as f64 / k);
-            // Grid coordinates are exact multiples of 1/n: key by them.
-            let key = p.map(|x| (x * k).round() as u64);
-            *index.entry(key).or_insert_with(|| {
-                pos.push(p);
-                (pos.len() - 1) as u32
+            let p: [f64; 3] = std::array::from_fn(|c| {
+                o[c] + u[c] * i as f64 / nu as f64 + v[c] * j as f64 / nv as f64
+            });
+            let key = p.map(|x| (x * k).round() as i64);
+            *self.index.entry(key).or_insert_with(|| {
+                self.positions.push(p);
+                (self.positions.len() - 1) as u32
             })
         };
-        for i in 0..n {
-            for j in 0..n {
+        let mut tris = Vec::with_capacity(2 * nu * nv);
+        for i in 0..nu {
+            for j in 0..nv {
                 let (a, b) = (vertex(i, j), vertex(i + 1, j));
                 let (c, d) = (vertex(i + 1, j + 1), vertex(i, j + 1));
                 tris.push([a, b, c]);
                 tris.push([a, c, d]);
             }
         }
+        self.tris.extend(tris);
     }
-    PolyMesh::new(pos, Polygons::from_triangles(&tris))
+
+    fn mesh(self) -> PolyMesh {
+        PolyMesh::new(self.positions, Polygons::from_triangles(&self.tris))
+    }
 }
 
 /// A closed prism over the unit square `[0, 1]²`, height 1, whose four long edges are rounded

@@ -9,7 +9,7 @@ mod common;
 use std::collections::HashMap;
 
 use rand::{Rng, SeedableRng};
-use subfit_mesh::shapes::torus_mesh;
+use subfit_mesh::shapes::{l_prism, torus_mesh};
 use subfit_mesh::{PolyMesh, Polygons};
 use subfit_target::{detect_features, FeatureOptions, Features};
 
@@ -77,24 +77,6 @@ fn grid_cube(n: usize) -> PolyMesh {
     b.patch([0.0, 1.0, 0.0], z, x);
     b.patch([0.0; 3], z, y);
     b.patch([1.0, 0.0, 0.0], y, z);
-    b.mesh()
-}
-
-/// An L-shaped prism: the profile (0,0) (2,0) (2,1) (1,1) (1,2) (0,2), height 1, gridded at 1/4.
-fn l_prism() -> PolyMesh {
-    let mut b = Builder::new(0.25);
-    let (x, y, z) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
-    let s = |a: [f64; 3], k: f64| a.map(|c| c * k);
-    for h in [0.0, 1.0] {
-        b.patch([0.0, 0.0, h], s(x, 2.0), y);
-        b.patch([0.0, 1.0, h], x, y);
-    }
-    b.patch([0.0; 3], s(x, 2.0), z); // y = 0
-    b.patch([2.0, 0.0, 0.0], y, z); // x = 2
-    b.patch([1.0, 1.0, 0.0], x, z); // y = 1, x ∈ [1, 2]
-    b.patch([1.0, 1.0, 0.0], y, z); // x = 1, y ∈ [1, 2] (the concave edge is at (1, 1))
-    b.patch([0.0, 2.0, 0.0], x, z); // y = 2
-    b.patch([0.0; 3], s(y, 2.0), z); // x = 0
     b.mesh()
 }
 
@@ -206,12 +188,12 @@ fn capped_cylinder_has_two_circles() {
 
 #[test]
 fn l_prism_has_eighteen_curves_and_twelve_corners_with_the_concave_edge() {
-    let f = detect(&l_prism());
+    let f = detect(&l_prism(4));
     assert_consistent(&f, "L prism");
     assert_eq!(f.curves.len(), 18, "{:?}", f.curves);
     assert_eq!(f.corners.len(), 12);
     // The concave vertical edge at (1, 1) is found.
-    let m = l_prism();
+    let m = l_prism(4);
     let concave = f.curves.iter().any(|c| {
         c.vertices.iter().all(|&v| {
             let p = m.positions[v as usize];

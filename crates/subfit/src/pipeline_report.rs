@@ -158,6 +158,14 @@ pub struct FeatureSummary {
     pub corners: usize,
     /// Darts (curve ends in smooth regions).
     pub darts: usize,
+    /// Concave sectors of the cage's corners split by a crease so the limit surface does not
+    /// fold there (`subfit_mesh::concave`).
+    #[serde(default)]
+    pub concave_sectors: usize,
+    /// Control points inserted for those creases (in [`InitSummary::control_points`], beyond
+    /// [`InitSummary::requested_control_points`]).
+    #[serde(default)]
+    pub concave_points: usize,
 }
 
 /// Quads and triangles of `faces`, and the fraction of quads (0 without faces). Cost `O(F)`.

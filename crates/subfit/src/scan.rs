@@ -375,6 +375,12 @@ pub fn fit_scan(
                 None => default_control_points(target.len()).min(budget),
             };
             let dense = (!mesh.faces.is_empty()).then_some(&mesh);
+            // Concave corners may add points within the budget, not to a count asked for.
+            init_options.max_control_points = if options.control_points.is_some() {
+                n
+            } else {
+                budget
+            };
             let (m, r) = initial_control_mesh(&target, dense, n, &init_options).map_err(|e| {
                 match e {
                     subfit_init::InitError::TooFewForTopology { .. } if options.control_points.is_none() => {
@@ -832,6 +838,8 @@ fn init_summary(
             curves: f.curves,
             corners: f.corners,
             darts: f.darts,
+            concave_sectors: r.concave.creases,
+            concave_points: r.concave.inserted,
         }),
         timings_s: InitTimings {
             contour: r.timings.contour.as_secs_f64(),

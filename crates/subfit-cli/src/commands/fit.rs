@@ -191,7 +191,13 @@ pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
         } else {
             String::new()
         }
-    )
+    ) + &match i.features {
+        Some(f) if f.concave_sectors > 0 => format!(
+            "; {} concave corner sector(s) split by a crease ({} control point(s) added)",
+            f.concave_sectors, f.concave_points
+        ),
+        _ => String::new(),
+    }
 }
 
 /// Blender subdivides Catmull-Clark meshes only: says so when a Loop cage is written.

@@ -92,6 +92,12 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         features: a.features.options(),
         semi_sharp: a.features.semi_sharp,
         cloud_features: a.features.cloud_features,
+        // Concave corners may add points, but not to a count asked for.
+        max_control_points: if a.control_points.is_some() {
+            n
+        } else {
+            usize::MAX
+        },
         ..InitOptions::default()
     };
     let sp = crate::progress::spinner(if use_mesh {
@@ -144,6 +150,12 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     let write_time = t.elapsed();
 
     print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
+    if report.concave.creases > 0 {
+        println!(
+            "note: {} concave corner sector(s) split by a crease so the limit surface does not fold there ({} control point(s) added)",
+            report.concave.creases, report.concave.inserted
+        );
+    }
     if let Some(r) = report.carve_radius {
         println!(
             "note: the implicit surface missed genus {}; used the space-carving fallback \
