@@ -205,7 +205,7 @@ pub struct InitReport {
     /// The sharp features detected on a mesh target with [`InitOptions::features`].
     pub features: Option<FeatureCounts>,
     /// Concave corners split by a crease into their sector so the limit surface does not fold
-    /// there ([`subfit_mesh::concave`]); zero without tags.
+    /// there ([`subfit_mesh::concave`]; mesh targets); zero without tags.
     pub concave: ConcaveSplits,
     /// The sharp feature edges the cage was built along, as segments (normalized units): what
     /// the creases of the fitted surface should follow (`subfit_fit::FitOptions::feature_segments`).
@@ -429,10 +429,14 @@ pub fn initial_control_mesh(
         report.fillet_widths = fillet_widths(&dense.positions, &dense.faces, f);
         tags = semi_sharp_tags(&out, &tags, &dense, f, &report.fillet_widths);
     }
-    let room = options
-        .max_control_points
-        .saturating_sub(out.num_vertices());
-    report.concave = split_concave_corners(&mut out, &mut tags, room);
+    // A point cloud's traced crease graph has stray crease edges (T-junctions on flat sides)
+    // where a split would only add creases off the data's features.
+    if report.source == InitSource::Mesh {
+        let room = options
+            .max_control_points
+            .saturating_sub(out.num_vertices());
+        report.concave = split_concave_corners(&mut out, &mut tags, room);
+    }
     report.timings.simplify = t.elapsed();
     report.simplify = srep;
     report.tags = tags;

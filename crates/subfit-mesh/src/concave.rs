@@ -32,6 +32,11 @@ use crate::{HalfEdgeMesh, PolyMesh, Polygons, Tags, VertexId, SHARPNESS_INFINITE
 /// T-junctions where a crease meets another one that runs straight on) are split.
 pub const CONCAVE_ANGLE: f64 = 175.0 * std::f64::consts::PI / 180.0;
 
+/// A concave sector's middle edge `d` and its creases `t1`, `t2` (unit vectors from the
+/// corner) have `d · (t1 + t2)` below this; for a flat sector of opening θ it is `2 cos(θ/2)`,
+/// 0.2 at θ ≈ 168°.
+const REFLEX_COSINE: f64 = 0.2;
+
 /// What [`split_concave_corners`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct ConcaveSplits {
@@ -45,7 +50,8 @@ pub struct ConcaveSplits {
 
 /// Splits every concave sector of `cage`'s corners by a crease (see the module docs). A sector
 /// is concave when the angles of its faces at the corner add up to more than
-/// [`CONCAVE_ANGLE`]. The new crease runs along the interior edge nearest the sector's angular
+/// [`CONCAVE_ANGLE`] and its middle edge points out of the convex wedge between its two
+/// creases (not into it, as on a bumpy fan between creases less than π apart). The new crease runs along the interior edge nearest the sector's angular
 /// middle among those whose other end has no sharp or boundary edge (so that no crease curve
 /// through it gets a corner); when there is none, the interior edge nearest the middle is split
 /// at its midpoint (its two faces must be triangles that no other split touches, and at most
@@ -205,8 +211,13 @@ fn concave_sectors(he: &HalfEdgeMesh, cage: &PolyMesh, tags: &Tags, v: VertexId)
     let Some(first) = (0..ring.len()).find(|&i| is_sharp[i]) else {
         return plans;
     };
+    let direction = |i: usize| {
+        let d = sub(cage.positions[ring[i].idx()], p);
+        let l = norm(d);
+        d.map(|c| if l > 0.0 { c / l } else { 0.0 })
+    };
     let mut sector: Vec<(usize, f64)> = Vec::new(); // (ring edge ending the face, cumulative angle)
-    let mut total = 0.0;
+    let (mut total, mut start) = (0.0, first);
     for step in 0..k {
         let f = (first + step) % ring.len();
         total += angle(f);
@@ -215,24 +226,28 @@ fn concave_sectors(he: &HalfEdgeMesh, cage: &PolyMesh, tags: &Tags, v: VertexId)
             sector.push((end, total));
             continue;
         }
-        if total > CONCAVE_ANGLE && !sector.is_empty() {
-            let off_middle = |&&(_, a): &&(usize, f64)| (a - 0.5 * total).abs();
-            let nearest = |it: &mut dyn Iterator<Item = &(usize, f64)>| {
-                it.min_by(|x, y| off_middle(x).total_cmp(&off_middle(y)))
-                    .map(|&(e, _)| ring[e].0)
-            };
-            let direct = nearest(&mut sector.iter().filter(|&&(e, _)| !on_crease(ring[e])));
-            if let Some(middle) = nearest(&mut sector.iter()) {
+        let off_middle = |&&(_, a): &&(usize, f64)| (a - 0.5 * total).abs();
+        let nearest = |it: &mut dyn Iterator<Item = &(usize, f64)>| {
+            it.min_by(|x, y| off_middle(x).total_cmp(&off_middle(y)))
+                .map(|&(e, _)| e)
+        };
+        if let (true, Some(middle)) = (total > CONCAVE_ANGLE, nearest(&mut sector.iter())) {
+            // A bumpy fan's angles add up to more than its opening: the sector is concave
+            // only if its middle edge does not point into the convex wedge of its creases
+            // (for a flat sector of angle θ this is θ > 168°).
+            let wedge: [f64; 3] = std::array::from_fn(|c| direction(start)[c] + direction(end)[c]);
+            if dot(direction(middle), wedge) < REFLEX_COSINE {
+                let direct = nearest(&mut sector.iter().filter(|&&(e, _)| !on_crease(ring[e])));
                 plans.push(Plan {
                     corner: v.0,
-                    direct,
-                    middle,
+                    direct: direct.map(|e| ring[e].0),
+                    middle: ring[middle].0,
                     sharpness,
                 });
             }
         }
         sector.clear();
-        total = 0.0;
+        (total, start) = (0.0, end);
     }
     plans
 }
