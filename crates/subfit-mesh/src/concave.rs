@@ -8,8 +8,8 @@
 //! the inside corner of an L-shaped bracket or the notches of fandisk — cannot follow the data:
 //! it spans the convex wedge between the two crease tangents instead, and folds over its own
 //! crease curves by a fraction of the corner's edge length (Biermann, Levin and Zorin 2000,
-//! "Piecewise smooth subdivision surfaces with normal control", §4, who add a concave-corner
-//! rule for this; OpenSubdiv, USD and Blender have no such rule). On fandisk at the default
+//! "Piecewise smooth subdivision surfaces with normal control", add a concave-corner rule for
+//! this; OpenSubdiv, USD and Blender have no such rule). On fandisk at the default
 //! tolerance that fold is the fit's largest error (3.2e-3 of the unit cube, near one notch).
 //!
 //! A cage that stays within OpenSubdiv's semantics avoids the fold by topology: an extra crease
@@ -51,9 +51,9 @@ pub struct ConcaveSplits {
 /// Splits every concave sector of `cage`'s corners by a crease (see the module docs). A sector
 /// is concave when the angles of its faces at the corner add up to more than
 /// [`CONCAVE_ANGLE`] and its middle edge points out of the convex wedge between its two
-/// creases (not into it, as on a bumpy fan between creases less than π apart). The new crease runs along the interior edge nearest the sector's angular
-/// middle among those whose other end has no sharp or boundary edge (so that no crease curve
-/// through it gets a corner); when there is none, the interior edge nearest the middle is split
+/// creases (not into it, as on a bumpy fan between creases less than π apart). The new crease
+/// runs along the interior edge nearest the sector's angular middle among those whose other
+/// end has no sharp or boundary edge (so that no crease curve through it gets a corner); when there is none, the interior edge nearest the middle is split
 /// at its midpoint (its two faces must be triangles that no other split touches, and at most
 /// `max_new_points` points are inserted) and the crease runs to the new point. The crease takes
 /// the corner's sharpness (the largest of its creases when the corner is untagged). A cage
