@@ -4,7 +4,9 @@
 mod common;
 
 use subfit_fit::internals::refine_red_green;
-use subfit_fit::{fit_stages, FitOptions, Fitter, StageOptions};
+use subfit_fit::{fit_stages, FitOptions, Fitter, StageOptions, StageStop, STALL_STAGES};
+use subfit_mesh::shapes::Shape;
+use subfit_target::{Target, TargetOptions};
 
 use common::{ellipsoid_target, fourteen_vertex_mesh, normalized};
 
@@ -93,4 +95,49 @@ fn stages_are_global_by_default() {
     };
     let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
     assert!(out.report.stages.iter().all(|s| s.active_points.is_none()));
+}
+
+/// Data no surface of the cage reaches — a small patch of points far beyond the ellipsoid's
+/// tip, fitted one-sided so nothing pulls the surface toward it — keeps data → surface E_max
+/// above its tolerance whatever refinement does: the driver gives up [`STALL_STAGES`] stages
+/// after its best cage instead of refining on to the budget, and returns the best.
+#[test]
+fn stages_give_up_when_no_stage_improves_on_the_best() {
+    let cloud = Shape::PAPER_ELLIPSOID.sample(8_000, 0.0, 7);
+    let mut points = cloud.positions.clone();
+    let mut normals = cloud.normals.clone().unwrap();
+    // A 12 × 12 patch of points, 0.02 wide, facing +z, at twice the ellipsoid's height.
+    for i in 0..12 {
+        for j in 0..12 {
+            points.push([0.02 * i as f64 / 11.0, 0.02 * j as f64 / 11.0, 2.0]);
+            normals.push([0.0, 0.0, 1.0]);
+        }
+    }
+    let target = Target::from_points(&points, Some(&normals), &TargetOptions::default()).unwrap();
+    let mesh = normalized(&target, &fourteen_vertex_mesh());
+    let stages = StageOptions {
+        tolerance_rms: 1e-5,
+        tolerance_max: 1e-3,
+        max_control_points: 100_000,
+        max_stages: 40,
+        ..StageOptions::default()
+    };
+    let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
+    let r = &out.report;
+    let summary: Vec<_> = r
+        .stages
+        .iter()
+        .map(|s| (s.num_control_points, s.two_sided.data_to_surface.max))
+        .collect();
+    assert_eq!(r.stop, StageStop::Stalled, "{summary:?}");
+    assert_eq!(
+        r.stages.len(),
+        r.best_stage + 1 + STALL_STAGES,
+        "{summary:?}"
+    );
+    assert_eq!(
+        out.mesh.num_vertices(),
+        r.stages[r.best_stage].num_control_points,
+        "the best cage is returned"
+    );
 }
