@@ -406,3 +406,41 @@ fn real_single_view_scan_is_open_and_closed_model_is_closed() {
     );
     assert_eq!(topology(&cage), (0, 0, 1), "bunny.off: {rep:?}");
 }
+
+/// The Stanford bunny's vertices (a mesh with 5 holes at its base, read as points): its trimmed
+/// contour has spurious handles (genus ≠ the mesh's 0). Told only the genus, the cage falls
+/// back to the closed carved wrap; told also that the data has boundary loops, it stays open
+/// and near the data, because a closed wrap cannot have the data's loops either.
+#[test]
+fn a_known_open_cloud_is_not_wrapped_closed() {
+    let Some(dir) = common::data_dir() else {
+        return;
+    };
+    let (mesh, _) = subfit_io::read_file(
+        &dir.join("stanford-bunny.obj"),
+        &subfit_io::ReadOptions::default(),
+    )
+    .unwrap();
+    let t = target(&mesh.positions);
+    let genus_only = InitOptions {
+        expected_genus: Some(0),
+        ..InitOptions::default()
+    };
+    let (wrap, rep) = initial_control_mesh(&t, None, 314, &genus_only).unwrap();
+    assert!(rep.carve_radius.is_some(), "{rep:?}");
+    assert_eq!(topology(&wrap).1, 0, "the carved wrap is closed");
+
+    let open = InitOptions {
+        expected_boundary_loops: Some(5),
+        ..genus_only
+    };
+    let (cage, rep) = initial_control_mesh(&t, None, 314, &open).unwrap();
+    assert!(rep.carve_radius.is_none(), "{rep:?}");
+    assert!(rep.cloud_open() && topology(&cage).1 >= 1, "{rep:?}");
+    let spacing = t.stats().point_spacing;
+    let far = farthest_from_data(&t, cage.positions.iter().copied());
+    assert!(
+        far < 3.0 * spacing,
+        "cage vertex {far} vs spacing {spacing}"
+    );
+}

@@ -102,7 +102,8 @@ pub struct FitScanOptions {
     pub stages: StageOptions,
     /// Target analysis options.
     pub target: TargetOptions,
-    /// Initial-mesh options (`expected_genus` is set from the faces with `as_points`).
+    /// Initial-mesh options (`expected_genus` and `expected_boundary_loops` are set from the faces
+    /// with `as_points`).
     pub init_options: InitOptions,
     /// The error mapped to red in `error.ply` (normalized units). Default `None`: the final
     /// surface → data `E_max`.
@@ -262,7 +263,10 @@ pub fn fit_scan(
         .quad_dominant
         .unwrap_or(options.scheme.is_some_and(|s| s != Scheme::Loop));
     if options.as_points && !mesh.faces.is_empty() {
-        init_options.expected_genus = topology(&mesh).ok().map(|t| t.genus);
+        if let Ok(t) = topology(&mesh) {
+            init_options.expected_genus = Some(t.genus);
+            init_options.expected_boundary_loops = Some(t.boundary_loops);
+        }
         mesh.faces = Polygons::new();
     }
     let target_topology = if mesh.faces.is_empty() {

@@ -82,6 +82,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     }
     let options = InitOptions {
         expected_genus,
+        expected_boundary_loops: input_topology.as_ref().map(|d| d.boundary_loops),
         require_genus: a.require_genus,
         quad_dominant: crate::cli::quad_dominant_flag(a.quad_dominant, a.no_quad_dominant)
             .unwrap_or(matches!(
