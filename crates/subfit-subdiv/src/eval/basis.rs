@@ -51,20 +51,25 @@ impl PatchCoef {
                 }
             }
         }
-        let keep: Vec<usize> = (0..k)
-            .filter(|&j| (0..combos.len()).any(|i| dense[i * k + j] != 0.0))
+        Self::from_dense(&mesh.cols, &dense, combos.len())
+    }
+
+    /// From `npts × cols.len()` dense rows over control points `cols`: keeps the nonzero
+    /// columns, sorted by control-point id.
+    pub(super) fn from_dense(cols: &[u32], dense: &[f64], npts: usize) -> Self {
+        let k = cols.len();
+        let mut order: Vec<usize> = (0..k)
+            .filter(|&j| (0..npts).any(|i| dense[i * k + j] != 0.0))
             .collect();
-        let mut order: Vec<usize> = keep.clone();
-        order.sort_by_key(|&j| mesh.cols[j]);
-        let cols: Vec<u32> = order.iter().map(|&j| mesh.cols[j]).collect();
-        let mut coef = Vec::with_capacity(combos.len() * cols.len());
-        for i in 0..combos.len() {
+        order.sort_by_key(|&j| cols[j]);
+        let mut coef = Vec::with_capacity(npts * order.len());
+        for i in 0..npts {
             coef.extend(order.iter().map(|&j| dense[i * k + j]));
         }
         Self {
-            cols,
+            cols: order.iter().map(|&j| cols[j]).collect(),
             coef,
-            npts: combos.len(),
+            npts,
         }
     }
 

@@ -3,10 +3,11 @@
 
 use super::basis::{best_child, child_local, mul2, PatchCoef};
 use super::memo::{make_node, MemoBudget, Node, CACHE_DEPTH, DEFAULT_CACHE_BYTES};
+use super::shape::Shapes;
 use super::types::{EvalError, EvalWeights, SurfaceParam, SurfacePoint};
 use crate::error::SubdivError;
 use crate::local::{
-    children, corner_points, patch_scheme, regular_patch, two_ring, LocalMesh, BOUNDARY, SHARP,
+    corner_points, patch_scheme, regular_patch, two_ring, LocalMesh, BOUNDARY, SHARP,
 };
 use crate::scheme::{Options, Scheme};
 use crate::topology::Topology;
@@ -52,7 +53,10 @@ pub struct Evaluator {
     /// patches at construction).
     roots: Vec<OnceLock<Node>>,
     /// Bytes held by nodes memoised after construction, and the budget they may use.
-    memo: MemoBudget,
+    pub(super) memo: MemoBudget,
+    /// Interned local topologies below the memoised levels and the steps between them
+    /// (counted in `memo`).
+    pub(super) shapes: Shapes,
 }
 
 impl Evaluator {
@@ -151,6 +155,7 @@ impl Evaluator {
                 used: AtomicUsize::new(0),
                 budget: DEFAULT_CACHE_BYTES,
             },
+            shapes: Shapes::default(),
         };
         let regular: Vec<Option<PatchCoef>> = (0..nf)
             .into_par_iter()
@@ -222,6 +227,7 @@ impl Evaluator {
                 *cell = OnceLock::new();
             }
         }
+        self.shapes.clear();
         *self.memo.used.get_mut() = 0;
     }
 
@@ -430,15 +436,24 @@ impl Evaluator {
             match node {
                 Node::Failed => return Err(err(depth)),
                 Node::Regular(pc) => return Ok(pc.eval(scheme, u, v, a, depth)),
-                Node::Irregular { mesh, t, kids } => {
-                    if depth >= self.cache_depth || self.irregular_corner(mesh, *t, u, v) {
-                        return self.descend(mesh.clone(), *t, u, v, a, depth, p.face);
+                Node::Irregular {
+                    mesh,
+                    t,
+                    kids,
+                    children: ch,
+                    shape,
+                } => {
+                    let at = (*t, u, v, a, depth, p.face);
+                    if self.irregular_corner(mesh, *t, u, v) {
+                        return self.descend_rows((**mesh).clone(), *t, u, v, a, depth, p.face);
                     }
-                    let ch = children(mesh, scheme, *t);
-                    let which = best_child(&ch, u, v);
+                    if depth >= self.cache_depth {
+                        return self.descend(mesh, Some(shape), at);
+                    }
+                    let which = best_child(ch, u, v);
                     if kids[which].get().is_none() && self.memo.full() {
                         // Over the memory budget: refine from here without memoising.
-                        return self.descend(mesh.clone(), *t, u, v, a, depth, p.face);
+                        return self.descend(mesh, Some(shape), at);
                     }
                     let (cu, cv, ca) = child_local(&ch[which].params, u, v);
                     node = kids[which].get_or_init(|| {

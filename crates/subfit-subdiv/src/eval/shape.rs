@@ -1,0 +1,270 @@
+//! Interned local topologies ("shapes") below the memoised levels, and each local refinement
+//! step between them as a sparse matrix over the parent's local vertices.
+//!
+//! Stam 1998, §3–4: near an irregular vertex the two-ring's topology repeats from level to
+//! level, so one local subdivision matrix serves every level. The same holds along a
+//! quad/triangle seam (Stam & Loop 2003, §3), where patches are never regular at any level and
+//! every point near a seam descends `log2(1 / distance)` levels: a handful of seam topologies
+//! recur along every seam. So the topology of each local neighbourhood is interned once per
+//! [`Evaluator`](super::Evaluator) (with its regular patch, if any, and its children), each
+//! refinement step from a shape to a child is computed once (by local refinement of identity
+//! rows) and kept as a sparse matrix, and a query only walks the shapes and multiplies the step
+//! matrices into the final patch from the patch side,
+//! `C · S_d ⋯ S_1 · R` (`C` the regular patch's control points, `R` the rows of the
+//! neighbourhood the walk started from): O(16 · nnz(S)) per level instead of one local
+//! refinement.
+
+use crate::local::{children, regular_patch, ChildFace, Combo, LocalMesh};
+use crate::scheme::Scheme;
+use std::collections::HashMap;
+use std::sync::{Arc, OnceLock, RwLock};
+
+/// The topology of a local neighbourhood (a [`LocalMesh`] without rows) and the face of
+/// interest in it, with what evaluation needs of it.
+#[derive(Debug)]
+pub(super) struct Shape {
+    /// The topology; `cols` and `rows` are empty.
+    pub(super) mesh: LocalMesh,
+    /// The face of interest.
+    pub(super) t: usize,
+    /// The regular patch's control points of face `t`, if it is regular.
+    pub(super) patch: Option<Vec<Combo>>,
+    /// The children of face `t` (order of [`children`]).
+    pub(super) children: Vec<ChildFace>,
+    /// Per child: the refinement step to its neighbourhood (`None`: local refinement failed).
+    kids: Vec<OnceLock<Option<Arc<Step>>>>,
+}
+
+/// One local refinement step: the child neighbourhood's shape and the rows of its vertices
+/// over the parent's local vertices (sparse, by child vertex).
+#[derive(Debug)]
+pub(super) struct Step {
+    /// The shape of the child neighbourhood.
+    pub(super) child: Arc<Shape>,
+    /// Row offsets (`nv_child + 1`).
+    off: Vec<u32>,
+    /// Parent local vertex of each weight.
+    idx: Vec<u32>,
+    /// Weights.
+    w: Vec<f64>,
+}
+
+impl Step {
+    /// The weights of child vertex `i` over parent local vertices.
+    fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let r = self.off[i] as usize..self.off[i + 1] as usize;
+        self.idx[r.clone()]
+            .iter()
+            .zip(&self.w[r])
+            .map(|(&j, &w)| (j as usize, w))
+    }
+
+    fn heap_bytes(&self) -> usize {
+        (self.off.len() + self.idx.len()) * 4 + self.w.len() * 8
+    }
+}
+
+impl Shape {
+    fn new(mesh: &LocalMesh, t: usize, scheme: Scheme) -> Self {
+        let mesh = LocalMesh {
+            cols: Vec::new(),
+            rows: Vec::new(),
+            ..mesh.clone()
+        };
+        let adj = mesh.adjacency();
+        let patch = regular_patch(&mesh, &adj, scheme, t);
+        let children = children(&mesh, scheme, t);
+        let kids = (0..children.len()).map(|_| OnceLock::new()).collect();
+        Self {
+            mesh,
+            t,
+            patch,
+            children,
+            kids,
+        }
+    }
+
+    /// The step to child `which` if it has been computed.
+    pub(super) fn step(&self, which: usize) -> Option<&Option<Arc<Step>>> {
+        self.kids[which].get()
+    }
+
+    /// Approximate heap bytes (array payloads).
+    fn heap_bytes(&self) -> usize {
+        let m = &self.mesh;
+        (m.fo.len() + m.fv.len() + m.fs.len() + m.vs.len() + m.nfaces.len()) * 4
+            + m.fe.len()
+            + m.corner.len()
+            + self.children.len() * 64
+    }
+}
+
+/// The interned shapes of one evaluator (thread-safe; cloned with the evaluator).
+#[derive(Debug, Default)]
+pub(super) struct Shapes {
+    map: RwLock<HashMap<Vec<u32>, Arc<Shape>>>,
+}
+
+impl Clone for Shapes {
+    fn clone(&self) -> Self {
+        Self {
+            map: RwLock::new(self.map.read().expect("shape table lock").clone()),
+        }
+    }
+}
+
+/// The interning key: every topology array of `mesh` (with lengths) and `t`.
+fn key(mesh: &LocalMesh, t: usize) -> Vec<u32> {
+    let mut k = Vec::with_capacity(4 + mesh.fo.len() + 3 * mesh.fv.len() + 4 * mesh.nv());
+    k.extend([t as u32, mesh.fo.len() as u32, mesh.nv() as u32]);
+    k.extend_from_slice(&mesh.fo);
+    k.extend_from_slice(&mesh.fv);
+    k.extend(mesh.fe.iter().map(|&f| u32::from(f)));
+    k.extend(mesh.fs.iter().map(|s| s.to_bits()));
+    k.extend(mesh.vs.iter().map(|s| s.to_bits()));
+    k.extend_from_slice(&mesh.nfaces);
+    k.extend(mesh.corner.iter().map(|&c| u32::from(c)));
+    k
+}
+
+impl Shapes {
+    /// The shape of `(mesh, t)`, interned, and the heap bytes it added (0 if it was known).
+    pub(super) fn intern(&self, mesh: &LocalMesh, t: usize, scheme: Scheme) -> (Arc<Shape>, usize) {
+        let k = key(mesh, t);
+        if let Some(s) = self.map.read().expect("shape table lock").get(&k) {
+            return (s.clone(), 0);
+        }
+        let shape = Arc::new(Shape::new(mesh, t, scheme));
+        let bytes = k.len() * 4 + shape.heap_bytes();
+        let mut map = self.map.write().expect("shape table lock");
+        let mut added = 0;
+        let s = map
+            .entry(k)
+            .or_insert_with(|| {
+                added = bytes;
+                shape
+            })
+            .clone();
+        (s, added)
+    }
+
+    /// Drops every shape.
+    pub(super) fn clear(&mut self) {
+        self.map.get_mut().expect("shape table lock").clear();
+    }
+}
+
+impl super::Evaluator {
+    /// The step from `shape` to its child `which`, computed on first use (local refinement of
+    /// identity rows, [`Self::refine_local`]); `None` if that refinement fails. Memory is
+    /// counted against the cache budget.
+    pub(super) fn shape_step(&self, shape: &Shape, which: usize) -> Option<Arc<Step>> {
+        shape.kids[which]
+            .get_or_init(|| {
+                let nv = shape.mesh.nv();
+                let mut ident = LocalMesh {
+                    cols: (0..nv as u32).collect(),
+                    rows: vec![0.0; nv * nv],
+                    ..shape.mesh.clone()
+                };
+                for i in 0..nv {
+                    ident.rows[i * nv + i] = 1.0;
+                }
+                let (child, c, _) = self.refine_local(&ident, shape.t, which)?;
+                let (mut off, mut idx, mut w) = (vec![0u32], Vec::new(), Vec::new());
+                for i in 0..child.nv() {
+                    for (j, &x) in child.row(i as u32).iter().enumerate() {
+                        if x != 0.0 {
+                            idx.push(j as u32);
+                            w.push(x);
+                        }
+                    }
+                    off.push(idx.len() as u32);
+                }
+                let (child, bytes) = self.shapes.intern(&child, c, self.options.scheme);
+                let step = Step { child, off, idx, w };
+                self.memo.add_bytes(bytes + step.heap_bytes());
+                Some(Arc::new(step))
+            })
+            .clone()
+    }
+
+    /// The dense `npts × K` rows of the regular patch `combos` of the last shape of `chain`
+    /// (or of `rows`' own neighbourhood if `chain` is empty) over the columns of `rows`:
+    /// `C · S_d ⋯ S_1 · R`. `rows` is `nv_0 × K`.
+    pub(super) fn chain_patch(
+        rows: &LocalMesh,
+        chain: &[Arc<Step>],
+        last: &Shape,
+        combos: &[Combo],
+    ) -> Vec<f64> {
+        let npts = combos.len();
+        let mut nv = last.mesh.nv();
+        let mut p = vec![0.0; npts * nv];
+        for (i, c) in combos.iter().enumerate() {
+            for &(v, w) in &c.terms[..c.n as usize] {
+                p[i * nv + v as usize] += w;
+            }
+        }
+        for (s, parent_nv) in chain.iter().rev().zip(
+            chain
+                .iter()
+                .rev()
+                .skip(1)
+                .map(|s| s.child.mesh.nv())
+                .chain([rows.nv()]),
+        ) {
+            let mut q = vec![0.0; npts * parent_nv];
+            for i in 0..npts {
+                let (pi, qi) = (&p[i * nv..(i + 1) * nv], &mut q[i * parent_nv..]);
+                for (j, &x) in pi.iter().enumerate() {
+                    if x != 0.0 {
+                        for (l, w) in s.row(j) {
+                            qi[l] += x * w;
+                        }
+                    }
+                }
+            }
+            p = q;
+            nv = parent_nv;
+        }
+        let k = rows.k();
+        let mut dense = vec![0.0; npts * k];
+        for i in 0..npts {
+            let out = &mut dense[i * k..(i + 1) * k];
+            for (j, &x) in p[i * nv..(i + 1) * nv].iter().enumerate() {
+                if x != 0.0 {
+                    for (o, r) in out.iter_mut().zip(rows.row(j as u32)) {
+                        *o += x * r;
+                    }
+                }
+            }
+        }
+        dense
+    }
+
+    /// The neighbourhood at the end of `chain` with rows over `rows`' columns (forward
+    /// application of the steps), for the rare cases the shape walk does not finish itself.
+    pub(super) fn chain_mesh(rows: &LocalMesh, chain: &[Arc<Step>]) -> LocalMesh {
+        let mut cur = rows.clone();
+        let k = rows.k();
+        for s in chain {
+            let nc = s.child.mesh.nv();
+            let mut next = vec![0.0; nc * k];
+            for i in 0..nc {
+                let out = &mut next[i * k..(i + 1) * k];
+                for (j, w) in s.row(i) {
+                    for (o, r) in out.iter_mut().zip(cur.row(j as u32)) {
+                        *o += w * r;
+                    }
+                }
+            }
+            cur = LocalMesh {
+                cols: rows.cols.clone(),
+                rows: next,
+                ..s.child.mesh.clone()
+            };
+        }
+        cur
+    }
+}
