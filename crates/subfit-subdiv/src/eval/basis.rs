@@ -82,14 +82,7 @@ impl PatchCoef {
         a: [[f64; 2]; 2],
         depth: u32,
     ) -> EvalWeights {
-        // A 12-point patch is Loop's box spline (a triangle), a 16-point one the bicubic
-        // B-spline, whatever the mesh's scheme (the quad/triangle scheme has both).
-        let patch = if self.npts == 12 {
-            Scheme::Loop
-        } else {
-            scheme
-        };
-        let (np, [p, du, dv, duu, duv, dvv]) = basis(patch, u, v);
+        let (np, vals) = chain_basis(self.npts, scheme, u, v, a);
         let n = self.cols.len();
         let mut out = [
             vec![0.0; n],
@@ -99,26 +92,9 @@ impl PatchCoef {
             vec![0.0; n],
             vec![0.0; n],
         ];
-        // Chain rule: ∂f/∂x_j = Σ_i a[i][j] ∂f/∂c_i; H_x = aᵀ H_c a.
-        for i in 0..np {
-            let (gu, gv) = (du[i], dv[i]);
-            let hx = [[duu[i], duv[i]], [duv[i], dvv[i]]];
-            let g = [a[0][0] * gu + a[1][0] * gv, a[0][1] * gu + a[1][1] * gv];
-            let mut h = [[0.0; 2]; 2];
-            for (j, hj) in h.iter_mut().enumerate() {
-                for (l, hjl) in hj.iter_mut().enumerate() {
-                    let mut s = 0.0;
-                    for (r, hr) in hx.iter().enumerate() {
-                        for (c, hrc) in hr.iter().enumerate() {
-                            s += a[r][j] * hrc * a[c][l];
-                        }
-                    }
-                    *hjl = s;
-                }
-            }
-            let vals = [p[i], g[0], g[1], h[0][0], h[0][1], h[1][1]];
+        for (i, vals) in vals.iter().enumerate().take(np) {
             let row = &self.coef[i * n..(i + 1) * n];
-            for (o, &val) in out.iter_mut().zip(&vals) {
+            for (o, &val) in out.iter_mut().zip(vals) {
                 if val != 0.0 {
                     for (x, &r) in o.iter_mut().zip(row) {
                         *x += val * r;
@@ -126,17 +102,60 @@ impl PatchCoef {
                 }
             }
         }
-        let [position, du, dv, duu, duv, dvv] = out;
-        EvalWeights {
-            indices: self.cols.clone(),
-            position,
-            du,
-            dv,
-            second: Some([duu, duv, dvv]),
-            kind: EvalKind::Patch,
-            depth,
-        }
+        patch_weights(self.cols.clone(), out, depth)
     }
+}
+
+/// The weights of a patch evaluation from its six rows (position, ∂u, ∂v, ∂uu, ∂uv, ∂vv) over
+/// control points `indices`.
+pub(super) fn patch_weights(indices: Vec<u32>, out: [Vec<f64>; 6], depth: u32) -> EvalWeights {
+    let [position, du, dv, duu, duv, dvv] = out;
+    EvalWeights {
+        indices,
+        position,
+        du,
+        dv,
+        second: Some([duu, duv, dvv]),
+        kind: EvalKind::Patch,
+        depth,
+    }
+}
+
+/// The regular patch basis of an `npts`-point patch at child parameters `(u, v)`, chained to
+/// the original parameters by `a` = ∂(child)/∂(original): per patch point, its weight in the
+/// position, ∂u, ∂v, ∂uu, ∂uv and ∂vv. Returns the number of points and the rows.
+pub(super) fn chain_basis(
+    npts: usize,
+    scheme: Scheme,
+    u: f64,
+    v: f64,
+    a: [[f64; 2]; 2],
+) -> (usize, [[f64; 6]; 16]) {
+    // A 12-point patch is Loop's box spline (a triangle), a 16-point one the bicubic
+    // B-spline, whatever the mesh's scheme (the quad/triangle scheme has both).
+    let patch = if npts == 12 { Scheme::Loop } else { scheme };
+    let (np, [p, du, dv, duu, duv, dvv]) = basis(patch, u, v);
+    let mut out = [[0.0; 6]; 16];
+    // Chain rule: ∂f/∂x_j = Σ_i a[i][j] ∂f/∂c_i; H_x = aᵀ H_c a.
+    for (i, o) in out.iter_mut().enumerate().take(np) {
+        let (gu, gv) = (du[i], dv[i]);
+        let hx = [[duu[i], duv[i]], [duv[i], dvv[i]]];
+        let g = [a[0][0] * gu + a[1][0] * gv, a[0][1] * gu + a[1][1] * gv];
+        let mut h = [[0.0; 2]; 2];
+        for (j, hj) in h.iter_mut().enumerate() {
+            for (l, hjl) in hj.iter_mut().enumerate() {
+                let mut s = 0.0;
+                for (r, hr) in hx.iter().enumerate() {
+                    for (c, hrc) in hr.iter().enumerate() {
+                        s += a[r][j] * hrc * a[c][l];
+                    }
+                }
+                *hjl = s;
+            }
+        }
+        *o = [p[i], g[0], g[1], h[0][0], h[0][1], h[1][1]];
+    }
+    (np, out)
 }
 
 pub(super) fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {

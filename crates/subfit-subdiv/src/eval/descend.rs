@@ -6,7 +6,7 @@
 //! refinement of the rows themselves, reusing one local subdivision matrix once the
 //! neighbourhood is self-similar.
 
-use super::basis::{best_child, child_local, mul2, PatchCoef};
+use super::basis::{best_child, chain_basis, child_local, mul2, PatchCoef};
 use super::shape::Shape;
 use super::types::{EvalError, EvalKind, EvalWeights};
 use super::Evaluator;
@@ -63,10 +63,8 @@ impl Evaluator {
         };
         loop {
             if let Some(c) = &cur.patch {
-                let dense = Self::chain_patch(mesh, &chain, &cur, c);
-                return Ok(
-                    PatchCoef::from_dense(&mesh.cols, &dense, c.len()).eval(scheme, u, v, a, depth)
-                );
+                let (_, vals) = chain_basis(c.len(), scheme, u, v, a);
+                return Ok(Self::chain_eval(mesh, &chain, &cur, c, &vals, depth));
             }
             let limit_ok = scheme == Scheme::Loop || depth >= 1;
             if limit_ok && (depth >= MAX_DEPTH || self.vertex_limit_at(&cur, u, v)) {

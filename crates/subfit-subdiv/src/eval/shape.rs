@@ -14,6 +14,8 @@
 //! neighbourhood the walk started from): O(16 · nnz(S)) per level instead of one local
 //! refinement.
 
+use super::basis::patch_weights;
+use super::types::EvalWeights;
 use crate::local::{children, regular_patch, ChildFace, Combo, LocalMesh};
 use crate::scheme::Scheme;
 use std::collections::HashMap;
@@ -189,38 +191,41 @@ impl super::Evaluator {
             .clone()
     }
 
-    /// The dense `npts × K` rows of the regular patch `combos` of the last shape of `chain`
-    /// (or of `rows`' own neighbourhood if `chain` is empty) over the columns of `rows`:
-    /// `C · S_d ⋯ S_1 · R`. `rows` is `nv_0 × K`.
-    pub(super) fn chain_patch(
+    /// The evaluation at the end of `chain`: `vals` (per point of the regular patch `combos`
+    /// of `last`, its six weights from [`chain_basis`](super::basis::chain_basis)) pulled back
+    /// through the steps onto the control points of `rows` (`nv_0 × K`):
+    /// `valsᵀ · C · S_d ⋯ S_1 · R`, six rows instead of the patch's 16 all the way down.
+    /// Keeps the columns with a nonzero weight, by ascending control-point id.
+    pub(super) fn chain_eval(
         rows: &LocalMesh,
         chain: &[Arc<Step>],
         last: &Shape,
         combos: &[Combo],
-    ) -> Vec<f64> {
-        let npts = combos.len();
+        vals: &[[f64; 6]; 16],
+        depth: u32,
+    ) -> EvalWeights {
         let mut nv = last.mesh.nv();
-        let mut p = vec![0.0; npts * nv];
-        for (i, c) in combos.iter().enumerate() {
+        let mut p = vec![0.0; 6 * nv];
+        for (c, val) in combos.iter().zip(vals) {
             for &(v, w) in &c.terms[..c.n as usize] {
-                p[i * nv + v as usize] += w;
+                for (o, &x) in val.iter().enumerate() {
+                    p[o * nv + v as usize] += x * w;
+                }
             }
         }
-        for (s, parent_nv) in chain.iter().rev().zip(
-            chain
-                .iter()
-                .rev()
-                .skip(1)
-                .map(|s| s.child.mesh.nv())
-                .chain([rows.nv()]),
-        ) {
-            let mut q = vec![0.0; npts * parent_nv];
-            for i in 0..npts {
-                let (pi, qi) = (&p[i * nv..(i + 1) * nv], &mut q[i * parent_nv..]);
-                for (j, &x) in pi.iter().enumerate() {
+        let parents = chain
+            .iter()
+            .rev()
+            .skip(1)
+            .map(|s| s.child.mesh.nv())
+            .chain([rows.nv()]);
+        for (s, parent_nv) in chain.iter().rev().zip(parents) {
+            let mut q = vec![0.0; 6 * parent_nv];
+            for (po, qo) in p.chunks_exact(nv).zip(q.chunks_exact_mut(parent_nv)) {
+                for (j, &x) in po.iter().enumerate() {
                     if x != 0.0 {
                         for (l, w) in s.row(j) {
-                            qi[l] += x * w;
+                            qo[l] += x * w;
                         }
                     }
                 }
@@ -229,10 +234,9 @@ impl super::Evaluator {
             nv = parent_nv;
         }
         let k = rows.k();
-        let mut dense = vec![0.0; npts * k];
-        for i in 0..npts {
-            let out = &mut dense[i * k..(i + 1) * k];
-            for (j, &x) in p[i * nv..(i + 1) * nv].iter().enumerate() {
+        let mut dense = vec![0.0; 6 * k];
+        for (po, out) in p.chunks_exact(nv).zip(dense.chunks_exact_mut(k)) {
+            for (j, &x) in po.iter().enumerate() {
                 if x != 0.0 {
                     for (o, r) in out.iter_mut().zip(rows.row(j as u32)) {
                         *o += x * r;
@@ -240,7 +244,18 @@ impl super::Evaluator {
                 }
             }
         }
-        dense
+        let mut order: Vec<usize> = (0..k)
+            .filter(|&j| (0..6).any(|o| dense[o * k + j] != 0.0))
+            .collect();
+        order.sort_by_key(|&j| rows.cols[j]);
+        let pick = |o: usize| {
+            order
+                .iter()
+                .map(|&j| dense[o * k + j])
+                .collect::<Vec<f64>>()
+        };
+        let out = std::array::from_fn(pick);
+        patch_weights(order.iter().map(|&j| rows.cols[j]).collect(), out, depth)
     }
 
     /// The neighbourhood at the end of `chain` with rows over `rows`' columns (forward
