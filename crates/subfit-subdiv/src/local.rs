@@ -317,7 +317,6 @@ impl LocalMesh {
 
 /// The parameters of a child face's corners in its parent's parameter domain, and the child
 /// vertex each corner is, for the children of one parent face in [`crate::refine`]'s order.
-#[derive(Clone, Debug)]
 pub(crate) struct ChildFace {
     /// Child vertex kinds of the corners.
     pub verts: Vec<ChildVertex>,

@@ -171,36 +171,77 @@ pub(super) fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
     ]
 }
 
+/// The affine map from a parent face's parameters to a child's, precomputed from the child's
+/// corner parameters (triangle: affine on corners 0, 1, 2; quad: on corners 0, 1, 3).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct ChildMap {
+    p0: [f64; 2],
+    /// ∂(child)/∂(parent).
+    inv: [[f64; 2]; 2],
+    tri: bool,
+}
+
+impl ChildMap {
+    pub(super) fn new(params: &[[f64; 2]]) -> Self {
+        let p0 = params[0];
+        let e1 = [params[1][0] - p0[0], params[1][1] - p0[1]];
+        let tri = params.len() == 3;
+        let q = if tri { params[2] } else { params[3] };
+        let e2 = [q[0] - p0[0], q[1] - p0[1]];
+        // parent = p0 + s e1 + t e2 ⇒ (s, t) = M⁻¹ (parent − p0), M = [e1 e2].
+        let det = e1[0] * e2[1] - e2[0] * e1[1];
+        let inv = [[e2[1] / det, -e2[0] / det], [-e1[1] / det, e1[0] / det]];
+        Self { p0, inv, tri }
+    }
+
+    /// Local parameters of parent point `(u, v)` in the child, and ∂(child)/∂(parent).
+    pub(super) fn local(&self, u: f64, v: f64) -> (f64, f64, [[f64; 2]; 2]) {
+        let (inv, p0) = (self.inv, self.p0);
+        let (du, dv) = (u - p0[0], v - p0[1]);
+        let s = inv[0][0] * du + inv[0][1] * dv;
+        let t = inv[1][0] * du + inv[1][1] * dv;
+        (s, t, inv)
+    }
+
+    /// How far inside the child's domain `(u, v)` is (its smallest barycentric or box margin).
+    fn margin(&self, u: f64, v: f64) -> f64 {
+        let (s, t, _) = self.local(u, v);
+        if self.tri {
+            s.min(t).min(1.0 - s - t)
+        } else {
+            s.min(t).min(1.0 - s).min(1.0 - t)
+        }
+    }
+}
+
+/// The maps of children `ch` (triangles and quads; empty for `n`-gon sub-patches).
+pub(super) fn child_maps(ch: &[ChildFace]) -> Vec<ChildMap> {
+    ch.iter()
+        .filter(|c| c.params.len() >= 3)
+        .map(|c| ChildMap::new(&c.params))
+        .collect()
+}
+
 /// Local parameters of parent point `(u, v)` in a child with corner parameters `params`
 /// (triangle: affine on corners 0, 1, 2; quad: on corners 0, 1, 3), and ∂(child)/∂(parent).
 pub(super) fn child_local(params: &[[f64; 2]], u: f64, v: f64) -> (f64, f64, [[f64; 2]; 2]) {
-    let p0 = params[0];
-    let e1 = [params[1][0] - p0[0], params[1][1] - p0[1]];
-    let q = if params.len() == 3 {
-        params[2]
-    } else {
-        params[3]
-    };
-    let e2 = [q[0] - p0[0], q[1] - p0[1]];
-    // parent = p0 + s e1 + t e2 ⇒ (s, t) = M⁻¹ (parent − p0), M = [e1 e2].
-    let det = e1[0] * e2[1] - e2[0] * e1[1];
-    let inv = [[e2[1] / det, -e2[0] / det], [-e1[1] / det, e1[0] / det]];
-    let (du, dv) = (u - p0[0], v - p0[1]);
-    let s = inv[0][0] * du + inv[0][1] * dv;
-    let t = inv[1][0] * du + inv[1][1] * dv;
-    (s, t, inv)
+    ChildMap::new(params).local(u, v)
 }
 
 /// The child whose domain contains `(u, v)` best (largest minimum barycentric / box margin).
 pub(super) fn best_child(ch: &[ChildFace], u: f64, v: f64) -> usize {
+    best_of(ch.iter().map(|c| ChildMap::new(&c.params)), u, v)
+}
+
+/// [`best_child`] from precomputed maps.
+pub(super) fn best_map(maps: &[ChildMap], u: f64, v: f64) -> usize {
+    best_of(maps.iter().copied(), u, v)
+}
+
+fn best_of(maps: impl Iterator<Item = ChildMap>, u: f64, v: f64) -> usize {
     let mut best = (f64::NEG_INFINITY, 0);
-    for (i, c) in ch.iter().enumerate() {
-        let (s, t, _) = child_local(&c.params, u, v);
-        let margin = if c.params.len() == 3 {
-            s.min(t).min(1.0 - s - t)
-        } else {
-            s.min(t).min(1.0 - s).min(1.0 - t)
-        };
+    for (i, m) in maps.enumerate() {
+        let margin = m.margin(u, v);
         if margin > best.0 {
             best = (margin, i);
         }

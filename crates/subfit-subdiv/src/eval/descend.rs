@@ -6,7 +6,7 @@
 //! refinement of the rows themselves, reusing one local subdivision matrix once the
 //! neighbourhood is self-similar.
 
-use super::basis::{best_child, chain_basis, child_local, mul2, PatchCoef};
+use super::basis::{best_child, best_map, chain_basis, child_local, mul2, PatchCoef};
 use super::shape::Shape;
 use super::types::{EvalError, EvalKind, EvalWeights};
 use super::Evaluator;
@@ -70,7 +70,7 @@ impl Evaluator {
             if limit_ok && (depth >= MAX_DEPTH || self.vertex_limit_at(&cur, u, v)) {
                 return fallback(&chain, &cur, u, v, a, depth);
             }
-            let which = best_child(&cur.children, u, v);
+            let which = best_map(&cur.maps, u, v);
             let step = match cur.step(which) {
                 Some(s) => s.clone(),
                 None if self.memo.full() => return fallback(&chain, &cur, u, v, a, depth),
@@ -79,7 +79,7 @@ impl Evaluator {
             let Some(step) = step else {
                 return fallback(&chain, &cur, u, v, a, depth);
             };
-            let (cu, cv, ca) = child_local(&cur.children[which].params, u, v);
+            let (cu, cv, ca) = cur.maps[which].local(u, v);
             u = cu;
             v = cv;
             a = mul2(ca, a);

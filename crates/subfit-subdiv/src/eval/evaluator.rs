@@ -1,7 +1,7 @@
 //! [`Evaluator`]: construction (validation, regular level-0 patches), the walk down each patch's
 //! memoised refinement tree, and single and batch evaluation.
 
-use super::basis::{best_child, child_local, mul2, PatchCoef};
+use super::basis::{best_map, mul2, PatchCoef};
 use super::memo::{make_node, MemoBudget, Node, CACHE_DEPTH, DEFAULT_CACHE_BYTES};
 use super::shape::Shapes;
 use super::types::{EvalError, EvalWeights, SurfaceParam, SurfacePoint};
@@ -440,8 +440,9 @@ impl Evaluator {
                     mesh,
                     t,
                     kids,
-                    children: ch,
+                    maps,
                     shape,
+                    ..
                 } => {
                     let at = (*t, u, v, a, depth, p.face);
                     if self.irregular_corner(mesh, *t, u, v) {
@@ -450,12 +451,12 @@ impl Evaluator {
                     if depth >= self.cache_depth {
                         return self.descend(mesh, Some(shape), at);
                     }
-                    let which = best_child(ch, u, v);
+                    let which = best_map(maps, u, v);
                     if kids[which].get().is_none() && self.memo.full() {
                         // Over the memory budget: refine from here without memoising.
                         return self.descend(mesh, Some(shape), at);
                     }
-                    let (cu, cv, ca) = child_local(&ch[which].params, u, v);
+                    let (cu, cv, ca) = maps[which].local(u, v);
                     node = kids[which].get_or_init(|| {
                         let n = self
                             .refine_local(mesh, *t, which)

@@ -1,9 +1,9 @@
 //! The memoised local-refinement tree of each patch: the first [`CACHE_DEPTH`] levels of local
 //! refinement around irregular vertices are kept, within a memory budget.
 
-use super::basis::PatchCoef;
+use super::basis::{child_maps, ChildMap, PatchCoef};
 use super::shape::Shape;
-use crate::local::{children, regular_patch, ChildFace, LocalMesh};
+use crate::local::{children, regular_patch, LocalMesh};
 use crate::scheme::Scheme;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -58,9 +58,9 @@ pub(super) enum Node {
         mesh: Box<LocalMesh>,
         t: usize,
         kids: Box<[OnceLock<Node>; 4]>,
-        /// The children of face `t` (order of [`children`]), kept so that walking the tree
-        /// does not recompute them.
-        children: Vec<ChildFace>,
+        /// The parameter maps of the children of face `t` (order of [`children`]), kept so
+        /// that walking the tree does not recompute them.
+        maps: Vec<ChildMap>,
         /// The interned topology of `mesh`, for the walk below the memoised levels.
         shape: OnceLock<Arc<Shape>>,
     },
@@ -74,15 +74,14 @@ impl Node {
         use std::mem::size_of;
         match self {
             Node::Regular(pc) => pc.cols.len() * 4 + pc.coef.len() * 8,
-            Node::Irregular { mesh, children, .. } => {
+            Node::Irregular { mesh, maps, .. } => {
                 mesh.cols.len() * 4
                     + mesh.rows.len() * 8
                     + (mesh.fo.len() + mesh.fv.len() + mesh.nfaces.len()) * 4
                     + mesh.fe.len()
                     + (mesh.fs.len() + mesh.vs.len()) * 4
                     + mesh.corner.len()
-                    + children.len() * size_of::<ChildFace>()
-                    + children.iter().map(|c| c.verts.len()).sum::<usize>() * 32
+                    + maps.len() * size_of::<ChildMap>()
                     + size_of::<[OnceLock<Node>; 4]>()
             }
             Node::Failed => 0,
@@ -101,7 +100,7 @@ pub(super) fn make_node(mut mesh: LocalMesh, t: usize, scheme: Scheme) -> Node {
         None => Node::Irregular {
             t,
             kids: Box::new(std::array::from_fn(|_| OnceLock::new())),
-            children: children(&mesh, scheme, t),
+            maps: child_maps(&children(&mesh, scheme, t)),
             shape: OnceLock::new(),
             mesh: Box::new(mesh),
         },

@@ -6,7 +6,7 @@
 //! quad/triangle seam (Stam & Loop 2003, §3), where patches are never regular at any level and
 //! every point near a seam descends `log2(1 / distance)` levels: a handful of seam topologies
 //! recur along every seam. So the topology of each local neighbourhood is interned once per
-//! [`Evaluator`](super::Evaluator) (with its regular patch, if any, and its children), each
+//! [`Evaluator`](super::Evaluator) (with its regular patch, if any, and its children's parameter maps), each
 //! refinement step from a shape to a child is computed once (by local refinement of identity
 //! rows) and kept as a sparse matrix, and a query only walks the shapes and multiplies the step
 //! matrices into the final patch from the patch side,
@@ -14,9 +14,9 @@
 //! neighbourhood the walk started from): O(16 · nnz(S)) per level instead of one local
 //! refinement.
 
-use super::basis::patch_weights;
+use super::basis::{child_maps, patch_weights, ChildMap};
 use super::types::EvalWeights;
-use crate::local::{children, regular_patch, ChildFace, Combo, LocalMesh};
+use crate::local::{children, regular_patch, Combo, LocalMesh};
 use crate::scheme::Scheme;
 use std::collections::HashMap;
 use std::sync::{Arc, OnceLock, RwLock};
@@ -31,8 +31,8 @@ pub(super) struct Shape {
     pub(super) t: usize,
     /// The regular patch's control points of face `t`, if it is regular.
     pub(super) patch: Option<Vec<Combo>>,
-    /// The children of face `t` (order of [`children`]).
-    pub(super) children: Vec<ChildFace>,
+    /// The parameter maps of the children of face `t` (order of [`children`]).
+    pub(super) maps: Vec<ChildMap>,
     /// Per child: the refinement step to its neighbourhood (`None`: local refinement failed).
     kids: Vec<OnceLock<Option<Arc<Step>>>>,
 }
@@ -75,13 +75,13 @@ impl Shape {
         };
         let adj = mesh.adjacency();
         let patch = regular_patch(&mesh, &adj, scheme, t);
-        let children = children(&mesh, scheme, t);
-        let kids = (0..children.len()).map(|_| OnceLock::new()).collect();
+        let maps = child_maps(&children(&mesh, scheme, t));
+        let kids = (0..maps.len()).map(|_| OnceLock::new()).collect();
         Self {
             mesh,
             t,
             patch,
-            children,
+            maps,
             kids,
         }
     }
@@ -97,7 +97,7 @@ impl Shape {
         (m.fo.len() + m.fv.len() + m.fs.len() + m.vs.len() + m.nfaces.len()) * 4
             + m.fe.len()
             + m.corner.len()
-            + self.children.len() * 64
+            + self.maps.len() * std::mem::size_of::<ChildMap>()
     }
 }
 
