@@ -1,18 +1,19 @@
 //! Interned local topologies ("shapes") below the memoised levels, and each local refinement
 //! step between them as a sparse matrix over the parent's local vertices.
 //!
-//! Stam 1998, §3–4: near an irregular vertex the two-ring's topology repeats from level to
-//! level, so one local subdivision matrix serves every level. The same holds along a
-//! quad/triangle seam (Stam & Loop 2003, §3), where patches are never regular at any level and
-//! every point near a seam descends `log2(1 / distance)` levels: a handful of seam topologies
-//! recur along every seam. So the topology of each local neighbourhood is interned once per
-//! [`Evaluator`](super::Evaluator) (with its regular patch, if any, and its children's parameter maps), each
-//! refinement step from a shape to a child is computed once (by local refinement of identity
-//! rows) and kept as a sparse matrix, and a query only walks the shapes and multiplies the step
-//! matrices into the final patch from the patch side,
-//! `C · S_d ⋯ S_1 · R` (`C` the regular patch's control points, `R` the rows of the
-//! neighbourhood the walk started from): O(16 · nnz(S)) per level instead of one local
-//! refinement.
+//! Stam 1998 (*Exact evaluation of Catmull-Clark subdivision surfaces at arbitrary parameter
+//! values*): near an irregular vertex the two-ring's topology repeats from level to level, so
+//! one local subdivision matrix serves every level. The same holds along a quad/triangle seam
+//! (Stam & Loop 2003, *Quad/triangle subdivision*), where patches are never regular at any
+//! level and every point near a seam descends `log2(1 / distance)` levels: a handful of seam
+//! topologies recur along every seam. So the topology of each local neighbourhood is interned
+//! once per [`Evaluator`](super::Evaluator) (with its regular patch, if any, and its children's
+//! parameter maps), each refinement step from a shape to a child is computed once (by local
+//! refinement of identity rows) and kept as a sparse matrix, and a query only walks the shapes
+//! and pulls the six evaluation rows (position, two first and three second derivatives) back
+//! through the steps: `valsᵀ · C · S_d ⋯ S_1 · R` (`C` the regular patch's control points, `R`
+//! the rows of the neighbourhood the walk started from), O(6 · nnz(S)) per level instead of
+//! one local refinement.
 
 use super::basis::{child_maps, patch_weights, ChildMap};
 use super::types::EvalWeights;
