@@ -7,7 +7,7 @@
 //! neighbourhood is self-similar.
 
 use super::basis::{best_child, best_map, chain_basis, child_local, mul2, PatchCoef};
-use super::shape::Shape;
+use super::shape::{Shape, Step as ShapeStep};
 use super::types::{EvalError, EvalKind, EvalWeights};
 use super::Evaluator;
 use crate::local::{
@@ -45,46 +45,52 @@ impl Evaluator {
             self.memo.add_bytes(bytes);
             s
         };
-        let first = match shape.and_then(OnceLock::get) {
-            Some(s) => s.clone(),
+        // Shapes and steps are borrowed, not reference-counted, on the way down: they live
+        // as long as `self` (and `owned`), and atomic counts would contend between threads.
+        let owned: Arc<Shape>;
+        let first: &Shape = match shape.and_then(OnceLock::get) {
+            Some(s) => s,
             None if self.memo.full() => {
                 return self.descend_rows(mesh.clone(), t, u, v, a, depth, face)
             }
             None => match shape {
-                Some(cell) => cell.get_or_init(intern).clone(),
-                None => intern(),
+                Some(cell) => cell.get_or_init(intern),
+                None => {
+                    owned = intern();
+                    &owned
+                }
             },
         };
         let mut cur = first;
-        let mut chain: Vec<Arc<super::shape::Step>> = Vec::new();
-        let fallback = |chain: &[Arc<super::shape::Step>], cur: &Shape, u, v, a, depth| {
+        let mut chain: Vec<&ShapeStep> = Vec::new();
+        let fallback = |chain: &[&ShapeStep], cur: &Shape, u, v, a, depth| {
             let m = Self::chain_mesh(mesh, chain);
             self.descend_rows(m, cur.t, u, v, a, depth, face)
         };
         loop {
             if let Some(c) = &cur.patch {
                 let (_, vals) = chain_basis(c.len(), scheme, u, v, a);
-                return Ok(Self::chain_eval(mesh, &chain, &cur, c, &vals, depth));
+                return Ok(Self::chain_eval(mesh, &chain, cur, c, &vals, depth));
             }
             let limit_ok = scheme == Scheme::Loop || depth >= 1;
-            if limit_ok && (depth >= MAX_DEPTH || self.vertex_limit_at(&cur, u, v)) {
-                return fallback(&chain, &cur, u, v, a, depth);
+            if limit_ok && (depth >= MAX_DEPTH || self.vertex_limit_at(cur, u, v)) {
+                return fallback(&chain, cur, u, v, a, depth);
             }
             let which = best_map(&cur.maps, u, v);
             let step = match cur.step(which) {
-                Some(s) => s.clone(),
-                None if self.memo.full() => return fallback(&chain, &cur, u, v, a, depth),
-                None => self.shape_step(&cur, which),
+                Some(s) => s.as_deref(),
+                None if self.memo.full() => return fallback(&chain, cur, u, v, a, depth),
+                None => self.shape_step(cur, which),
             };
             let Some(step) = step else {
-                return fallback(&chain, &cur, u, v, a, depth);
+                return fallback(&chain, cur, u, v, a, depth);
             };
             let (cu, cv, ca) = cur.maps[which].local(u, v);
             u = cu;
             v = cv;
             a = mul2(ca, a);
             depth += 1;
-            cur = step.child.clone();
+            cur = &step.child;
             chain.push(step);
         }
     }

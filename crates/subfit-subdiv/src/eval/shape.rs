@@ -161,7 +161,7 @@ impl super::Evaluator {
     /// The step from `shape` to its child `which`, computed on first use (local refinement of
     /// identity rows, [`Self::refine_local`]); `None` if that refinement fails. Memory is
     /// counted against the cache budget.
-    pub(super) fn shape_step(&self, shape: &Shape, which: usize) -> Option<Arc<Step>> {
+    pub(super) fn shape_step<'s>(&self, shape: &'s Shape, which: usize) -> Option<&'s Step> {
         shape.kids[which]
             .get_or_init(|| {
                 let nv = shape.mesh.nv();
@@ -189,7 +189,7 @@ impl super::Evaluator {
                 self.memo.add_bytes(bytes + step.heap_bytes());
                 Some(Arc::new(step))
             })
-            .clone()
+            .as_deref()
     }
 
     /// The evaluation at the end of `chain`: `vals` (per point of the regular patch `combos`
@@ -199,7 +199,7 @@ impl super::Evaluator {
     /// Keeps the columns with a nonzero weight, by ascending control-point id.
     pub(super) fn chain_eval(
         rows: &LocalMesh,
-        chain: &[Arc<Step>],
+        chain: &[&Step],
         last: &Shape,
         combos: &[Combo],
         vals: &[[f64; 6]; 16],
@@ -261,7 +261,7 @@ impl super::Evaluator {
 
     /// The neighbourhood at the end of `chain` with rows over `rows`' columns (forward
     /// application of the steps), for the rare cases the shape walk does not finish itself.
-    pub(super) fn chain_mesh(rows: &LocalMesh, chain: &[Arc<Step>]) -> LocalMesh {
+    pub(super) fn chain_mesh(rows: &LocalMesh, chain: &[&Step]) -> LocalMesh {
         let mut cur = rows.clone();
         let k = rows.k();
         for s in chain {
