@@ -119,12 +119,21 @@ const MONOMIALS: [[i32; 3]; 15] = [
     [0, 0, 4],
 ];
 
-/// `x^k` and its first two derivatives for `k ≤ 4` (0 for negative exponents).
+/// `x^k` and its first two derivatives for `k ≤ 4` (0 for negative exponents), from the
+/// powers `pw = [1, x, x², x³, x⁴]` of [`powers`].
 #[inline]
-fn pow_d(x: f64, k: i32) -> [f64; 3] {
-    let p = |e: i32| if e < 0 { 0.0 } else { x.powi(e) };
+fn pow_d(pw: &[f64; 5], k: i32) -> [f64; 3] {
+    let p = |e: i32| if e < 0 { 0.0 } else { pw[e as usize] };
     let kf = k as f64;
     [p(k), kf * p(k - 1), kf * (kf - 1.0) * p(k - 2)]
+}
+
+/// `[1, x, x², x³, x⁴]`, rounded as `f64::powi` rounds them (`x²·x`, `x²·x²`), without its
+/// library call per power.
+#[inline]
+fn powers(x: f64) -> [f64; 5] {
+    let x2 = x * x;
+    [1.0, x, x2, x2 * x, x2 * x2]
 }
 
 /// The quartic box-spline basis of the regular Loop patch at barycentric parameters `(u, v)`.
@@ -138,8 +147,9 @@ pub fn loop_box_spline(u: f64, v: f64) -> PatchBasis<LOOP_PATCH_POINTS> {
     // For each monomial: value and partials in (w0, w1, w2), then chain rule with
     // ∂/∂u = ∂/∂w1 − ∂/∂w0 and ∂/∂v = ∂/∂w2 − ∂/∂w0.
     let mut m = [[0.0f64; 6]; 15];
+    let (p0, p1, p2) = (powers(w0), powers(u), powers(v));
     for (k, e) in MONOMIALS.iter().enumerate() {
-        let (a, b, c) = (pow_d(w0, e[0]), pow_d(u, e[1]), pow_d(v, e[2]));
+        let (a, b, c) = (pow_d(&p0, e[0]), pow_d(&p1, e[1]), pow_d(&p2, e[2]));
         let f = a[0] * b[0] * c[0];
         let f0 = a[1] * b[0] * c[0];
         let f1 = a[0] * b[1] * c[0];
@@ -362,6 +372,27 @@ mod tests {
                 .position(|&p| p == [1 - a - c, a])
                 .unwrap();
             assert!((b.point[i] - r.point[j]).abs() < 1e-15, "{i} -> {j}");
+        }
+    }
+
+    #[test]
+    fn power_table_rounds_as_powi() {
+        for x in [
+            0.0,
+            1.0,
+            0.3,
+            1.0 / 3.0,
+            0.999_999_9,
+            1e-9,
+            0.123_456_789,
+            -0.7,
+        ] {
+            // Runtime values: the compiler may fold `powi` of constants differently.
+            let x = std::hint::black_box(x);
+            for (e, &p) in powers(x).iter().enumerate() {
+                let e = std::hint::black_box(e as i32);
+                assert_eq!(p.to_bits(), x.powi(e).to_bits(), "{x}^{e}");
+            }
         }
     }
 }

@@ -1,9 +1,13 @@
 //! Evaluation below the memoised levels: repeated local refinement until the point lies in a
-//! regular patch (Stam 1998), reusing one local subdivision matrix once the neighbourhood is
-//! self-similar, and the limit masks exactly at an irregular vertex (once no finite sharpness is
-//! left around it, [`crate::crease`]).
+//! regular patch (Stam 1998), as a walk through interned shapes whose refinement steps are
+//! cached sparse matrices (module `shape`), and the limit masks exactly at an irregular vertex
+//! (once no finite sharpness is left around it, [`crate::crease`]). Where the walk cannot be
+//! used (memory budget spent, limit at a vertex, a failed refinement), repeated local
+//! refinement of the rows themselves, reusing one local subdivision matrix once the
+//! neighbourhood is self-similar.
 
-use super::basis::{best_child, child_local, mul2, PatchCoef};
+use super::basis::{best_child, best_map, chain_basis, child_local, mul2, PatchCoef};
+use super::shape::{Shape, Step as ShapeStep};
 use super::types::{EvalError, EvalKind, EvalWeights};
 use super::Evaluator;
 use crate::local::{
@@ -12,16 +16,108 @@ use crate::local::{
 };
 use crate::mask::Mask;
 use crate::scheme::Scheme;
+use std::sync::{Arc, OnceLock};
 
 /// Refinement depth after which a point that is still not inside a regular patch is taken to be
 /// at the nearest corner (it is then within `2^-MAX_DEPTH` of it in parameter space).
 pub const MAX_DEPTH: u32 = 60;
 
+/// Where a descent starts: face `t` of the neighbourhood, parameters `(u, v)` on it, Jacobian
+/// `a` = ∂(parameters)/∂(original parameters), refinement `depth`, and the control face (for
+/// errors).
+pub(super) type Start = (usize, f64, f64, [[f64; 2]; 2], u32, u32);
+
 impl Evaluator {
+    /// Evaluation below the memoised levels from `mesh` (rows over control points): walks the
+    /// interned shapes (`shape` caches the one of `mesh`, if given) and multiplies the cached
+    /// step matrices into the regular patch at the end; falls back to [`Self::descend_rows`]
+    /// where the walk cannot be used. Cost per level O(16 · nnz(step)) once the shapes and
+    /// steps on the way are known, plus one O(16 · nv · K) product at the end.
+    pub(super) fn descend(
+        &self,
+        mesh: &LocalMesh,
+        shape: Option<&OnceLock<Arc<Shape>>>,
+        (t, mut u, mut v, mut a, mut depth, face): Start,
+    ) -> Result<EvalWeights, EvalError> {
+        let scheme = self.options.scheme;
+        let intern = || {
+            let (s, bytes) = self.shapes.intern(mesh, t, scheme);
+            self.memo.add_bytes(bytes);
+            s
+        };
+        // Shapes and steps are borrowed, not reference-counted, on the way down: they live
+        // as long as `self` (and `owned`), and atomic counts would contend between threads.
+        let owned: Arc<Shape>;
+        let first: &Shape = match shape.and_then(OnceLock::get) {
+            Some(s) => s,
+            None if self.memo.full() => {
+                return self.descend_rows(mesh.clone(), t, u, v, a, depth, face)
+            }
+            None => match shape {
+                Some(cell) => cell.get_or_init(intern),
+                None => {
+                    owned = intern();
+                    &owned
+                }
+            },
+        };
+        let mut cur = first;
+        let mut chain: Vec<&ShapeStep> = Vec::new();
+        let fallback = |chain: &[&ShapeStep], cur: &Shape, u, v, a, depth| {
+            let m = Self::chain_mesh(mesh, chain);
+            self.descend_rows(m, cur.t, u, v, a, depth, face)
+        };
+        loop {
+            if let Some(c) = &cur.patch {
+                let (_, vals) = chain_basis(c.len(), scheme, u, v, a);
+                return Ok(Self::chain_eval(mesh, &chain, cur, c, &vals, depth));
+            }
+            let limit_ok = scheme == Scheme::Loop || depth >= 1;
+            if limit_ok && (depth >= MAX_DEPTH || self.vertex_limit_at(cur, u, v)) {
+                return fallback(&chain, cur, u, v, a, depth);
+            }
+            let which = best_map(&cur.maps, u, v);
+            let step = match cur.step(which) {
+                Some(s) => s.as_deref(),
+                None if self.memo.full() => return fallback(&chain, cur, u, v, a, depth),
+                None => self.shape_step(cur, which),
+            };
+            let Some(step) = step else {
+                return fallback(&chain, cur, u, v, a, depth);
+            };
+            let (cu, cv, ca) = cur.maps[which].local(u, v);
+            u = cu;
+            v = cv;
+            a = mul2(ca, a);
+            depth += 1;
+            cur = &step.child;
+            chain.push(step);
+        }
+    }
+
+    /// Whether [`Self::descend_rows`] would take the limit at a vertex for `(u, v)` on `shape`:
+    /// `(u, v)` is exactly a corner whose vertex is irregular and has no finite sharpness left.
+    fn vertex_limit_at(&self, shape: &Shape, u: f64, v: f64) -> bool {
+        let (mesh, t) = (&shape.mesh, shape.t);
+        let corners: &[[f64; 2]] = match patch_scheme(self.options.scheme, mesh.face(t).len()) {
+            Scheme::Loop => &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            _ => &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        };
+        let Some(k) = corners.iter().position(|c| c[0] == u && c[1] == v) else {
+            return false;
+        };
+        let adj = mesh.adjacency();
+        let x = mesh.face(t)[k];
+        let settled = mesh
+            .ring(&adj, x)
+            .is_some_and(|r| !mesh.semi_sharp_at(x, &r));
+        settled && !corner_points(mesh, &adj, self.options.scheme, t, k, &mut |_, _| {})
+    }
+
     /// Evaluation by repeated local refinement from `mesh` (face `t`, parameters `(u, v)`,
     /// Jacobian `a` to the original parameters, at refinement `depth`), without memoisation.
     #[allow(clippy::too_many_arguments, reason = "the state of the descent")]
-    pub(super) fn descend(
+    pub(super) fn descend_rows(
         &self,
         mut mesh: LocalMesh,
         mut t: usize,

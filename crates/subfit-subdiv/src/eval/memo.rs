@@ -1,11 +1,12 @@
 //! The memoised local-refinement tree of each patch: the first [`CACHE_DEPTH`] levels of local
 //! refinement around irregular vertices are kept, within a memory budget.
 
-use super::basis::PatchCoef;
-use crate::local::{regular_patch, LocalMesh};
+use super::basis::{child_maps, ChildMap, PatchCoef};
+use super::shape::Shape;
+use crate::local::{children, regular_patch, LocalMesh};
 use crate::scheme::Scheme;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// Default budget of the memoised local refinements of an [`Evaluator`](super::Evaluator): 256 MiB.
 pub const DEFAULT_CACHE_BYTES: usize = 256 << 20;
@@ -33,7 +34,11 @@ impl MemoBudget {
     }
 
     pub(super) fn add(&self, node: &Node) {
-        self.used.fetch_add(node.heap_bytes(), Ordering::Relaxed);
+        self.add_bytes(node.heap_bytes());
+    }
+
+    pub(super) fn add_bytes(&self, bytes: usize) {
+        self.used.fetch_add(bytes, Ordering::Relaxed);
     }
 }
 
@@ -49,9 +54,15 @@ pub(super) enum Node {
     Regular(PatchCoef),
     /// An irregular (sub-)patch: its refined neighbourhood and, lazily, its four children.
     Irregular {
-        mesh: LocalMesh,
+        /// Boxed, so a node (and each of the four child cells) stays small.
+        mesh: Box<LocalMesh>,
         t: usize,
         kids: Box<[OnceLock<Node>; 4]>,
+        /// The parameter maps of the children of face `t` (order of [`children`]), kept so
+        /// that walking the tree does not recompute them.
+        maps: Vec<ChildMap>,
+        /// The interned topology of `mesh`, for the walk below the memoised levels.
+        shape: OnceLock<Arc<Shape>>,
     },
     /// Local refinement failed (a broken invariant, reported as [`EvalError::Incomplete`](super::EvalError::Incomplete)).
     Failed,
@@ -63,13 +74,14 @@ impl Node {
         use std::mem::size_of;
         match self {
             Node::Regular(pc) => pc.cols.len() * 4 + pc.coef.len() * 8,
-            Node::Irregular { mesh, .. } => {
+            Node::Irregular { mesh, maps, .. } => {
                 mesh.cols.len() * 4
                     + mesh.rows.len() * 8
                     + (mesh.fo.len() + mesh.fv.len() + mesh.nfaces.len()) * 4
                     + mesh.fe.len()
                     + (mesh.fs.len() + mesh.vs.len()) * 4
                     + mesh.corner.len()
+                    + maps.len() * size_of::<ChildMap>()
                     + size_of::<[OnceLock<Node>; 4]>()
             }
             Node::Failed => 0,
@@ -78,14 +90,37 @@ impl Node {
 }
 
 /// A tree node for face `t` of `mesh`: regular patch or irregular (to be refined further).
-pub(super) fn make_node(mesh: LocalMesh, t: usize, scheme: Scheme) -> Node {
+/// Columns of `mesh` whose weights are all zero are dropped first (exact: they contribute
+/// nothing), so deep nodes keep only the few control points they depend on.
+pub(super) fn make_node(mut mesh: LocalMesh, t: usize, scheme: Scheme) -> Node {
+    compact(&mut mesh);
     let adj = mesh.adjacency();
     match regular_patch(&mesh, &adj, scheme, t) {
         Some(c) => Node::Regular(PatchCoef::new(&mesh, &c)),
         None => Node::Irregular {
-            mesh,
             t,
             kids: Box::new(std::array::from_fn(|_| OnceLock::new())),
+            maps: child_maps(&children(&mesh, scheme, t)),
+            shape: OnceLock::new(),
+            mesh: Box::new(mesh),
         },
     }
+}
+
+/// Drops the columns of `mesh` whose weights are zero in every row. Cost O(nv · K).
+fn compact(mesh: &mut LocalMesh) {
+    let k = mesh.k();
+    let keep: Vec<usize> = (0..k)
+        .filter(|&j| mesh.rows.chunks_exact(k).any(|r| r[j] != 0.0))
+        .collect();
+    if keep.len() == k {
+        return;
+    }
+    let rows = mesh
+        .rows
+        .chunks_exact(k)
+        .flat_map(|r| keep.iter().map(move |&j| r[j]))
+        .collect();
+    mesh.cols = keep.iter().map(|&j| mesh.cols[j]).collect();
+    mesh.rows = rows;
 }

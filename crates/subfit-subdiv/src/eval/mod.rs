@@ -43,7 +43,10 @@
 //! * `basis` — the regular patch basis and a regular patch's control points as weight rows.
 //! * `memo` — the memoised local-refinement tree of each patch and its memory budget.
 //! * `evaluator` — [`Evaluator`]: construction, the walk down the memoised tree, batches.
-//! * `descend` — local refinement below the memoised levels, and limits at irregular vertices.
+//! * `shape` — interned local topologies below the memoised levels and the sparse refinement
+//!   steps between them (Stam 1998's repeated local subdivision matrices).
+//! * `descend` — the walk below the memoised levels, local refinement where it cannot be
+//!   used, and limits at irregular vertices.
 //! * `random` — seeded random parameters ([`random_samples`]).
 
 mod basis;
@@ -51,6 +54,7 @@ mod descend;
 mod evaluator;
 mod memo;
 mod random;
+mod shape;
 mod types;
 
 pub use descend::MAX_DEPTH;
