@@ -98,8 +98,10 @@ fn imls_flags_are_validated_before_any_work() {
 
 /// Xie et al. Fig. 13's static setting: the bunny's points without normals, a fixed 314 control
 /// points. IMLS and SDM both fit it (the pipeline measures both with the same foot points and
-/// data → surface distances); neither may be more than 30 % worse than the other two-sided.
-/// Measured: IMLS 3.17e-3, SDM 3.36e-3 (two-sided E_rms, unit cube).
+/// data → surface distances); neither may be more than 30 % worse than the other two-sided, and
+/// both reach the two-sided RMS of 3e-3 of the diagonal. The cage is open: the mesh's
+/// holes are known, so the init keeps the trimmed contour instead of a closed wrap. Measured:
+/// IMLS 1.16e-3, SDM 1.15e-3 of the diagonal (3.2e-3 and 3.4e-3 unit cube with the closed wrap).
 #[test]
 fn bunny_points_at_314_control_points_by_imls_and_sdm() {
     let Some(data) = data_dir() else { return };
@@ -131,8 +133,12 @@ fn bunny_points_at_314_control_points_by_imls_and_sdm() {
         let rep = report(&out);
         assert_eq!(rep["control_points"].as_u64(), Some(314));
         let e = rep["final"]["two_sided"]["e_rms"].as_f64().unwrap();
-        println!("bunny 314, {method}: two-sided E_rms {e:.3e}");
-        assert!(e < 0.006, "{method}: {e}");
+        let fraction = rep["final"]["two_sided"]["e_rms_fraction_of_diagonal"]
+            .as_f64()
+            .unwrap();
+        println!("bunny 314, {method}: two-sided E_rms {e:.3e} ({fraction:.2e} of the diagonal)");
+        assert!(fraction <= 3e-3, "{method}: {fraction}");
+        assert_eq!(rep["init"]["cloud_open"], true, "{method}: {}", rep["init"]);
         two.push(e);
     }
     assert!(two[0] < 1.3 * two[1] && two[1] < 1.3 * two[0], "{two:?}");
