@@ -6,6 +6,7 @@
 //! cargo run --release -p subfit --example hard_cases -- range-scan IN.obj OUT.ply [RES] [NOISE] [SEED | VIEW x,y,z]
 //! cargo run --release -p subfit --example hard_cases -- holes IN.obj OUT.obj [COUNT] [RADIUS] [SEED]
 //! cargo run --release -p subfit --example hard_cases -- cut IN.obj OUT.obj [AXIS] [FRACTION]
+//! cargo run --release -p subfit --example hard_cases -- noisy IN.obj OUT.ply [N] [NOISE] [OUTLIERS] [SEED]
 //! ```
 //!
 //! * `range-scan`: an orthographic depth camera of `RES × RES` pixels (default 400) looking
@@ -16,6 +17,9 @@
 //! * `holes`: `COUNT` (default 27) holes, each the faces within `RADIUS` × the diagonal (default
 //!   0.02) of a random vertex, grown through face adjacency so a hole is one disc; holes that
 //!   would touch another one are skipped.
+//! * `noisy`: `N` points (default 150,000) sampled uniformly by area, moved by Gaussian noise of
+//!   `NOISE` × the diagonal (default 0.003) and joined by `OUTLIERS` × N points (default 0.03)
+//!   drawn uniformly in the bounding box grown by 10 % (issue 16's noisy scans). Points only.
 //! * `cut`: the faces whose centroid lies below `FRACTION` (default 0.05) of the extent along
 //!   `AXIS` (x, y or z; default y) are removed: open at the base.
 #![allow(clippy::print_stdout)]
@@ -264,9 +268,46 @@ fn cut(mesh: &PolyMesh, axis: usize, fraction: f64) -> PolyMesh {
     keep_faces(mesh, &keep)
 }
 
+fn noisy(mesh: &PolyMesh, n: usize, noise: f64, outliers: f64, seed: u64) -> Vec<[f64; 3]> {
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
+    let (lo, hi) = bounds(&mesh.positions);
+    let diag = dot(sub(hi, lo), sub(hi, lo)).sqrt();
+    let tris = mesh.faces.triangulate_fan();
+    let mut cdf = Vec::with_capacity(tris.len());
+    let mut total = 0.0;
+    for t in &tris {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        let x = cross(sub(b, a), sub(c, a));
+        total += 0.5 * dot(x, x).sqrt();
+        cdf.push(total);
+    }
+    let mut points = Vec::with_capacity(n + (outliers * n as f64) as usize);
+    for _ in 0..n {
+        let r = rng.next() * total;
+        let f = cdf.partition_point(|&c| c < r).min(tris.len() - 1);
+        let [a, b, c] = tris[f].map(|i| mesh.positions[i as usize]);
+        let (mut u, mut v) = (rng.next(), rng.next());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        points.push(
+            [0, 1, 2].map(|k| {
+                a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]) + noise * diag * rng.normal()
+            }),
+        );
+    }
+    for _ in 0..(outliers * n as f64) as usize {
+        points.push([0, 1, 2].map(|k| {
+            let pad = 0.1 * (hi[k] - lo[k]);
+            lo[k] - pad + rng.next() * (hi[k] - lo[k] + 2.0 * pad)
+        }));
+    }
+    points
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "hard_cases range-scan|holes|cut IN OUT [options]";
+    let usage = "hard_cases range-scan|holes|noisy|cut IN OUT [options]";
     let (Some(what), Some(input), Some(output)) = (args.first(), args.get(1), args.get(2)) else {
         return Err(usage.into());
     };
@@ -294,6 +335,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let (m, made) = holes(&mesh, count, radius, seed);
             println!("{made} holes");
             m
+        }
+        "noisy" => {
+            let n = arg(3).map_or(Ok(150_000), str::parse)?;
+            let noise = arg(4).map_or(Ok(0.003), str::parse)?;
+            let outliers = arg(5).map_or(Ok(0.03), str::parse)?;
+            let seed = arg(6).map_or(Ok(1), str::parse)?;
+            PolyMesh::point_cloud(noisy(&mesh, n, noise, outliers, seed), None)
         }
         "cut" => {
             let axis = match arg(3).unwrap_or("y") {
