@@ -233,3 +233,12 @@ pub struct TargetStats {
     /// Phase durations.
     pub timings: TargetTimings,
 }
+
+impl TargetStats {
+    /// Whether the scan is noisy: its [`Self::noise_level`] above 0.3 × [`Self::point_spacing`],
+    /// the rule that also widens the fits' neighbourhoods (clean scans measure below 0.25,
+    /// 0.3 % noise about 0.4). Always `false` for a mesh target or an empty cloud.
+    pub fn is_noisy(&self) -> bool {
+        self.triangles == 0 && crate::outliers::is_noisy(self.noise_level, self.point_spacing)
+    }
+}

@@ -253,13 +253,19 @@ pub(crate) fn detect(
 /// degrees; at least `k_min`, at most [`MAX_NOISY_K`]. Returns `k_min` when the noise is below
 /// [`NOISY`] × the spacing (clean scans keep their neighbourhood).
 pub(crate) fn noisy_knn(noise: f64, spacing: f64, k_min: usize) -> usize {
-    if !(spacing > 0.0) || !(noise > NOISY * spacing) {
+    if !is_noisy(noise, spacing) {
         return k_min;
     }
     // Radius of k neighbours on a surface ≈ spacing · (k / OUTLIER_K)^½.
     let r = NOISE_RADII * noise;
     let k = (OUTLIER_K as f64 * (r / spacing).powi(2)).ceil();
     (k.min(MAX_NOISY_K as f64) as usize).max(k_min)
+}
+
+/// Whether noise level `noise` makes a scan of median 16th-neighbour distance `spacing` noisy
+/// (above [`NOISY`] × `spacing`).
+pub(crate) fn is_noisy(noise: f64, spacing: f64) -> bool {
+    spacing > 0.0 && noise > NOISY * spacing
 }
 
 /// Noise level, relative to the median 16th-neighbour distance, above which a scan is noisy.

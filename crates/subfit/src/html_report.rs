@@ -262,8 +262,11 @@ impl Fitted {
             (
                 "tolerance (unit cube)".into(),
                 format!(
-                    "RMS {}{}, judged {}",
+                    "RMS {}{}{}, judged {}",
                     sig(o.tolerance_rms),
+                    r.noise_floored_tolerance
+                        .map(|t| format!(" (noisy scan: judged as {})", sig(t)))
+                        .unwrap_or_default(),
                     o.tolerance_max
                         .map(|m| format!(", max {}", sig(m)))
                         .unwrap_or_default(),
@@ -360,7 +363,10 @@ impl Fitted {
             ));
             done += s.iterations;
         }
-        let mut hlines = vec![(o.tolerance_rms, "RMS tolerance".to_string())];
+        let mut hlines = vec![(
+            r.noise_floored_tolerance.unwrap_or(o.tolerance_rms),
+            "RMS tolerance".to_string(),
+        )];
         if let Some(m) = o.tolerance_max {
             hlines.push((m, "max tolerance".into()));
         }

@@ -468,6 +468,10 @@ pub struct Report {
     /// units).
     #[serde(default)]
     pub target_point_spacing: f64,
+    /// The RMS tolerance the fit was judged by when the target is a noisy scan: the requested
+    /// one raised to the noise floor `√(tol² + (1.25 σ)²)` (unit cube); `None` otherwise.
+    #[serde(default)]
+    pub noise_floored_tolerance: Option<f64>,
     /// The target mesh's topology (`None` for a point cloud).
     pub target_topology: Option<Topology>,
     /// Faces of the target re-oriented to agree with their neighbours, if any.

@@ -431,6 +431,19 @@ pub fn fit_scan(
         ..options.fit.clone()
     };
 
+    let stages = noise_floored(&options.stages, target.stats());
+    if let Some(t) = stages.noise_floor {
+        warn(
+            format!(
+                "{name}: a noisy scan (noise level {:.2e}, {:.2} × the point spacing): the RMS tolerance is judged as √(tol² + ({NOISE_FLOOR_FACTOR} σ)²) = {t:.2e} unit cube, since the data's own noise keeps data → surface near σ",
+                target.stats().noise_level,
+                target.stats().noise_level / target.stats().point_spacing,
+            ),
+            &mut progress,
+        );
+    }
+    let (noise_floor, stages) = (stages.noise_floor, stages.options);
+
     step(Step::Fit, &mut progress);
     let t_fit = Instant::now();
     let result = {
@@ -442,14 +455,7 @@ pub fn fit_scan(
                 }
             }
         };
-        fit_stages(
-            &target,
-            &control,
-            &fit,
-            &options.stages,
-            Some(&mut on_event),
-        )
-        .map_err(|e| match e {
+        fit_stages(&target, &control, &fit, &stages, Some(&mut on_event)).map_err(|e| match e {
             subfit_fit::FitError::Interrupted => Error::Interrupted,
             e => Error::Fit {
                 name: name.clone(),
@@ -520,10 +526,9 @@ pub fn fit_scan(
     };
     let measure_time = t_measure.elapsed().as_secs_f64();
     let two = TwoSidedErrors::new(&final_two, diagonal, unit);
-    let reached = options.stages.met(&last, &final_two);
-    let reached_one_sided = options.stages.reached(&last);
-    let reached_two_sided =
-        final_two.within(options.stages.tolerance_rms, options.stages.tolerance_max);
+    let reached = stages.met(&last, &final_two);
+    let reached_one_sided = stages.reached(&last);
+    let reached_two_sided = final_two.within(stages.tolerance_rms, stages.tolerance_max);
     let cage = PolyMesh::new(
         result
             .mesh
@@ -540,6 +545,7 @@ pub fn fit_scan(
         target_outliers_removed: target.stats().outliers_removed,
         target_noise_level: target.stats().noise_level,
         target_point_spacing: target.stats().point_spacing,
+        noise_floored_tolerance: noise_floor,
         target_topology,
         reoriented,
         normalized_unit_in_original_units: unit,
@@ -868,4 +874,38 @@ pub fn read_cage(path: &Path) -> Result<InitialCage, Error> {
         tags: Tags::new(),
         name: path.display().to_string(),
     })
+}
+
+/// Factor on a noisy scan's noise level in its RMS tolerance ([`noise_floored`]).
+pub const NOISE_FLOOR_FACTOR: f64 = 1.25;
+
+/// Stage options with the RMS tolerance of a noisy scan raised to its noise floor.
+struct Floored {
+    options: StageOptions,
+    /// The raised tolerance (unit cube), when it was raised.
+    noise_floor: Option<f64>,
+}
+
+/// `stages` with the RMS tolerance raised to `√(tol² + (1.25 σ)²)` when the target is a noisy
+/// point cloud ([`subfit_target::TargetStats::is_noisy`], σ its estimated noise level): the
+/// data's own noise keeps the data → surface RMS of the true surface near σ, so a tolerance below
+/// it can be met only by fitting the noise — refinement to the budget, a rougher surface, no
+/// closer to the scanned object (Cheng et al. 2007 §V name noisy data as SDM's limit). 0.3 %
+/// noise and 3 % outliers on 150k points of Igea: σ = 3.6e-3 and data → surface 3.85e-3 unit
+/// cube at every stage from 578 to 5,000 control points, 77 s, while the distance to the clean
+/// mesh stayed near 8e-4 of its diagonal.
+fn noise_floored(stages: &StageOptions, stats: &subfit_target::TargetStats) -> Floored {
+    let mut options = stages.clone();
+    if !stats.is_noisy() || stages.tolerance_rms <= 0.0 {
+        return Floored {
+            options,
+            noise_floor: None,
+        };
+    }
+    let sigma = NOISE_FLOOR_FACTOR * stats.noise_level;
+    options.tolerance_rms = stages.tolerance_rms.hypot(sigma);
+    Floored {
+        noise_floor: Some(options.tolerance_rms),
+        options,
+    }
 }
