@@ -27,6 +27,7 @@
 use std::collections::VecDeque;
 use std::path::Path;
 
+use subfit::mesh::vec3::{self, cross, dot, norm, sub};
 use subfit::mesh::{PolyMesh, Polygons};
 
 struct Rng(u64);
@@ -44,34 +45,14 @@ impl Rng {
     }
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    let n = dot(a, a).sqrt();
-    a.map(|c| c / n)
+/// The bounding box of a mesh's positions (an input mesh has some).
+fn bounds(mesh: &PolyMesh) -> ([f64; 3], [f64; 3]) {
+    mesh.bounding_box().expect("a mesh with vertices")
 }
 
-fn bounds(p: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for q in p {
-        for k in 0..3 {
-            lo[k] = lo[k].min(q[k]);
-            hi[k] = hi[k].max(q[k]);
-        }
-    }
-    (lo, hi)
+/// `a` scaled to unit length (a view direction, never zero here).
+fn unit(a: [f64; 3]) -> [f64; 3] {
+    vec3::unit(a).expect("a non-zero direction")
 }
 
 fn range_scan(
@@ -82,9 +63,9 @@ fn range_scan(
     seed: u64,
 ) -> Vec<[f64; 3]> {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
-    let (lo, hi) = bounds(&mesh.positions);
+    let (lo, hi) = bounds(mesh);
     let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-    let diag = dot(sub(hi, lo), sub(hi, lo)).sqrt();
+    let diag = norm(sub(hi, lo));
     let view = unit(view.unwrap_or_else(|| [rng.normal(), rng.normal(), rng.normal()]));
     let up = if view[2].abs() < 0.9 {
         [0.0, 0.0, 1.0]
@@ -195,8 +176,8 @@ fn keep_faces(mesh: &PolyMesh, keep: &[bool]) -> PolyMesh {
 
 fn holes(mesh: &PolyMesh, count: usize, radius: f64, seed: u64) -> (PolyMesh, usize) {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
-    let (lo, hi) = bounds(&mesh.positions);
-    let r = radius * dot(sub(hi, lo), sub(hi, lo)).sqrt();
+    let (lo, hi) = bounds(mesh);
+    let r = radius * norm(sub(hi, lo));
     let vf = vertex_faces(mesh);
     let nf = mesh.faces.len();
     // 0: kept, 1: removed, 2: ring around a hole (no other hole may take it).
@@ -217,12 +198,10 @@ fn holes(mesh: &PolyMesh, count: usize, radius: f64, seed: u64) -> (PolyMesh, us
                 for &g in &vf[w as usize] {
                     if seen.insert(g) {
                         let face = mesh.faces.face(subfit::mesh::FaceId(g));
-                        if face.iter().all(|&u| {
-                            dot(
-                                sub(mesh.positions[u as usize], c),
-                                sub(mesh.positions[u as usize], c),
-                            ) <= r * r
-                        }) {
+                        if face
+                            .iter()
+                            .all(|&u| vec3::dist2(mesh.positions[u as usize], c) <= r * r)
+                        {
                             disc.push(g);
                             queue.push_back(g);
                         }
@@ -252,7 +231,7 @@ fn holes(mesh: &PolyMesh, count: usize, radius: f64, seed: u64) -> (PolyMesh, us
 }
 
 fn cut(mesh: &PolyMesh, axis: usize, fraction: f64) -> PolyMesh {
-    let (lo, hi) = bounds(&mesh.positions);
+    let (lo, hi) = bounds(mesh);
     let at = lo[axis] + fraction * (hi[axis] - lo[axis]);
     let keep: Vec<bool> = mesh
         .faces
@@ -270,8 +249,8 @@ fn cut(mesh: &PolyMesh, axis: usize, fraction: f64) -> PolyMesh {
 
 fn noisy(mesh: &PolyMesh, n: usize, noise: f64, outliers: f64, seed: u64) -> Vec<[f64; 3]> {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
-    let (lo, hi) = bounds(&mesh.positions);
-    let diag = dot(sub(hi, lo), sub(hi, lo)).sqrt();
+    let (lo, hi) = bounds(mesh);
+    let diag = norm(sub(hi, lo));
     let tris = mesh.faces.triangulate_fan();
     let mut cdf = Vec::with_capacity(tris.len());
     let mut total = 0.0;
