@@ -431,8 +431,8 @@ pub fn fit_scan(
         ..options.fit.clone()
     };
 
-    let stages = noise_floored(&options.stages, target.stats());
-    if let Some(t) = stages.noise_floor {
+    let (stages, noise_floor) = noise_floored(&options.stages, target.stats());
+    if let Some(t) = noise_floor {
         warn(
             format!(
                 "{name}: a noisy scan (noise level {:.2e}, {:.2} × the point spacing): the RMS tolerance is judged as √(tol² + ({NOISE_FLOOR_FACTOR} σ)²) = {t:.2e} unit cube, since the data's own noise keeps data → surface near σ",
@@ -442,7 +442,6 @@ pub fn fit_scan(
             &mut progress,
         );
     }
-    let (noise_floor, stages) = (stages.noise_floor, stages.options);
 
     step(Step::Fit, &mut progress);
     let t_fit = Instant::now();
@@ -879,13 +878,6 @@ pub fn read_cage(path: &Path) -> Result<InitialCage, Error> {
 /// Factor on a noisy scan's noise level in its RMS tolerance ([`noise_floored`]).
 pub const NOISE_FLOOR_FACTOR: f64 = 1.25;
 
-/// Stage options with the RMS tolerance of a noisy scan raised to its noise floor.
-struct Floored {
-    options: StageOptions,
-    /// The raised tolerance (unit cube), when it was raised.
-    noise_floor: Option<f64>,
-}
-
 /// `stages` with the RMS tolerance raised to `√(tol² + (1.25 σ)²)` when the target is a noisy
 /// point cloud ([`subfit_target::TargetStats::is_noisy`], σ its estimated noise level): the
 /// data's own noise keeps the data → surface RMS of the true surface near σ, so a tolerance below
@@ -893,19 +885,18 @@ struct Floored {
 /// closer to the scanned object (Cheng et al. 2007 §V name noisy data as SDM's limit). 0.3 %
 /// noise and 3 % outliers on 150k points of Igea: σ = 3.6e-3 and data → surface 3.85e-3 unit
 /// cube at every stage from 578 to 5,000 control points, 77 s, while the distance to the clean
-/// mesh stayed near 8e-4 of its diagonal.
-fn noise_floored(stages: &StageOptions, stats: &subfit_target::TargetStats) -> Floored {
+/// mesh stayed near 8e-4 of its diagonal. Returns the options and the raised tolerance (unit
+/// cube), if it was raised.
+fn noise_floored(
+    stages: &StageOptions,
+    stats: &subfit_target::TargetStats,
+) -> (StageOptions, Option<f64>) {
     let mut options = stages.clone();
     if !stats.is_noisy() || stages.tolerance_rms <= 0.0 {
-        return Floored {
-            options,
-            noise_floor: None,
-        };
+        return (options, None);
     }
     let sigma = NOISE_FLOOR_FACTOR * stats.noise_level;
     options.tolerance_rms = stages.tolerance_rms.hypot(sigma);
-    Floored {
-        noise_floor: Some(options.tolerance_rms),
-        options,
-    }
+    let floor = options.tolerance_rms;
+    (options, Some(floor))
 }
