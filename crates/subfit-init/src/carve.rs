@@ -171,7 +171,7 @@ pub(crate) fn carve_cancellable(
     if tris.is_empty() {
         return Err(ContourError::Empty(resolution));
     }
-    let (mesh, found, kept) = keep_components(positions, &tris, min_component_fraction);
+    let (mesh, found, kept) = keep_components(positions, &tris, min_component_fraction, None);
     let he =
         HalfEdgeMesh::from_mesh(&mesh).map_err(|e| ContourError::NotManifold(e.to_string()))?;
     let report = ContourReport {

@@ -36,7 +36,10 @@
 //! If most band points on an edge to the outside region are negative, the normals point inward
 //! and the IMLS values are negated ([`ContourReport::flipped`]).
 //!
-//! Then small components are removed ([`ContourOptions::min_component_fraction`]). Cost:
+//! Then small components are removed ([`ContourOptions::min_component_fraction`]), unless one
+//! alone covers data (at least [`crate::islands::MIN_ISLAND_POINTS`] points farther than the
+//! band width from every other kept component: an island of a range scan, [`crate::islands`]).
+//! Cost:
 //! `O(n log n)` for the `n` octree points (about the band's cells on the band level plus, with
 //! a finer resolution, a few layers of finest cells around the zero set) plus one IMLS
 //! evaluation per band point (parallel in `subfit-target`).
@@ -224,7 +227,13 @@ pub fn contour(
         return Err(ContourError::Empty(frame.resolution));
     }
 
-    let (mesh, found, kept) = keep_components(positions, &tris, options.min_component_fraction);
+    let band_width = frame.band as f64 * frame.cell * (1u64 << frame.band_level) as f64;
+    let (mesh, found, kept) = keep_components(
+        positions,
+        &tris,
+        options.min_component_fraction,
+        Some((target.points(), band_width)),
+    );
     let he =
         HalfEdgeMesh::from_mesh(&mesh).map_err(|e| ContourError::NotManifold(e.to_string()))?;
     let mut leaves_per_level = vec![0; cut_leaves_per_level.len()];
@@ -795,15 +804,29 @@ pub(crate) fn keep_components(
     positions: Vec<[f64; 3]>,
     tris: &[[u32; 3]],
     fraction: f64,
+    cover: Option<(&[[f64; 3]], f64)>,
 ) -> (PolyMesh, usize, usize) {
     let polys = Polygons::from_triangles(tris);
     let comps = face_components(&polys, positions.len());
     let counts = comps.face_counts();
     let largest = counts.iter().copied().max().unwrap_or(0);
-    let keep: Vec<bool> = counts
+    let mut keep: Vec<bool> = counts
         .iter()
         .map(|&c| c == largest || c as f64 >= fraction * largest as f64)
         .collect();
+    if let Some((points, gap)) = cover {
+        let alone = crate::islands::uncovered_by_component(
+            points,
+            &positions,
+            &comps.vertex_labels,
+            comps.count,
+            &keep,
+            gap,
+        );
+        for (k, &a) in keep.iter_mut().zip(&alone) {
+            *k |= a >= crate::islands::MIN_ISLAND_POINTS;
+        }
+    }
     let mut map = vec![u32::MAX; positions.len()];
     let mut out_pos = Vec::new();
     let mut out = Vec::new();

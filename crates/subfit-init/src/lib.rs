@@ -10,6 +10,7 @@
 //!   leaves, which always yields a closed, manifold, consistently oriented, crack-free surface.
 //! * [`carve`](mod@carve): a normal-free wrap of a point cloud (space carving with a ball), the
 //!   fallback when the IMLS contour misses an expected genus (e.g. badly oriented normals).
+//! * [`islands`](mod@islands): the rule that keeps a small component when it alone covers data.
 //! * [`trim`](mod@trim): the faces of a contour that no data supports are cut away, so an open
 //!   cloud (a single-view scan) gives an open surface with its boundary loops.
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
@@ -28,6 +29,7 @@ pub mod carve;
 pub mod contour;
 mod heap;
 pub mod init;
+pub mod islands;
 mod march;
 mod octree;
 pub mod quads;

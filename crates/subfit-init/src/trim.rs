@@ -47,7 +47,9 @@
 //!    supported by a few stray points. The share of the data, not the face count, decides,
 //!    because a single-view scan can hold real disconnected pieces (the bunny scan `bun000`
 //!    has a strip of about 1 % of its points whose surface is about 1 % of the main one's:
-//!    dropping it left data 0.15 unit cube from the cage).
+//!    dropping it left data 0.15 unit cube from the cage). A component that alone covers data —
+//!    at least [`crate::islands::MIN_ISLAND_POINTS`] points farther than a band width from every
+//!    other kept component — stays whatever its share ([`crate::islands`]).
 //! 5. The boundary loops are smoothed ([`TrimOptions::boundary_smoothing`] passes of moving each
 //!    boundary vertex halfway to the midpoint of its loop neighbours, unless a face would turn
 //!    by more than 60°): the cut follows the marching tetrahedra's faces and zig-zags by about a
@@ -194,7 +196,8 @@ pub fn trim_unsupported(
     report.holes_kept = holes;
     report.hole_faces_kept = hole_faces;
     report.cleanup_faces_removed = clean(&he, &mut keep);
-    report.components_dropped = drop_small_components(target, contour, &he, &mut keep, options);
+    report.components_dropped =
+        drop_small_components(target, contour, &he, &mut keep, options, band_width);
     let kept = keep.iter().filter(|&&k| k).count();
     if kept == 0 {
         return unchanged(report);
@@ -475,6 +478,7 @@ fn drop_small_components(
     he: &HalfEdgeMesh,
     keep: &mut [bool],
     options: &TrimOptions,
+    gap: f64,
 ) -> usize {
     let mut polys = Polygons::new();
     for (f, &k) in keep.iter().enumerate() {
@@ -503,9 +507,22 @@ fn drop_small_components(
     }
     let most = (0..comps.count).max_by_key(|&c| carried[c]).unwrap_or(0);
     let floor = options.min_component_data * target.len() as f64;
-    let small: Vec<bool> = (0..comps.count)
+    let mut small: Vec<bool> = (0..comps.count)
         .map(|c| c != most && (carried[c] as f64) < floor)
         .collect();
+    // An island that alone covers data stays ([`crate::islands`]).
+    let kept: Vec<bool> = small.iter().map(|&s| !s).collect();
+    let alone = crate::islands::uncovered_by_component(
+        target.points(),
+        &mesh.positions,
+        &comps.vertex_labels,
+        comps.count,
+        &kept,
+        gap,
+    );
+    for (s, &a) in small.iter_mut().zip(&alone) {
+        *s &= a < crate::islands::MIN_ISLAND_POINTS;
+    }
     for (f, k) in keep.iter_mut().enumerate() {
         let l = comps.face_labels[f];
         if *k && l != u32::MAX && small[l as usize] {
