@@ -35,7 +35,7 @@
 //! (`α` = 1) and 0.23 (`α` = 100, i.e. not moved) from the turned cage, normalized units. So each
 //! vertex's rotation is linearized too, `R_i ← (I + [ω_i]×) R_i`, and eliminated: `H` gets the
 //! Schur complement of `ω_i` in vertex `i`'s terms (`add_rotation_coupling`), a Gauss-Newton
-//! model of `min_R E` itself. Both fits above now end on the turned cage (< 1e-4; `tests/arap.rs`).
+//! model of `min_R E` itself. Both fits above now end on the turned cage (2.8e-7; `tests/arap.rs`).
 //! The pairs it couples — two neighbours of one vertex — are in the pattern (the umbrella `LᵀL`);
 //! the coupling needs block size 3 (SDM, TDM, IMLS), so the PD system keeps frozen rotations.
 //!
