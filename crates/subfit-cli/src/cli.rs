@@ -147,6 +147,9 @@ pub struct BenchSequenceArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// ARAP weight α towards the template [default: `subfit sequence`'s].
+    /// Nodes of the tracking step (0: off) [default: `subfit sequence`'s].
+    #[arg(long)]
+    pub track_nodes: Option<u32>,
     #[arg(long)]
     pub arap: Option<f64>,
     /// ARAP weight at the start of each frame's annealing [default: `subfit sequence`'s].
@@ -388,6 +391,11 @@ pub struct SequenceArgs {
     /// Data term of every frame: SDM (Cheng et al.) or IMLS (Xie et al.).
     #[arg(long, value_enum, default_value_t = MethodArg::Sdm)]
     pub method: MethodArg,
+    /// Nodes of the embedded deformation that carries the previous frame's cage onto each new
+    /// frame before its fit (it follows motion along the surface, which closest points do not
+    /// see); 0 turns the tracking off.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(0..=2000))]
+    pub track_nodes: u32,
     /// Weight α of the as-rigid-as-possible term towards the template.
     #[arg(long, default_value_t = 0.01)]
     pub arap: f64,

@@ -70,6 +70,7 @@ mod solve;
 mod stages;
 mod surface_term;
 mod term;
+pub mod track;
 
 pub use any_term::{AnySample, AnyTerm};
 pub use arap::Arap;

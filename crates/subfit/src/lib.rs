@@ -32,6 +32,7 @@ mod outputs;
 pub mod pipeline_report;
 mod scan;
 mod sequence;
+mod sequence_tracking;
 
 pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
@@ -43,7 +44,7 @@ pub use scan::{
 pub use sequence::{
     fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence,
     SequenceFrame, SequenceOptions, SequenceOptionsSummary, SequenceReport, SilhouetteOptions,
-    DEFAULT_SILHOUETTE_WEIGHT,
+    TrackingOptions, TrackingReport, DEFAULT_SILHOUETTE_WEIGHT,
 };
 
 pub use subfit_fit as fit;

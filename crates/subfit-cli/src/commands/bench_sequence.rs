@@ -115,6 +115,9 @@ fn run_one(
         arap: a.arap.unwrap_or(d.arap),
         arap_start: a.arap_start.unwrap_or(d.arap_start),
         iterations: a.iterations.map_or(d.iterations, |k| k as usize),
+        tracking: a
+            .track_nodes
+            .map_or(d.tracking.clone(), crate::commands::sequence::tracking),
         cancel: crate::interrupt::token(),
         ..d
     };

@@ -120,7 +120,16 @@ fn options(a: &SequenceArgs) -> anyhow::Result<SequenceOptions> {
             weight: a.silhouette_weight,
             ..subfit::SilhouetteOptions::default()
         },
+        tracking: tracking(a.track_nodes),
         cancel: crate::interrupt::token(),
         ..SequenceOptions::default()
+    })
+}
+
+/// The tracking step with `nodes` nodes (0: off).
+pub fn tracking(nodes: u32) -> Option<subfit::TrackingOptions> {
+    (nodes > 0).then(|| subfit::TrackingOptions {
+        nodes: nodes as usize,
+        ..subfit::TrackingOptions::default()
     })
 }

@@ -1,0 +1,68 @@
+//! The tracking step of `fit_sequence` (`subfit_fit::track`): on a generated sequence whose
+//! material spins about the body's axis (0.25 rad a frame: the surface moves little, its
+//! points much) and bends, the tracked limit points of the first frame after the template are
+//! much closer to where their material went with the step than without it (measured 1.4 % vs
+//! 3.2 % of the diagonal, RMS) — closest points alone leave the cage behind.
+#![allow(clippy::print_stderr)]
+
+use subfit::mesh::deforming::{DeformingParams, DeformingSequence, MaterialLookup};
+use subfit::{fit_sequence, FitScanOptions, Input, SequenceOptions, SilhouetteOptions};
+
+/// Frames fitted.
+const FRAMES: usize = 2;
+
+/// Drift RMS of frame 1 (fraction of the diagonal), with or without tracking.
+fn drift(tracking: bool) -> f64 {
+    let seq = DeformingSequence::new(DeformingParams::large_tangential_motion()).unwrap();
+    let frame0 = seq.frame(0, 3000, 11);
+    let lookup = MaterialLookup::new(&frame0);
+    let mut template_fit = FitScanOptions {
+        control_points: Some(200),
+        ..FitScanOptions::default()
+    };
+    template_fit.stages.max_control_points = 200;
+    let d = SequenceOptions::default();
+    let options = SequenceOptions {
+        template_fit,
+        silhouette: SilhouetteOptions {
+            views: 0,
+            ..SilhouetteOptions::default()
+        },
+        tracking: if tracking { d.tracking.clone() } else { None },
+        ..d
+    };
+    let frames = (0..FRAMES).map(|i| Input::Mesh {
+        mesh: if i == 0 {
+            frame0.mesh.clone()
+        } else {
+            seq.frame(i, 3000, 11 + i as u64).mesh
+        },
+        name: format!("frame {i}"),
+    });
+    let fitted = fit_sequence(frames, &options, &mut |_| Ok(()), &mut |_| {}).unwrap();
+    for f in &fitted.report.frames {
+        assert!(
+            f.two_sided.e_rms_fraction_of_diagonal <= 2e-3,
+            "frame {}: two-sided RMS {}",
+            f.index,
+            f.two_sided.e_rms_fraction_of_diagonal
+        );
+        assert_eq!(f.tracking.is_some(), tracking && f.index > 0);
+    }
+    let d = seq.drift(&fitted.limit_points(0).unwrap(), &lookup);
+    eprintln!(
+        "tracking {tracking}: drift RMS per frame {:?}",
+        d.frames
+            .iter()
+            .map(|f| (1e4 * f.rms_relative).round() / 1e4)
+            .collect::<Vec<_>>()
+    );
+    d.frames[1].rms_relative
+}
+
+#[test]
+fn tracking_follows_motion_along_the_surface() {
+    let (with, without) = (drift(true), drift(false));
+    eprintln!("drift RMS at frame 1: {with:.4} with tracking, {without:.4} without");
+    assert!(with < 0.6 * without, "{with} vs {without}");
+}
