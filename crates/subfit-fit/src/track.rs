@@ -28,21 +28,26 @@
 //! `A_k`; the rigidity rows are linearized exactly, so a turn costs nothing to first order (a
 //! penalty `‖A_k − R_k‖²` with `R_k` held for the step charges a turn like a shear: a rigid
 //! turn of the body by 0.15 rad was then followed only in part, 0.040 → 0.025 from the true
-//! motion, against 5.6e-5 now, `tests/track.rs`). 12 unknowns a node; foot points
+//! motion, against 4.4e-4 now, `tests/track.rs`). 12 unknowns a node; foot points
 //! recomputed every iteration; a sample whose foot point is farther than
 //! [`TrackOptions::max_distance`] or whose moved normal is more than 60° from the target's is
 //! left out (Li et al. §4's pruning). The normal matrix is dense `12m × 12m`, factored by
 //! Cholesky each iteration (`m` = 30 by default in sequences: 360 unknowns).
 //!
-//! **Weights, measured** (`subfit bench sequence`'s generated body, frame 0 → 1, whose true
-//! motion is 2.08 % of the diagonal RMS; drift left after the step, RMS): the regularity
-//! penalizes bending at the node spacing (`κ h²`) and the rigidity the frame's change of
-//! thickness (4 % per frame), so stiff weights cannot fit the frame (γ = 100, ρ = 1e-3: 1.7 %
-//! left, plane residual stuck at 4e-3); soft ones let the nodes slide where nothing is seen (γ =
-//! 1, ρ = 1e-3: 1.2 %). Best were few nodes and soft weights: 30 nodes, γ = 0.01, ρ = 1e-4,
-//! β = 0 (β > 0 pulls each point to its closest point, i.e. against sliding): 0.97 % left. The
-//! rest of each frame's motion along the surface is not observable by a local tracker on this
-//! smooth body, and it accumulates over a sequence (see `subfit::sequence`).
+//! **Weights, measured** (`subfit bench sequence`'s generated body, 8,000-vertex frames,
+//! frame 0 → 1, whose true motion is 2.08 % of the diagonal RMS; drift left after one step
+//! from rest, RMS): the regularity penalizes bending at the node spacing (`κ h²`) and the
+//! rigidity the frame's change of thickness (4 % per frame), so stiff weights cannot fit the
+//! frame (γ = 100, ρ = 1e-3: 1.7 % left, plane residual stuck at 4e-3). With 30 nodes and ρ =
+//! 1e-4: γ = 0.1 leaves 1.18 %, 0.01 0.93 %, 1e-3 0.67 %, **1e-4 0.40 %**, 1e-5 0.49 % (the
+//! middle of the body starts to slide); 15 nodes 1.18 %, 45–60 nodes 0.51–0.76 %. β > 0 pulls
+//! each point to its closest point, i.e. against sliding. Stiffness annealing as in Li et
+//! al. (half the iterations with γ and ρ 100–10,000 times higher, then the given weights with
+//! each sample held along the surface where the stiff phase put it) made it worse, 1.44–1.69 %:
+//! the stiff solution is wrong where the body bends. From rest to frame 3 (5.7 % of motion):
+//! 1.5 % left. The rest of the motion along the surface is not observable by a local tracker
+//! on this smooth body (most of it at the rounded ends), and it accumulates over a sequence
+//! (see `subfit::sequence`). A rigid turn is followed to 1.1 % of itself (`tests/track.rs`).
 //!
 //! **Cost** per step: `iterations × (S foot points + S·(12s)² + (12m)³/3 flops)`.
 
@@ -59,7 +64,7 @@ pub struct TrackOptions {
     pub iterations: usize,
     /// Nodes each sample is skinned to (`s`). Default 4.
     pub skin: usize,
-    /// Weight `γ` of the regularity term. Default 0.01 (see the module docs).
+    /// Weight `γ` of the regularity term. Default 1e-4 (see the module docs).
     pub regularity: f64,
     /// Weight `ρ` of the rigidity term. Default 1e-4.
     pub rigidity: f64,
@@ -75,7 +80,7 @@ impl Default for TrackOptions {
         Self {
             iterations: 20,
             skin: 4,
-            regularity: 0.01,
+            regularity: 1e-4,
             rigidity: 1e-4,
             point_weight: 0.0,
             max_distance: 0.1,

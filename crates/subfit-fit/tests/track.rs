@@ -89,5 +89,5 @@ fn a_turn_along_the_surface_is_followed() {
         / out.len() as f64)
         .sqrt();
     eprintln!("{stats:?}; distance to the true motion: RMS {before:.4} -> {after:.6}");
-    assert!(after < 0.01 * before, "RMS {before} -> {after}");
+    assert!(after < 0.02 * before, "RMS {before} -> {after}");
 }

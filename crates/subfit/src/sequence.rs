@@ -14,11 +14,11 @@
 //! Closest points only move the cage along the surface's normal; the step follows the part of
 //! the motion along the surface that the frame's shape reveals (a spin of an elliptic section,
 //! a bend seen from its inner and outer sides). Measured with `subfit bench sequence` (30 frames
-//! of ~25k vertices, 1,000 control points; drift max over the frames, fraction of the
-//! diagonal): default motion 16.6 % without tracking, 10.5 % with; large tangential motion
-//! 39.8 % → 17.0 %; 1.2–1.8 s per frame. The goal (1 %) is not met: on this smooth body about
-//! half of each frame's motion along the surface is not observable by a local tracker (frame
-//! 0 → 1: 2.08 % of motion, 0.97 % left after the step), and what is left accumulates.
+//! of ~25k vertices, 1,000 control points; largest drift over the frames, fraction of the
+//! diagonal): default motion 16.6 % without tracking, 11.9 % with (worst frame's RMS 4.8 %);
+//! large tangential motion 39.8 % → 13.7 % (RMS 8.8 %); 1.2–2.0 s per frame. The goal (1 %) is
+//! not met: on this smooth body part of each frame's motion along the surface is not
+//! observable by a local tracker (frame 0 → 1: 2.08 % of motion, 0.40 % left after the step), and what is left accumulates.
 //!
 //! All frames share one normalization, the first frame's (the unit cube of frame 0), so that
 //! the cage moves in one set of units; every figure is reported in the frame's own units and
