@@ -50,7 +50,7 @@ fn frame(item: &Bound<'_, PyAny>, index: usize) -> PyResult<Input> {
     frames, *, template=None, control_points=None, scheme_name="auto", method="sdm",
     arap=0.01, lambda_=1e-5, iterations=12, tolerance=5e-4, sample_level=2,
     silhouette_views=8, silhouette_resolution=128,
-    silhouette_weight=subfit::DEFAULT_SILHOUETTE_WEIGHT, progress=None
+    silhouette_weight=subfit::DEFAULT_SILHOUETTE_WEIGHT, track_nodes=30, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_sequence_py(
@@ -68,6 +68,7 @@ pub fn fit_sequence_py(
     silhouette_views: i64,
     silhouette_resolution: i64,
     silhouette_weight: f64,
+    track_nodes: i64,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeSequence> {
     let method = match method.to_ascii_lowercase().as_str() {
@@ -141,6 +142,13 @@ pub fn fit_sequence_py(
             resolution: in_range("silhouette_resolution", silhouette_resolution, 16, 1024)?,
             weight: silhouette_weight,
             ..subfit::SilhouetteOptions::default()
+        },
+        tracking: match in_range("track_nodes", track_nodes, 0, 2000)? {
+            0 => None,
+            nodes => Some(subfit::TrackingOptions {
+                nodes,
+                ..subfit::TrackingOptions::default()
+            }),
         },
         cancel: cancel.clone(),
         ..SequenceOptions::default()

@@ -68,3 +68,17 @@ def test_a_raising_progress_callback_stops_the_run():
 
     with pytest.raises(RuntimeError, match="enough"):
         subfit.fit_sequence(frames(3, []), control_points=60, silhouette_views=0, progress=stop)
+
+
+def test_tracking_runs_by_default_and_track_nodes_zero_turns_it_off():
+    for nodes, expect in [(30, True), (0, False)]:
+        seq = subfit.fit_sequence(
+            frames(2, []), control_points=80, silhouette_views=0, track_nodes=nodes,
+        )
+        f = seq.report["frames"][1]
+        assert (f["tracking"] is not None) == expect, f.get("tracking")
+        if expect:
+            assert f["tracking"]["matched"] > 0
+            assert f["tracking"]["rms_after"] <= f["tracking"]["rms_before"]
+    with pytest.raises(ValueError, match="track_nodes"):
+        subfit.fit_sequence(frames(1, []), control_points=60, track_nodes=-1)

@@ -105,7 +105,9 @@ def fit_sequence(
 
     The template is the first frame fitted as :func:`subfit.fit` would (or ``template``, a
     cage in the first frame's coordinates); each next frame starts from the previous frame's
-    cage and is fitted with the data term, smoothing, an as-rigid-as-possible term towards
+    cage, carried onto it by an embedded deformation (``track_nodes`` nodes, 0: off; it follows
+    motion along the surface), and is fitted with the data term, smoothing, an
+    as-rigid-as-possible term towards
     the template and a soft silhouette term from ``silhouette_views`` views (Xie et al. 2023
     §4.2; 0 turns it off). Every frame's cage has the template's connectivity and vertex
     order.
@@ -128,7 +130,7 @@ def fit_sequence(
         The other flags of ``subfit sequence``: ``scheme`` ("auto"), ``method`` ("sdm" or
         "imls"), ``arap`` (0.01), ``lambda_`` (1e-5), ``iterations`` (12), ``tolerance``
         (5e-4), ``sample_level`` (2), ``silhouette_resolution`` (128),
-        ``silhouette_weight``.
+        ``silhouette_weight``, ``track_nodes`` (30).
 
     Raises
     ------
