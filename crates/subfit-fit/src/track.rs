@@ -55,6 +55,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
+use subfit_mesh::vec3::{dist2, dot as dot3, sub};
 use subfit_target::Target;
 
 /// Options of [`track`].
@@ -489,17 +490,4 @@ pub fn track(
 
 fn v(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
-    let d = sub(a, b);
-    dot3(d, d)
 }

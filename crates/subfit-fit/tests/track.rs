@@ -27,6 +27,11 @@ fn vertex_normals(p: &[[f64; 3]], tris: &[[u32; 3]]) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// RMS of the distances between corresponding points.
+fn rms_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    (a.iter().zip(b).map(|(p, q)| dist2(*p, *q)).sum::<f64>() / a.len() as f64).sqrt()
+}
+
 fn turn_z(p: [f64; 3], angle: f64, shift: [f64; 3]) -> [f64; 3] {
     let (s, c) = angle.sin_cos();
     [
@@ -74,20 +79,10 @@ fn a_turn_along_the_surface_is_followed() {
         None,
         &TrackOptions::default(),
     );
-    let before = (samples
-        .iter()
-        .zip(&expected)
-        .map(|(a, b)| dist2(*a, *b))
-        .sum::<f64>()
-        / samples.len() as f64)
-        .sqrt();
-    let after = (out
-        .iter()
-        .zip(&expected)
-        .map(|(a, b)| dist2(*a, *b))
-        .sum::<f64>()
-        / out.len() as f64)
-        .sqrt();
+    let (before, after) = (
+        rms_distance(&samples, &expected),
+        rms_distance(&out, &expected),
+    );
     eprintln!("{stats:?}; distance to the true motion: RMS {before:.4} -> {after:.6}");
     assert!(after < 0.02 * before, "RMS {before} -> {after}");
 }
