@@ -146,10 +146,10 @@ pub struct BenchSequenceArgs {
     /// Seed of the frames' tessellations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// ARAP weight α towards the template [default: `subfit sequence`'s].
     /// Nodes of the tracking step (0: off) [default: `subfit sequence`'s].
     #[arg(long)]
     pub track_nodes: Option<u32>,
+    /// ARAP weight α towards the template [default: `subfit sequence`'s].
     #[arg(long)]
     pub arap: Option<f64>,
     /// ARAP weight at the start of each frame's annealing [default: `subfit sequence`'s].
