@@ -3,7 +3,7 @@
 //! ([`subfit_fit::track`]) before the frame's fit.
 
 use serde::Serialize;
-use subfit_fit::track::{track, DeformationGraph, NodeMotion, TrackOptions};
+use subfit_fit::track::{plane_rms_to, track, DeformationGraph, NodeMotion, TrackOptions};
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::Target;
 
@@ -22,6 +22,11 @@ pub struct TrackingOptions {
     pub predict: bool,
     /// Refinement level of the limit samples that are tracked. Default 1.
     pub level: usize,
+    /// Discrepancy factor `τ`: a step stops once its point-to-plane RMS is within `τ` times
+    /// the previous frame's own (the fitted cage against the frame it was fitted to: the
+    /// data's noise and tessellation), so a subject that holds still is not tracked into a
+    /// slide ([`TrackOptions::stop_rms`]). 0 turns the rule off. Default 1.5.
+    pub discrepancy: f64,
     /// The step's own options.
     pub step: TrackOptions,
 }
@@ -33,6 +38,7 @@ impl Default for TrackingOptions {
             neighbors: 8,
             predict: true,
             level: 1,
+            discrepancy: 1.5,
             step: TrackOptions::default(),
         }
     }
@@ -49,6 +55,9 @@ pub struct TrackingReport {
     pub rms_after: f64,
     /// Gauss-Newton iterations.
     pub iterations: usize,
+    /// The RMS at which the step would stop ([`TrackingOptions::discrepancy`] times the
+    /// previous frame's own; 0 without the rule).
+    pub stop_rms: f64,
 }
 
 /// The step's state between frames: its graph (on the template), the limit samples it tracks
@@ -57,6 +66,8 @@ pub(crate) struct Tracking {
     graph: DeformationGraph,
     samples: LimitStencils,
     motion: Option<NodeMotion>,
+    /// The previous frame's point-to-plane RMS against its own frame ([`Self::settle`]).
+    floor: f64,
 }
 
 impl Tracking {
@@ -70,7 +81,24 @@ impl Tracking {
                 tangent2: op.tangent2,
             },
             motion: None,
+            floor: 0.0,
         }
+    }
+
+    /// Records how closely `cage`, fitted to `target`, lies on it (the samples' RMS
+    /// point-to-plane distance): the next step's floor.
+    pub(crate) fn settle(&mut self, cage: &[[f64; 3]], target: &Target, o: &TrackingOptions) {
+        let (samples, normals) = self.samples_of(cage);
+        self.floor = plane_rms_to(&samples, &normals, target, o.step.max_distance).0;
+    }
+
+    fn samples_of(&self, cage: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let samples = self.samples.position.apply(cage);
+        let normals = normals_from_tangents(
+            &self.samples.tangent1.apply(cage),
+            &self.samples.tangent2.apply(cage),
+        );
+        (samples, normals)
     }
 
     /// Carries `cage` (the previous frame's) onto `target`; returns the moved cage.
@@ -80,11 +108,11 @@ impl Tracking {
         target: &Target,
         o: &TrackingOptions,
     ) -> (Vec<[f64; 3]>, TrackingReport) {
-        let samples = self.samples.position.apply(cage);
-        let normals = normals_from_tangents(
-            &self.samples.tangent1.apply(cage),
-            &self.samples.tangent2.apply(cage),
-        );
+        let (samples, normals) = self.samples_of(cage);
+        let step = TrackOptions {
+            stop_rms: o.discrepancy * self.floor,
+            ..o.step.clone()
+        };
         let initial = self
             .motion
             .as_ref()
@@ -97,7 +125,7 @@ impl Tracking {
             &normals,
             target,
             initial.as_ref(),
-            &o.step,
+            &step,
         );
         self.motion = Some(motion);
         let report = TrackingReport {
@@ -105,6 +133,7 @@ impl Tracking {
             rms_before: stats.rms_before,
             rms_after: stats.rms_after,
             iterations: stats.iterations,
+            stop_rms: step.stop_rms,
         };
         (moved, report)
     }
