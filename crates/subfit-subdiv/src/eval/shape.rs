@@ -220,8 +220,11 @@ impl super::Evaluator {
             .skip(1)
             .map(|s| s.child.mesh.nv())
             .chain([rows.nv()]);
+        // One scratch buffer for all levels, swapped with `p` after each.
+        let mut q = Vec::new();
         for (s, parent_nv) in chain.iter().rev().zip(parents) {
-            let mut q = vec![0.0; 6 * parent_nv];
+            q.clear();
+            q.resize(6 * parent_nv, 0.0);
             for (po, qo) in p.chunks_exact(nv).zip(q.chunks_exact_mut(parent_nv)) {
                 for (j, &x) in po.iter().enumerate() {
                     if x != 0.0 {
@@ -231,7 +234,7 @@ impl super::Evaluator {
                     }
                 }
             }
-            p = q;
+            std::mem::swap(&mut p, &mut q);
             nv = parent_nv;
         }
         let k = rows.k();
