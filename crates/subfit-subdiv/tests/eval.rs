@@ -565,14 +565,16 @@ fn cache_budget_bounds_memory_without_changing_results() {
             }
         }
         assert_eq!(none.cache_bytes(), 0, "{scheme:?}: budget 0 memoised");
-        // At most one node past the budget (single-threaded here); nodes are far below `used`.
+        // The per-patch nodes and the shared shapes each stop at most one node or shape past
+        // the budget (single-threaded here); both are far below `used`.
         assert!(
             small.cache_bytes() >= used / 4,
             "{scheme:?}: small budget not used"
         );
         assert!(
-            small.cache_bytes() < used / 2,
-            "{scheme:?}: small budget exceeded"
+            small.cache_bytes() < 3 * used / 4,
+            "{scheme:?}: small budget exceeded: {} of {used}",
+            small.cache_bytes()
         );
         free.clear_cache();
         assert_eq!(free.cache_bytes(), 0);

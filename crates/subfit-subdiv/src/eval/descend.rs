@@ -42,7 +42,7 @@ impl Evaluator {
         let scheme = self.options.scheme;
         let intern = || {
             let (s, bytes) = self.shapes.intern(mesh, t, scheme);
-            self.memo.add_bytes(bytes);
+            self.memo.add_shape_bytes(bytes);
             s
         };
         // Shapes and steps are borrowed, not reference-counted, on the way down: they live
@@ -50,7 +50,7 @@ impl Evaluator {
         let owned: Arc<Shape>;
         let first: &Shape = match shape.and_then(OnceLock::get) {
             Some(s) => s,
-            None if self.memo.full() => {
+            None if self.memo.shapes_full() => {
                 return self.descend_rows(mesh.clone(), t, u, v, a, depth, face)
             }
             None => match shape {
@@ -79,7 +79,7 @@ impl Evaluator {
             let which = best_map(&cur.maps, u, v);
             let step = match cur.step(which) {
                 Some(s) => s.as_deref(),
-                None if self.memo.full() => return fallback(&chain, cur, u, v, a, depth),
+                None if self.memo.shapes_full() => return fallback(&chain, cur, u, v, a, depth),
                 None => self.shape_step(cur, which),
             };
             let Some(step) = step else {

@@ -12,7 +12,6 @@ use crate::local::{
 use crate::scheme::{Options, Scheme};
 use crate::topology::Topology;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use subfit_mesh::{Polygons, Tags};
 
@@ -152,10 +151,7 @@ impl Evaluator {
             vsemi,
             patch_start,
             roots: Vec::new(),
-            memo: MemoBudget {
-                used: AtomicUsize::new(0),
-                budget: DEFAULT_CACHE_BYTES,
-            },
+            memo: MemoBudget::new(DEFAULT_CACHE_BYTES),
             shapes: Shapes::default(),
         };
         let regular: Vec<Option<PatchCoef>> = (0..nf)
@@ -189,9 +185,11 @@ impl Evaluator {
     }
 
     /// Sets the memory budget (bytes) of the local refinements memoised by [`Self::weights`]
-    /// (default [`DEFAULT_CACHE_BYTES`]). Once the memoised nodes hold this much, further
-    /// evaluations still work and give the same results (to round-off), but refine from the
-    /// deepest memoised node each time instead of memoising more; 0 turns memoisation off.
+    /// (default [`DEFAULT_CACHE_BYTES`]; the per-patch nodes and the shared shapes of the walk
+    /// below them may each use this much). Once the memoised nodes hold this much, further
+    /// evaluations still work and give the same results (to round-off), but go on from the
+    /// deepest memoised node each time (through the shared shapes while they fit, by plain
+    /// local refinement after) instead of memoising more; 0 turns memoisation off.
     /// The budget is checked before each node is added, so concurrent evaluations may exceed it
     /// by one node (tens of kB) per thread. Does not drop what is already memoised (see
     /// [`Self::clear_cache`]).
@@ -211,9 +209,10 @@ impl Evaluator {
     }
 
     /// Approximate heap bytes held by local refinements memoised since construction (array
-    /// payloads; the regular level-0 patches built by [`Self::new`] are not counted).
+    /// payloads; the regular level-0 patches built by [`Self::new`] are not counted): the
+    /// per-patch nodes and the shared shapes, each kept within [`Self::cache_budget`].
     pub fn cache_bytes(&self) -> usize {
-        self.memo.used.load(Ordering::Relaxed)
+        self.memo.total()
     }
 
     /// Drops every memoised local refinement (keeping the regular level-0 patches built by
@@ -230,6 +229,7 @@ impl Evaluator {
         }
         self.shapes.clear();
         *self.memo.used.get_mut() = 0;
+        *self.memo.shape_used.get_mut() = 0;
     }
 
     /// The options (scheme, boundary rule).

@@ -186,7 +186,7 @@ impl super::Evaluator {
                 }
                 let (child, bytes) = self.shapes.intern(&child, c, self.options.scheme);
                 let step = Step { child, off, idx, w };
-                self.memo.add_bytes(bytes + step.heap_bytes());
+                self.memo.add_shape_bytes(bytes + step.heap_bytes());
                 Some(Arc::new(step))
             })
             .as_deref()
