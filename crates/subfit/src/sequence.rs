@@ -677,7 +677,6 @@ fn fit_frame(
     let track_time = t_track.elapsed().as_secs_f64();
     let schedule = arap_schedule(options);
     let mut iterations = 0;
-    let mut left = 0;
     for (k, &(alpha, iters)) in schedule.iter().enumerate() {
         let last = k + 1 == schedule.len();
         fitter.set_arap(alpha);
@@ -685,18 +684,9 @@ fn fit_frame(
         fitter.set_stage(options.lambda, iters, tolerance, 0.0, 1e-4);
         let r = fitter.run(&mut positions, None).map_err(fit_err)?;
         iterations += r.iterations.len();
-        left = iters.saturating_sub(r.iterations.len());
     }
     let data = data_samples(&target, options.data_samples);
-    let (mut two, _, _) = fitter.measure_two_sided(&positions, &data.points);
-    // The fitter's early stop is one-sided (surface → data): a frame whose data is not yet
-    // covered as closely goes on with the iterations its last level left.
-    if left > 0 && options.tolerance_rms > 0.0 && !two.within(options.tolerance_rms, 0.0) {
-        fitter.set_stage(options.lambda, left, 0.0, 0.0, 1e-4);
-        let r = fitter.run(&mut positions, None).map_err(fit_err)?;
-        iterations += r.iterations.len();
-        two = fitter.measure_two_sided(&positions, &data.points).0;
-    }
+    let (two, _, _) = fitter.measure_two_sided(&positions, &data.points);
     let fit_time = t.elapsed().as_secs_f64() - track_time;
     let unit = carry.normalization.length_to_original(1.0);
     let diagonal = subfit_fit::DataTerm::bbox_diagonal(&subfit_fit::FootPointTerm::from_options(

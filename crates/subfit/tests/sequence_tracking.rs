@@ -1,9 +1,8 @@
 //! The tracking step of `fit_sequence` (`subfit_fit::track`): on a generated sequence whose
 //! material spins about the body's axis (0.25 rad a frame: the surface moves little, its
 //! points much) and bends, the tracked limit points of the first frame after the template are
-//! closer to where their material went with the step than without it (measured 1.14 % vs
-//! 1.58 % of the diagonal, RMS; 3.2 % without while a frame's fit stopped on the one-sided
-//! measure alone) — closest points alone leave the cage behind.
+//! much closer to where their material went with the step than without it (measured 0.83 % vs
+//! 3.2 % of the diagonal, RMS) — closest points alone leave the cage behind.
 #![allow(clippy::print_stderr)]
 
 use subfit::mesh::deforming::{DeformingParams, DeformingSequence, DriftStats, MaterialLookup};
@@ -75,7 +74,7 @@ fn drift(tracking: bool) -> f64 {
 fn tracking_follows_motion_along_the_surface() {
     let (with, without) = (drift(true), drift(false));
     eprintln!("drift RMS at frame 1: {with:.4} with tracking, {without:.4} without");
-    assert!(with < 0.8 * without, "{with} vs {without}");
+    assert!(with < 0.5 * without, "{with} vs {without}");
 }
 
 /// A subject that holds still, scanned anew each frame (every frame its own tessellation):
