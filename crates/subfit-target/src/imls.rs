@@ -38,6 +38,36 @@ impl Target {
         imls_value(self.index(), self.points(), self.normals(), x, h)
     }
 
+    /// The IMLS value at `x` whose kernel reaches the data: [`Self::imls`] where some point lies
+    /// within the support radius `h`, else the kernel grown to `d + h`, `d` the distance to the
+    /// nearest point, so the points of a patch around the nearest one vote on the side. The
+    /// nearest point's tangent plane alone (the fallback of [`Self::imls`]) takes the side of a
+    /// single point's normal: one wrong normal, or a point of a thin part seen edge-on, puts a
+    /// far point inside (the contour of a point cloud then grows pockets, bridges and stray
+    /// components in its band).
+    ///
+    /// Where the nearest point is flagged in `rim` (`#P` flags, or empty for none: the cloud's
+    /// boundary points, [`crate::cloud_boundary_points`]) the tangent-plane fallback is kept:
+    /// beyond the data's edge the grown kernel would interpolate across a hole of the scan and
+    /// cap it. Cost: one nearest query and one more radius query where the fallback is used.
+    pub fn imls_reaching(&self, x: [f64; 3], rim: &[bool]) -> f64 {
+        let v = self.imls(x);
+        if !v.fallback {
+            return v.value;
+        }
+        let nearest = self.index().nearest(&x);
+        if rim.get(nearest.index as usize).copied().unwrap_or(false) {
+            return v.value;
+        }
+        self.imls_with_radius(x, nearest.distance + self.imls_radius())
+            .value
+    }
+
+    /// [`Self::imls_reaching`] for many points, in parallel; `#Q` values in order.
+    pub fn imls_reaching_batch(&self, xs: &[[f64; 3]], rim: &[bool]) -> Vec<f64> {
+        xs.par_iter().map(|&x| self.imls_reaching(x, rim)).collect()
+    }
+
     /// [`Self::imls`] for many points, in parallel; `#Q` results in order.
     pub fn imls_batch(&self, xs: &[[f64; 3]]) -> Vec<ImlsValue> {
         xs.par_iter().map(|&x| self.imls(x)).collect()

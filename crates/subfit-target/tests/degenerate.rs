@@ -309,3 +309,40 @@ fn progress_is_reported() {
     assert!(seen.contains(&subfit_target::Phase::Estimate));
     assert!(seen.contains(&subfit_target::Phase::Orient));
 }
+
+/// Far from the data, [`Target::imls_reaching`] lets a patch of points vote on the side: above
+/// a plane of points with upward normals, one of them flipped right under the query, the
+/// nearest point's tangent plane puts the query inside, the grown kernel outside (unless that
+/// point is flagged as the cloud's rim). Where points lie within `h` it is the IMLS value
+/// itself.
+#[test]
+fn imls_reaching_outvotes_one_wrong_normal() {
+    let n = 41;
+    let pts = grid(n, |x, y| [x, y, 0.0]);
+    let mut normals = vec![[0.0, 0.0, 1.0]; pts.len()];
+    let centre = (n / 2) * n + n / 2;
+    normals[centre] = [0.0, 0.0, -1.0];
+    let options = TargetOptions {
+        imls_radius: Some(0.05),
+        ..TargetOptions::default()
+    };
+    let t = Target::from_points(&pts, Some(&normals), &options).unwrap();
+    let above = t.to_normalized(add(pts[centre], [0.0, 0.0, 0.2]));
+    let h = t.imls_radius();
+    assert!(t.normalization().length_to_normalized(0.2) > 2.0 * h, "{h}");
+    let nearest = t.imls(above);
+    assert!(nearest.fallback && nearest.value < 0.0, "{nearest:?}");
+    let reaching = t.imls_reaching(above, &[]);
+    assert!(reaching > 0.0, "{reaching}");
+    // Beyond a point of the cloud's rim the tangent plane is kept.
+    let mut rim = vec![false; t.len()];
+    rim[t.index().nearest(&above).index as usize] = true;
+    assert_eq!(t.imls_reaching(above, &rim), nearest.value);
+    let near = t.to_normalized(add(pts[centre + 3], [0.0, 0.0, 0.005]));
+    assert!(!t.imls(near).fallback);
+    assert_eq!(t.imls_reaching(near, &rim), t.imls(near).value);
+    assert_eq!(
+        t.imls_reaching_batch(&[above, near], &[]),
+        vec![reaching, t.imls(near).value]
+    );
+}
