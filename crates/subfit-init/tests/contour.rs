@@ -127,6 +127,14 @@ fn invalid_contour_options_are_errors() {
         contour(&t, &bad),
         Err(subfit_init::ContourError::InvalidOption(_))
     ));
+    let bad = ContourOptions {
+        refine_levels: 5,
+        ..ContourOptions::default()
+    };
+    assert!(matches!(
+        contour(&t, &bad),
+        Err(subfit_init::ContourError::InvalidOption(_))
+    ));
 }
 
 #[test]
@@ -351,5 +359,70 @@ fn resolutions_out_of_range_are_errors() {
             contour(&t, &bad),
             Err(subfit_init::ContourError::InvalidOption(_))
         ));
+    }
+}
+
+/// Thin parts keep their topology with a level of refinement below the band: a thin ring (tube
+/// radius 0.02 on a ring of radius 1) and a thin genus-2 tube (half-thickness 0.03), 8,000
+/// points each. On the band level alone (the default) their insides fall between the lattice
+/// points and the contour breaks into pieces or loses its holes (the torus: 29 components;
+/// the genus-2 tube: 6 components of genus 0); with [`ContourOptions::refine_levels`] 1 it
+/// is one component of the right genus near the surface.
+#[test]
+fn thin_tubes_keep_their_topology() {
+    for shape in [
+        Shape::Torus {
+            major: 1.0,
+            minor: 0.02,
+        },
+        Shape::Genus2 { eps: 0.03 },
+    ] {
+        let t = target_of(&shape, 8000);
+        let (m, rep) = contour(&t, &ContourOptions::default()).unwrap();
+        assert_ne!(topology(&m), (shape.genus(), 0, 1), "{shape:?}: {rep:?}");
+        let refined = ContourOptions {
+            refine_levels: 1,
+            ..ContourOptions::default()
+        };
+        let (m, rep) = contour(&t, &refined).unwrap();
+        assert_eq!(topology(&m), (shape.genus(), 0, 1), "{shape:?}: {rep:?}");
+        assert_crack_free(&m);
+        let worst = m
+            .positions
+            .iter()
+            .map(|&p| distance(&shape, &t, p))
+            .fold(0.0, f64::max);
+        assert!(worst < rep.cell_size, "{shape:?}: {worst} vs {rep:?}");
+    }
+}
+
+/// A hollow ball: points on a sphere of radius 1 (normals outward) and on one of radius 0.6
+/// (normals inward, towards the cavity). The cavity is off the band and out of the flood
+/// fill's reach, and the band points around it are on its outside side: it is classified
+/// outside, and the contour is the two spheres (a region enclosed by the band was taken as
+/// inside before, which put a third, data-less sphere at the band's inner edge).
+#[test]
+fn an_enclosed_cavity_is_outside() {
+    let unit = Shape::Ellipsoid {
+        a: 1.0,
+        b: 1.0,
+        c: 1.0,
+    };
+    let outer = unit.sample(8000, 0.0, 5);
+    let inner = unit.sample(3000, 0.0, 6);
+    let mut points = outer.positions.clone();
+    let mut normals = outer.normals.clone().unwrap();
+    points.extend(inner.positions.iter().map(|p| p.map(|c| 0.6 * c)));
+    normals.extend(inner.normals.unwrap().iter().map(|n| n.map(|c| -c)));
+    let t = Target::from_points(&points, Some(&normals), &TargetOptions::default()).unwrap();
+    let (m, rep) = contour(&t, &ContourOptions::default()).unwrap();
+    assert!(rep.enclosed_nodes == 0 && !rep.flipped, "{rep:?}");
+    assert_eq!(topology(&m), (0, 0, 2), "{rep:?}");
+    for &p in &m.positions {
+        let r = subfit_mesh::vec3::norm(t.to_original(p));
+        assert!(
+            (r - 1.0).abs() < 0.05 || (r - 0.6).abs() < 0.05,
+            "{r}: {rep:?}"
+        );
     }
 }
