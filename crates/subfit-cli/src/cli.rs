@@ -76,6 +76,11 @@ pub struct InitArgs {
     /// Sharp features of a mesh target (tags are written only into an .obj output).
     #[command(flatten)]
     pub features: FeatureArgs,
+    /// Point clouds: levels of adaptive refinement of the implicit surface's octree below its
+    /// band level (0–4). 1 keeps thin parts (plates, tubes thinner than about the IMLS radius)
+    /// in one piece with their genus; the default 0 is better on clouds with small holes.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
+    pub contour_refine: u8,
     /// The scheme the cage is for: `catmull-clark` and `quad-tri` make it quad-dominant unless
     /// `--no-quad-dominant`; `loop` and `auto` keep triangles.
     #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
@@ -325,6 +330,11 @@ pub struct FitArgs {
     /// Sharp features of a mesh target.
     #[command(flatten)]
     pub features: FeatureArgs,
+    /// Point clouds: levels of adaptive refinement of the implicit surface's octree below its
+    /// band level (0–4). 1 keeps thin parts (plates, tubes thinner than about the IMLS radius)
+    /// in one piece with their genus; the default 0 is better on clouds with small holes.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
+    pub contour_refine: u8,
     /// Output directory (control.obj, control.usda, control.tags.json, limit.ply, error.ply,
     /// log.csv, preview.png, report.html, report.json).
     #[arg(short, long, default_value = "subfit-fit")]

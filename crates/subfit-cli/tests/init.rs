@@ -342,3 +342,53 @@ fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
     assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("Loop"));
 }
+
+/// A thin ring (tube radius 0.2 around a circle of radius 10, 7,200 points with normals): on
+/// the contour's band level alone the tube falls between the lattice points and the cage
+/// breaks into pieces of genus 0; `--contour-refine 1` refines the octree once more near the
+/// surface and keeps one ring of genus 1. Out-of-range levels are usage errors.
+#[test]
+fn contour_refine_keeps_a_thin_ring_in_one_piece() {
+    let d = tempfile::tempdir().unwrap();
+    let (nu, nv) = (600, 12);
+    let mut xyz = String::new();
+    for i in 0..nu {
+        let u = std::f64::consts::TAU * i as f64 / nu as f64;
+        for j in 0..nv {
+            let v = std::f64::consts::TAU * (j as f64 + 0.5 * (i % 2) as f64) / nv as f64;
+            let rho = 10.0 + 0.2 * v.cos();
+            let p = [rho * u.cos(), rho * u.sin(), 0.2 * v.sin()];
+            let n = [v.cos() * u.cos(), v.cos() * u.sin(), v.sin()];
+            let _ = writeln!(xyz, "{} {} {} {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
+        }
+    }
+    let cloud = write(d.path(), "ring.xyz", &xyz);
+    let out = d.path().join("cage.obj");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "init",
+            cloud.to_str().unwrap(),
+            "--control-points",
+            "150",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        subfit(&args)
+    };
+    let plain = run(&[]);
+    assert_eq!(plain.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&plain.stdout);
+    assert!(!text.contains("genus 1, 1 component(s)"), "{text}");
+    let refined = run(&["--contour-refine", "1"]);
+    let text = String::from_utf8_lossy(&refined.stdout);
+    assert_eq!(refined.status.code(), Some(0), "{text}");
+    assert!(
+        text.contains("genus 1, 0 boundary loop(s), 1 component(s)"),
+        "{text}"
+    );
+    let (v, f) = read_obj(&out);
+    assert_eq!(closed_genus(v.len(), &f), 1, "{text}");
+    let r = run(&["--contour-refine", "5"]);
+    assert_eq!(r.status.code(), Some(2));
+}

@@ -97,6 +97,10 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             features: a.features.options(),
             semi_sharp: a.features.semi_sharp,
             cloud_features: a.features.cloud_features,
+            contour: subfit::init::ContourOptions {
+                refine_levels: usize::from(a.contour_refine),
+                ..subfit::init::ContourOptions::default()
+            },
             ..FitScanOptions::default().init_options
         },
         ..FitScanOptions::default()

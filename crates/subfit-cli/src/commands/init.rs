@@ -93,6 +93,10 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         features: a.features.options(),
         semi_sharp: a.features.semi_sharp,
         cloud_features: a.features.cloud_features,
+        contour: subfit::init::ContourOptions {
+            refine_levels: usize::from(a.contour_refine),
+            ..subfit::init::ContourOptions::default()
+        },
         // Concave corners may add points, but not to a count asked for.
         max_control_points: if a.control_points.is_some() {
             n
