@@ -86,7 +86,7 @@ pub use remesh::RefineStats;
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
     fit_stages, StageEvent, StageOptions, StageReport, StageStop, StagesReport, StagesResult,
-    STALL_STAGES,
+    STALL_GAIN, STALL_STAGES,
 };
 pub use surface_term::{fan_triangles, SurfaceTerm, WeightedSurfaceTerm};
 pub use term::{DataTerm, Mat3};

@@ -288,7 +288,8 @@ pub enum StageStop {
     /// The control-point budget is spent and `λ` is at its end value.
     Budget,
     /// Nothing left to change (`λ` at its end, no refinement possible or useful), or
-    /// [`STALL_STAGES`] stages in a row did not improve on the best cage.
+    /// [`STALL_STAGES`] stages in a row did not improve on the best cage by more than
+    /// [`STALL_GAIN`].
     Stalled,
     /// `max_stages` or `max_iterations` reached.
     Limit,
@@ -300,6 +301,13 @@ pub enum StageStop {
 /// is spent: a single-view range scan of a bunny spent 16 stages growing 395 → 4,999 control
 /// points after its best cage, at stage 1.
 pub const STALL_STAGES: usize = 4;
+
+/// For the count of [`STALL_STAGES`], a stage improves only when it lowers the best
+/// badness (error over tolerance) by more than this fraction; the best cage is still the
+/// lowest one. A noisy scan at its noise floor creeps down by a few hundredths of a percent per
+/// stage: the 150k-point noisy beetle (0.3 % noise) went from 2,021 to 5,000 control points in
+/// 8 more stages and 35 s for 0.6 %, its data → surface RMS held up by the noise.
+pub const STALL_GAIN: f64 = 0.01;
 
 /// The log of [`fit_stages`].
 #[derive(Clone, Debug, PartialEq)]
@@ -459,6 +467,8 @@ pub fn fit_stages(
     let mut used = 0;
     let mut best: Option<Best> = None;
     let mut since_best = 0;
+    // The badness of the last stage that improved by more than STALL_GAIN.
+    let mut stall_base = f64::INFINITY;
     // Whether data → surface met the tolerances at the last measurement: until it does, a
     // stage does not stop at the one-sided tolerance.
     let mut data_met = !stages.two_sided;
@@ -539,7 +549,12 @@ pub fn fit_stages(
         };
         let badness = stages.badness(&last, &m.two_sided);
         let improved = best.as_ref().is_none_or(|b| badness < b.badness);
-        since_best = if improved { 0 } else { since_best + 1 };
+        if badness < stall_base * (1.0 - STALL_GAIN) {
+            stall_base = badness;
+            since_best = 0;
+        } else {
+            since_best += 1;
+        }
         if improved {
             best = Some(Best {
                 stage,
