@@ -19,7 +19,8 @@
 use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh};
 use subfit_target::Target;
 
-use crate::contour::{bounds, keep_components, ContourError, ContourReport};
+use crate::contour::{bounds, ContourError, ContourReport};
+use crate::islands::keep_components;
 use crate::march::{march_grid, Grid};
 
 /// Carves the space around the target's points with a ball of radius `radius` (normalized

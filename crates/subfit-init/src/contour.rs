@@ -53,9 +53,10 @@
 //! a finer resolution, a few layers of finest cells around the zero set) plus one IMLS
 //! evaluation per band point (parallel in `subfit-target`).
 
-use subfit_mesh::{face_components, Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons};
+use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh};
 use subfit_target::Target;
 
+use crate::islands::keep_components;
 use crate::march::Marcher;
 use crate::octree::{
     dilate3, face_centre, face_needs_steiner, leaf_tets, pack, unpack, KeyMap, Leaf, Octree,
@@ -875,59 +876,6 @@ fn mid_key(points: &Points, a: u32, b: u32) -> u64 {
     pack([0, 1, 2].map(|k| (pa[k] + pb[k]) / 2))
 }
 
-/// Keeps the components with at least `fraction` × (largest face count) faces; re-indexes.
-/// Returns the mesh, the number of components found and kept.
-pub(crate) fn keep_components(
-    positions: Vec<[f64; 3]>,
-    tris: &[[u32; 3]],
-    fraction: f64,
-    cover: Option<(&[[f64; 3]], f64)>,
-) -> (PolyMesh, usize, usize) {
-    let polys = Polygons::from_triangles(tris);
-    let comps = face_components(&polys, positions.len());
-    let counts = comps.face_counts();
-    let largest = counts.iter().copied().max().unwrap_or(0);
-    let mut keep: Vec<bool> = counts
-        .iter()
-        .map(|&c| c == largest || c as f64 >= fraction * largest as f64)
-        .collect();
-    if let Some((points, gap)) = cover {
-        let alone = crate::islands::uncovered_by_component(
-            points,
-            &positions,
-            &comps.vertex_labels,
-            comps.count,
-            &keep,
-            gap,
-        );
-        for (k, &a) in keep.iter_mut().zip(&alone) {
-            *k |= a >= crate::islands::MIN_ISLAND_POINTS;
-        }
-    }
-    let mut map = vec![u32::MAX; positions.len()];
-    let mut out_pos = Vec::new();
-    let mut out = Vec::new();
-    for (f, t) in tris.iter().enumerate() {
-        if !keep[comps.face_labels[f] as usize] {
-            continue;
-        }
-        out.push(t.map(|v| {
-            let m = &mut map[v as usize];
-            if *m == u32::MAX {
-                *m = out_pos.len() as u32;
-                out_pos.push(positions[v as usize]);
-            }
-            *m
-        }));
-    }
-    let kept = keep.iter().filter(|&&k| k).count();
-    (
-        PolyMesh::new(out_pos, Polygons::from_triangles(&out)),
-        comps.count,
-        kept,
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1003,7 +951,7 @@ mod tests {
         for p in &positions {
             assert!(sdf(*p).abs() < 0.5, "{p:?}");
         }
-        let mesh = PolyMesh::new(positions, Polygons::from_triangles(&tris));
+        let mesh = PolyMesh::new(positions, subfit_mesh::Polygons::from_triangles(&tris));
         let he = HalfEdgeMesh::from_mesh(&mesh).expect("manifold");
         assert_eq!(
             (he.genus(), he.boundary_loops().len(), he.components().count),

@@ -11,7 +11,9 @@
 //! sits next to data the kept surface already covers; an island is the only surface near its
 //! points. So a component that would be dropped is kept when at least [`MIN_ISLAND_POINTS`] data
 //! points lie farther than a gap from every kept component and nearest to it.
+//! [`keep_components`] applies the size rule and this one to a contour's triangles.
 
+use subfit_mesh::{face_components, PolyMesh, Polygons};
 use subfit_target::PointIndex;
 
 /// Data points an island must cover alone for it to be kept: more than a few stray points
@@ -63,6 +65,59 @@ pub fn uncovered_by_component(
         out[vertex_labels[dropped_v[n.index as usize]] as usize] += 1;
     }
     out
+}
+
+/// Keeps the components with at least `fraction` × (largest face count) faces; re-indexes.
+/// Returns the mesh, the number of components found and kept.
+pub(crate) fn keep_components(
+    positions: Vec<[f64; 3]>,
+    tris: &[[u32; 3]],
+    fraction: f64,
+    cover: Option<(&[[f64; 3]], f64)>,
+) -> (PolyMesh, usize, usize) {
+    let polys = Polygons::from_triangles(tris);
+    let comps = face_components(&polys, positions.len());
+    let counts = comps.face_counts();
+    let largest = counts.iter().copied().max().unwrap_or(0);
+    let mut keep: Vec<bool> = counts
+        .iter()
+        .map(|&c| c == largest || c as f64 >= fraction * largest as f64)
+        .collect();
+    if let Some((points, gap)) = cover {
+        let alone = uncovered_by_component(
+            points,
+            &positions,
+            &comps.vertex_labels,
+            comps.count,
+            &keep,
+            gap,
+        );
+        for (k, &a) in keep.iter_mut().zip(&alone) {
+            *k |= a >= MIN_ISLAND_POINTS;
+        }
+    }
+    let mut map = vec![u32::MAX; positions.len()];
+    let mut out_pos = Vec::new();
+    let mut out = Vec::new();
+    for (f, t) in tris.iter().enumerate() {
+        if !keep[comps.face_labels[f] as usize] {
+            continue;
+        }
+        out.push(t.map(|v| {
+            let m = &mut map[v as usize];
+            if *m == u32::MAX {
+                *m = out_pos.len() as u32;
+                out_pos.push(positions[v as usize]);
+            }
+            *m
+        }));
+    }
+    let kept = keep.iter().filter(|&&k| k).count();
+    (
+        PolyMesh::new(out_pos, Polygons::from_triangles(&out)),
+        comps.count,
+        kept,
+    )
 }
 
 #[cfg(test)]
