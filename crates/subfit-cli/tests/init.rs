@@ -212,33 +212,13 @@ fn bad_inputs_exit_with_2_and_leave_no_file() {
 #[test]
 fn a_cloud_with_bad_normals_gets_its_genus() {
     let d = tempfile::tempdir().unwrap();
-    let (nu, nv) = (120, 48);
-    let mut xyz = String::new();
-    for i in 0..nu {
-        let u = std::f64::consts::TAU * i as f64 / nu as f64;
-        for j in 0..nv {
-            let v = std::f64::consts::TAU * j as f64 / nv as f64;
-            let rho = 10.0 + 3.5 * v.cos();
-            let p = [rho * u.cos(), rho * u.sin(), 3.5 * v.sin()];
-            let s = if (i * nv + j) % 3 == 0 { -1.0 } else { 1.0 };
-            let n = [v.cos() * u.cos(), v.cos() * u.sin(), v.sin()].map(|c| s * c);
-            let _ = writeln!(xyz, "{} {} {} {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
-        }
-    }
-    let cloud = write(d.path(), "torus.xyz", &xyz);
+    let cloud = write(
+        d.path(),
+        "torus.xyz",
+        &torus_xyz(10.0, 3.5, (120, 48), false, 3),
+    );
     let out = d.path().join("cage.obj");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            "init",
-            cloud.to_str().unwrap(),
-            "--control-points",
-            "150",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        subfit(&args)
-    };
+    let run = |extra: &[&str]| init_150(&cloud, &out, extra);
     let plain = run(&[]);
     assert_eq!(plain.status.code(), Some(0));
     let text = String::from_utf8_lossy(&plain.stdout);
@@ -350,32 +330,13 @@ fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
 #[test]
 fn contour_refine_keeps_a_thin_ring_in_one_piece() {
     let d = tempfile::tempdir().unwrap();
-    let (nu, nv) = (600, 12);
-    let mut xyz = String::new();
-    for i in 0..nu {
-        let u = std::f64::consts::TAU * i as f64 / nu as f64;
-        for j in 0..nv {
-            let v = std::f64::consts::TAU * (j as f64 + 0.5 * (i % 2) as f64) / nv as f64;
-            let rho = 10.0 + 0.2 * v.cos();
-            let p = [rho * u.cos(), rho * u.sin(), 0.2 * v.sin()];
-            let n = [v.cos() * u.cos(), v.cos() * u.sin(), v.sin()];
-            let _ = writeln!(xyz, "{} {} {} {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
-        }
-    }
-    let cloud = write(d.path(), "ring.xyz", &xyz);
+    let cloud = write(
+        d.path(),
+        "ring.xyz",
+        &torus_xyz(10.0, 0.2, (600, 12), true, 0),
+    );
     let out = d.path().join("cage.obj");
-    let run = |extra: &[&str]| {
-        let mut args = vec![
-            "init",
-            cloud.to_str().unwrap(),
-            "--control-points",
-            "150",
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        subfit(&args)
-    };
+    let run = |extra: &[&str]| init_150(&cloud, &out, extra);
     let plain = run(&[]);
     assert_eq!(plain.status.code(), Some(0));
     let text = String::from_utf8_lossy(&plain.stdout);
@@ -391,4 +352,48 @@ fn contour_refine_keeps_a_thin_ring_in_one_piece() {
     assert_eq!(closed_genus(v.len(), &f), 1, "{text}");
     let r = run(&["--contour-refine", "5"]);
     assert_eq!(r.status.code(), Some(2));
+}
+
+/// A torus cloud with normals as XYZ text: `nu × nv` points on the torus of radii `major` and
+/// `minor` around z, every other ring of the tube shifted by half a step when `stagger`, the
+/// normal of every `flip`-th point reversed (0: none).
+fn torus_xyz(
+    major: f64,
+    minor: f64,
+    (nu, nv): (usize, usize),
+    stagger: bool,
+    flip: usize,
+) -> String {
+    let mut xyz = String::new();
+    for i in 0..nu {
+        let u = std::f64::consts::TAU * i as f64 / nu as f64;
+        let shift = if stagger { 0.5 * (i % 2) as f64 } else { 0.0 };
+        for j in 0..nv {
+            let v = std::f64::consts::TAU * (j as f64 + shift) / nv as f64;
+            let rho = major + minor * v.cos();
+            let p = [rho * u.cos(), rho * u.sin(), minor * v.sin()];
+            let s = if flip > 0 && (i * nv + j) % flip == 0 {
+                -1.0
+            } else {
+                1.0
+            };
+            let n = [v.cos() * u.cos(), v.cos() * u.sin(), v.sin()].map(|c| s * c);
+            let _ = writeln!(xyz, "{} {} {} {} {} {}", p[0], p[1], p[2], n[0], n[1], n[2]);
+        }
+    }
+    xyz
+}
+
+/// `subfit init CLOUD --control-points 150 -o OUT EXTRA…`.
+fn init_150(cloud: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "init",
+        cloud.to_str().unwrap(),
+        "--control-points",
+        "150",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    subfit(&args)
 }
