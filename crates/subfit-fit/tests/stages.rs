@@ -207,3 +207,62 @@ fn stages_give_up_when_the_gain_is_below_the_stall_gain() {
     // Counting every gain, however small, the driver would have gone on.
     assert!(rms.len() < last_better + 1 + STALL_STAGES, "{summary:?}");
 }
+
+/// With the control-point budget spent and `λ` at its end, a stage only flips edges: the first
+/// such stage that does not gain more than [`STALL_GAIN`] over the last stage that did ends the
+/// fit ([`StageStop::Budget`]), where before it went on as long as any stage gained at all (the
+/// noisy Lucy: 0.1 % for its last 7 s). A noisy ellipsoid (20,000 points, noise 0.002) under a
+/// tolerance far below its noise spends a budget of 150 in 7 stages; its 8th, at 150 points,
+/// keeps a flip and gains 0.1 %.
+#[test]
+fn a_spent_budget_ends_at_the_first_stage_without_a_real_gain() {
+    let cloud = Shape::PAPER_ELLIPSOID.sample(20_000, 0.002, 5);
+    let target = Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .unwrap();
+    let mesh = normalized(&target, &fourteen_vertex_mesh());
+    let stages = StageOptions {
+        tolerance_rms: 1e-5,
+        max_control_points: 150,
+        max_stages: 40,
+        ..StageOptions::default()
+    };
+    let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
+    let r = &out.report;
+    let rms: Vec<f64> = r
+        .stages
+        .iter()
+        .map(|s| {
+            s.two_sided
+                .data_to_surface
+                .rms
+                .max(s.two_sided.surface_to_data.rms)
+        })
+        .collect();
+    let summary: Vec<_> = r
+        .stages
+        .iter()
+        .zip(&rms)
+        .map(|(s, e)| (s.num_control_points, s.lambda, *e))
+        .collect();
+    assert_eq!(r.stop, StageStop::Budget, "{summary:?}");
+    // The first stage with the budget spent and λ at its end that gains no more than
+    // STALL_GAIN over the last stage that did is the last stage.
+    let mut base = f64::INFINITY;
+    let mut end = None;
+    for (k, &(n, lambda, e)) in summary.iter().enumerate() {
+        let gained = e < base * (1.0 - STALL_GAIN);
+        if gained {
+            base = e;
+        }
+        if n >= stages.max_control_points && lambda <= stages.lambda_end && !gained {
+            end = Some(k);
+            break;
+        }
+    }
+    assert_eq!(Some(r.stages.len() - 1), end, "{summary:?}");
+    assert!(out.mesh.num_vertices() <= stages.max_control_points);
+}
