@@ -28,6 +28,19 @@
 //! the orientation of the whole cage is taken from the majority of pairs, so either winding
 //! works).
 //!
+//! **Noisy point clouds** ([`subfit_target::TargetStats::is_noisy`]): interior pairs count
+//! everywhere at full weight, point-to-plane along the surface's normal at the sample
+//! (`Q_j = n_k n_kᵀ`; a noisy cloud's own normals are noisier). Cheng et al.'s one-sided term
+//! is small for any surface inside the band of noisy points — every sample has a point near
+//! it — so the surface drifts within the band; the data → surface least squares pins it to
+//! the middle of the band (the scan's mean). Measured on 150k-point clouds with 0.3 % noise
+//! and 3 % outliers (`hard_cases noisy`), `subfit fit` with defaults, two-sided RMS to the
+//! clean mesh as a fraction of its diagonal, before → after: Lucy 1.84e-3 → 1.37e-3,
+//! armadillo 1.36e-3 → 1.03e-3, camel head 1.15e-3 → 1.00e-3, bunny 1.08e-3 → 9.9e-4, Igea
+//! 9.4e-4 → 8.9e-4, rocker arm 6.7e-4 → 5.7e-4, fertility 5.6e-4 → 4.8e-4; the beetle, fitted
+//! to its 5,000-point budget, 7.9e-4 → 1.02e-3 (at about 30 points per control point the
+//! pairs' own noise, σ·√(3·#control points / #points), is no longer small).
+//!
 //! Per sample the assigned data points sum to one quadratic `eᵀ Q e − 2 eᵀ b + c` in
 //! `e = S_k − x₀` (`x₀` the sample at the projection), added to the sample's own model. The
 //! weight `w` is [`crate::FitOptions::coverage`] (1: both directions count alike; 0: off, the
@@ -76,6 +89,9 @@ pub struct Coverage {
     weight: f64,
     /// Whether interior pairs (point-to-plane) count too; see [`Self::with_interior`].
     interior: bool,
+    /// A noisy point cloud: interior pairs count everywhere, along the sample's normal (see
+    /// the module docs).
+    noisy: bool,
     /// The fitter's sample tessellation (faces over sample rows), set by [`Self::prepare`].
     faces: Polygons,
     /// Sample rows on the tessellation's boundary.
@@ -228,6 +244,7 @@ impl Coverage {
             boundary,
             weight,
             interior: open,
+            noisy: target.stats().is_noisy(),
             faces: Polygons::default(),
             sample_boundary: Vec::new(),
             rings: Vec::new(),
@@ -406,8 +423,8 @@ impl Coverage {
             let point_to_point = !known || self.boundary[j] || past_rim;
             // An interior pair counts only where the data is uncovered: from 0 at two sample
             // spacings (a covered point is within about one of its nearest sample) to full
-            // weight at four.
-            let gate = if point_to_point {
+            // weight at four; on a noisy cloud everywhere.
+            let gate = if point_to_point || self.noisy {
                 1.0
             } else if self.interior && spacing > 0.0 {
                 (dist / (2.0 * spacing) - 1.0).clamp(0.0, 1.0)
@@ -419,7 +436,12 @@ impl Coverage {
             }
             let sum =
                 out[k as usize].get_or_insert_with(|| Box::new(CoverSum::new(xs[k as usize])));
-            sum.add(self.points[j], (!point_to_point).then_some(n), w * gate);
+            let plane = if self.noisy {
+                sample_normals[k as usize]
+            } else {
+                n
+            };
+            sum.add(self.points[j], (!point_to_point).then_some(plane), w * gate);
         }
         self.assign_features(xs, spacing, &mut out);
         out

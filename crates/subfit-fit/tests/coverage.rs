@@ -4,7 +4,7 @@
 //! shrunk inside it.
 
 use subfit_fit::{
-    fit_stages, DataTerm, FitOptions, Fitter, FootPointTerm, FootSample, StageOptions,
+    fit_stages, Coverage, DataTerm, FitOptions, Fitter, FootPointTerm, FootSample, StageOptions,
 };
 use subfit_mesh::{PolyMesh, Polygons};
 use subfit_report::MeshDistance;
@@ -313,5 +313,87 @@ fn feature_curves_pull_the_creases_perpendicular_to_them() {
     assert!(
         (energy - expected).abs() < 1e-9 * expected,
         "{energy} vs {expected}"
+    );
+}
+
+/// On a noisy cloud every data point pulls its nearest sample along the surface's normal, not
+/// only uncovered data: Cheng et al.'s one-sided term is small for any surface inside the band
+/// of noisy points, so only this data → surface least squares puts the surface in the band's
+/// middle. A plane of 3,600 points with Gaussian noise σ = 0.05 across it, and a flat cage
+/// one σ above it: the pulls, summed over the samples, move the cage to the band's middle
+/// (the old rule counted no pair here, every point being within a sample spacing).
+#[test]
+fn a_noisy_cloud_pulls_the_surface_to_the_middle_of_its_band() {
+    let (n, sigma) = (60, 0.05);
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut uniform = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut points = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            // Box–Muller.
+            let (u, v) = (uniform().max(1e-300), uniform());
+            let z = sigma * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+            let at = |k: usize| -1.0 + 2.0 * (k as f64 + 0.5) / n as f64;
+            points.push([at(i), at(j), z]);
+        }
+    }
+    let target = Target::from_points(&points, None, &TargetOptions::default()).unwrap();
+    assert!(target.stats().is_noisy(), "{:?}", target.stats());
+    // A 6 × 6 grid of triangles over the square, one σ above the plane (normalized units).
+    let k = 6;
+    let mut cage = Vec::new();
+    for i in 0..=k {
+        for j in 0..=k {
+            let at = |k2: usize| -1.0 + 2.0 * k2 as f64 / k as f64;
+            cage.push(target.to_normalized([at(i), at(j), sigma]));
+        }
+    }
+    let id = |i: usize, j: usize| (i * (k + 1) + j) as u32;
+    let mut tris = Vec::new();
+    for i in 0..k {
+        for j in 0..k {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let faces = Polygons::from_triangles(&tris);
+    let op = sampling_operator(
+        &faces,
+        cage.len(),
+        &Default::default(),
+        &Options::new(Scheme::Loop),
+        3,
+    )
+    .unwrap();
+    let mut coverage = Coverage::new(&target, 1.0);
+    coverage.prepare(&op);
+    let xs = op.position.apply(&cage);
+    let sums = coverage.assign(&xs);
+    let pairs: u32 = sums.iter().flatten().map(|s| s.count()).sum();
+    assert!(pairs as usize >= points.len() / 2, "{pairs} pairs");
+    // The common shift t of all samples along z minimizing the summed quadratics:
+    // t = −Σ r_z / Σ Q_zz with (Q, r) the models at the samples.
+    let (mut q, mut r) = (0.0, 0.0);
+    for (s, &x) in sums.iter().zip(&xs) {
+        if let Some(s) = s {
+            let (qs, rs) = s.model(x);
+            q += qs[2][2];
+            r += rs[2];
+        }
+    }
+    let t = -r / q;
+    // Normalized units: the plane is at z = 0 and the cage at σ·scale.
+    let scale = target.to_normalized([0.0, 0.0, sigma])[2] - target.to_normalized([0.0; 3])[2];
+    let plane = target.to_normalized([0.0; 3])[2];
+    let lands = xs[0][2] + t - plane;
+    assert!(
+        lands.abs() < 0.15 * scale,
+        "the cage lands {:.3} σ from the plane",
+        lands / scale
     );
 }
