@@ -261,6 +261,15 @@ pub struct FitArgs {
     /// Step control: none, Levenberg-Marquardt, or Armijo backtracking.
     #[arg(long, value_enum, default_value_t = StepArg::Lm)]
     pub step: StepArg,
+    /// Optimizer: Gauss-Newton on the sparse normal equations, or a first-order method on the
+    /// objective's gradient Cᵀ ∂E/∂S (Xie et al. 2023 fit with Adam); an iteration of a
+    /// first-order method is 25 gradient steps.
+    #[arg(long, value_enum, default_value_t = OptimizerArg::GaussNewton)]
+    pub optimizer: OptimizerArg,
+    /// `--optimizer adam`: the step size, in unit-cube units (the largest move of a control
+    /// point per step).
+    #[arg(long, default_value_t = 1e-3)]
+    pub learning_rate: f64,
     /// Smoothing weight λ of the first stage (dimensionless; 0 disables smoothing).
     #[arg(long, default_value_t = 1e-3)]
     pub lambda: f64,
@@ -466,6 +475,17 @@ pub enum MethodArg {
     Sdm,
     /// The IMLS distance (Xie et al. 2023).
     Imls,
+}
+
+/// An optimizer named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum OptimizerArg {
+    /// Gauss-Newton with the --step control (Cheng et al. 2007).
+    GaussNewton,
+    /// Adam (Kingma & Ba 2015), step size --learning-rate.
+    Adam,
+    /// L-BFGS (argmin's, More-Thuente line search, 7 correction pairs).
+    Lbfgs,
 }
 
 /// A step control named on the command line.

@@ -18,12 +18,14 @@ use crate::arap::ArapState;
 use crate::assemble::{FillScratch, Pattern};
 use crate::error::{FitError, FitPhase};
 use crate::foot_point_term::FootPointTerm;
-use crate::options::{FitOptions, StepControl};
+use crate::options::{FitOptions, Optimizer, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
 use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
 use crate::surface_term::fan_triangles;
 use crate::term::{DataTerm, Mat3};
+
+mod first_order;
 
 /// LM damping beyond `μ > MU_MAX · max diag(H)` means no descent is possible.
 const MU_MAX: f64 = 1e16;
@@ -514,6 +516,9 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         if self.reached(&cur.stats) {
             report.stop = StopReason::Tolerance;
             return Ok(report);
+        }
+        if opts.optimizer != Optimizer::GaussNewton {
+            return self.run_first_order(control, report, progress);
         }
         let mut lm = Damping {
             mu: f64::NAN,

@@ -79,7 +79,10 @@ pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
 pub use foot_point_term::{FootPointSource, FootPointTerm, FootSample};
 pub use imls_term::{ImlsSample, ImlsTerm};
-pub use options::{FillOrdering, FitOptions, LinearSolver, Method, StepControl, Variant};
+pub use options::{
+    FillOrdering, FitOptions, LinearSolver, Method, Optimizer, StepControl, Variant,
+    FIRST_ORDER_STEPS,
+};
 pub use pcg::PcgStats;
 pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};
 pub use remesh::RefineStats;

@@ -41,6 +41,33 @@ pub enum StepControl {
     Armijo,
 }
 
+/// The optimizer of [`crate::Fitter::run`]. Gauss-Newton solves the sparse normal equations
+/// of the quadratic models (Cheng et al. 2007); the first-order optimizers only need the
+/// objective and its gradient `∇_P F = Cᵀ ∂F/∂S` ([`crate::Fitter::objective_and_gradient`]),
+/// the path of a differentiable pipeline (Xie et al. 2023 §3.1 fit with Adam). With a
+/// first-order optimizer one iteration is [`FIRST_ORDER_STEPS`] gradient steps, so that the
+/// iteration budgets of the stages stay comparable.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Optimizer {
+    /// Gauss-Newton with the step control of [`FitOptions::step`]. The default.
+    #[default]
+    GaussNewton,
+    /// Adam (Kingma & Ba 2015), β₁ = 0.9, β₂ = 0.999, ε = 1e-12, with this step size
+    /// (normalized units: the largest move of a control point per step).
+    Adam {
+        /// Step size α (normalized units).
+        learning_rate: f64,
+    },
+    /// L-BFGS (argmin's, with a More–Thuente line search) keeping this many correction pairs.
+    Lbfgs {
+        /// Correction pairs kept (argmin's `m`).
+        memory: usize,
+    },
+}
+
+/// Gradient steps per iteration of a first-order [`Optimizer`].
+pub const FIRST_ORDER_STEPS: usize = 25;
+
 /// The eight variants named in Cheng 2007 (§II-D, §IV-C).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Variant {
@@ -124,6 +151,8 @@ pub struct FitOptions {
     pub method: Method,
     /// Step control. Default [`StepControl::LevenbergMarquardt`].
     pub step: StepControl,
+    /// Optimizer. Default [`Optimizer::GaussNewton`].
+    pub optimizer: Optimizer,
     /// Smoothing weight `λ` of `F_s = λ/n Σ|W(P_i)|²` (§II-E; dimensionless, as the error term
     /// is a mean over samples). Default `1e-3` (the papers' starting value); 0 disables it.
     pub lambda: f64,
@@ -223,6 +252,7 @@ impl Default for FitOptions {
             sample_level: 3,
             method: Method::Sdm,
             step: StepControl::LevenbergMarquardt,
+            optimizer: Optimizer::GaussNewton,
             lambda: 1e-3,
             max_iterations: 20,
             tolerance_rms: 0.0,
@@ -351,6 +381,12 @@ impl FitOptions {
                 return Err((name, v));
             }
         }
-        Ok(())
+        match self.optimizer {
+            Optimizer::Adam { learning_rate: a } if !(a.is_finite() && a > 0.0) => {
+                Err(("optimizer learning_rate", a))
+            }
+            Optimizer::Lbfgs { memory: 0 } => Err(("optimizer memory", 0.0)),
+            _ => Ok(()),
+        }
     }
 }

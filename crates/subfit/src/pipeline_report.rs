@@ -249,6 +249,9 @@ pub struct OptionsSummary {
     /// Weight `α` of the ARAP regularizer (0: off).
     #[serde(default)]
     pub arap: f64,
+    /// The optimizer (`GaussNewton`, `Adam`, `Lbfgs`; `--optimizer`).
+    #[serde(default)]
+    pub optimizer: String,
 }
 
 /// One stage.

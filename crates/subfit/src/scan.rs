@@ -576,6 +576,12 @@ pub fn fit_scan(
             imls_radius: (fit.method == subfit_fit::Method::Imls)
                 .then(|| subfit_fit::ImlsTerm::from_options(&target, &fit).radius()),
             arap: fit.arap,
+            optimizer: match fit.optimizer {
+                subfit_fit::Optimizer::GaussNewton => "GaussNewton",
+                subfit_fit::Optimizer::Adam { .. } => "Adam",
+                subfit_fit::Optimizer::Lbfgs { .. } => "Lbfgs",
+            }
+            .into(),
         },
         control_points: result.mesh.num_vertices(),
         control_faces: result.mesh.faces.len(),

@@ -6,12 +6,12 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use subfit::fit::{FitOptions, Method, StageOptions, StepControl};
+use subfit::fit::{FitOptions, Method, Optimizer, StageOptions, StepControl};
 use subfit::init::InitOptions;
 use subfit::subdiv::Scheme;
 use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, OUTPUTS};
 
-use crate::cli::{quad_dominant_flag, FitArgs, MethodArg, SchemeArg, StepArg};
+use crate::cli::{quad_dominant_flag, FitArgs, MethodArg, OptimizerArg, SchemeArg, StepArg};
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let fitted = execute(&a)?;
@@ -71,6 +71,13 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             sample_level: a.sample_level as usize,
             method,
             step,
+            optimizer: match a.optimizer {
+                OptimizerArg::GaussNewton => Optimizer::GaussNewton,
+                OptimizerArg::Adam => Optimizer::Adam {
+                    learning_rate: a.learning_rate,
+                },
+                OptimizerArg::Lbfgs => Optimizer::Lbfgs { memory: 7 },
+            },
             coverage: a.coverage,
             imls_radius: a.imls_radius,
             arap: a.arap,
