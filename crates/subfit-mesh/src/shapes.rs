@@ -700,3 +700,83 @@ mod cage_tests {
         assert!(far.positions.iter().all(|&p| s.implicit(p).abs() > 0.05));
     }
 }
+
+/// A small seeded xorshift generator (Marsaglia 2003) for the hard-case generators
+/// ([`noisy_scan`] and the `hard_cases` example): the same stream on every machine and with
+/// every version of `rand`, so measured clouds can be made again.
+#[derive(Clone, Debug)]
+pub struct XorShift(u64);
+
+impl XorShift {
+    /// The generator of `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D))
+    }
+
+    /// Uniform in `[0, 1)`.
+    pub fn uniform(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Standard normal (Box–Muller).
+    pub fn normal(&mut self) -> f64 {
+        let (u, v) = (self.uniform().max(1e-300), self.uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+}
+
+/// A noisy scan of `mesh` (issue 16): `n` points sampled uniformly by area, each moved by
+/// Gaussian noise of `noise` × the bounding-box diagonal per coordinate, followed by
+/// `outliers` × `n` points uniform in the bounding box grown by 10 % per side. Seeded by
+/// `seed` ([`XorShift`]). An empty vector for a mesh without faces or area.
+/// Cost: O(n log #faces).
+pub fn noisy_scan(
+    mesh: &PolyMesh,
+    n: usize,
+    noise: f64,
+    outliers: f64,
+    seed: u64,
+) -> Vec<[f64; 3]> {
+    let Some((lo, hi)) = mesh.bounding_box() else {
+        return Vec::new();
+    };
+    let mut rng = XorShift::new(seed);
+    let diag = crate::vec3::norm(crate::vec3::sub(hi, lo));
+    let tris = mesh.faces.triangulate_fan();
+    let mut cdf = Vec::with_capacity(tris.len());
+    let mut total = 0.0;
+    for t in &tris {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        let x = crate::vec3::cross(crate::vec3::sub(b, a), crate::vec3::sub(c, a));
+        total += 0.5 * dot(x, x).sqrt();
+        cdf.push(total);
+    }
+    if tris.is_empty() || total <= 0.0 {
+        return Vec::new();
+    }
+    let mut points = Vec::with_capacity(n + (outliers * n as f64) as usize);
+    for _ in 0..n {
+        let r = rng.uniform() * total;
+        let f = cdf.partition_point(|&c| c < r).min(tris.len() - 1);
+        let [a, b, c] = tris[f].map(|i| mesh.positions[i as usize]);
+        let (mut u, mut v) = (rng.uniform(), rng.uniform());
+        if u + v > 1.0 {
+            (u, v) = (1.0 - u, 1.0 - v);
+        }
+        points.push(
+            [0, 1, 2].map(|k| {
+                a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]) + noise * diag * rng.normal()
+            }),
+        );
+    }
+    for _ in 0..(outliers * n as f64) as usize {
+        points.push([0, 1, 2].map(|k| {
+            let pad = 0.1 * (hi[k] - lo[k]);
+            lo[k] - pad + rng.uniform() * (hi[k] - lo[k] + 2.0 * pad)
+        }));
+    }
+    points
+}

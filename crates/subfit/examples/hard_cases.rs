@@ -27,23 +27,9 @@
 use std::collections::VecDeque;
 use std::path::Path;
 
+use subfit::mesh::shapes::{noisy_scan, XorShift};
 use subfit::mesh::vec3::{self, cross, dot, norm, sub};
 use subfit::mesh::{PolyMesh, Polygons};
-
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let (u, v) = (self.next().max(1e-300), self.next());
-        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-    }
-}
 
 /// The bounding box of a mesh's positions (an input mesh has some).
 fn bounds(mesh: &PolyMesh) -> ([f64; 3], [f64; 3]) {
@@ -62,7 +48,7 @@ fn range_scan(
     view: Option<[f64; 3]>,
     seed: u64,
 ) -> Vec<[f64; 3]> {
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
+    let mut rng = XorShift::new(seed);
     let (lo, hi) = bounds(mesh);
     let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
     let diag = norm(sub(hi, lo));
@@ -175,7 +161,7 @@ fn keep_faces(mesh: &PolyMesh, keep: &[bool]) -> PolyMesh {
 }
 
 fn holes(mesh: &PolyMesh, count: usize, radius: f64, seed: u64) -> (PolyMesh, usize) {
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
+    let mut rng = XorShift::new(seed);
     let (lo, hi) = bounds(mesh);
     let r = radius * norm(sub(hi, lo));
     let vf = vertex_faces(mesh);
@@ -187,7 +173,7 @@ fn holes(mesh: &PolyMesh, count: usize, radius: f64, seed: u64) -> (PolyMesh, us
         if made == count {
             break;
         }
-        let v = (rng.next() * mesh.positions.len() as f64) as usize;
+        let v = (rng.uniform() * mesh.positions.len() as f64) as usize;
         let c = mesh.positions[v.min(mesh.positions.len() - 1)];
         let Some(&f0) = vf[v].first() else { continue };
         let mut disc = vec![f0];
@@ -247,43 +233,6 @@ fn cut(mesh: &PolyMesh, axis: usize, fraction: f64) -> PolyMesh {
     keep_faces(mesh, &keep)
 }
 
-fn noisy(mesh: &PolyMesh, n: usize, noise: f64, outliers: f64, seed: u64) -> Vec<[f64; 3]> {
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15 ^ seed.wrapping_mul(0x2545_F491_4F6C_DD1D));
-    let (lo, hi) = bounds(mesh);
-    let diag = norm(sub(hi, lo));
-    let tris = mesh.faces.triangulate_fan();
-    let mut cdf = Vec::with_capacity(tris.len());
-    let mut total = 0.0;
-    for t in &tris {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        let x = cross(sub(b, a), sub(c, a));
-        total += 0.5 * dot(x, x).sqrt();
-        cdf.push(total);
-    }
-    let mut points = Vec::with_capacity(n + (outliers * n as f64) as usize);
-    for _ in 0..n {
-        let r = rng.next() * total;
-        let f = cdf.partition_point(|&c| c < r).min(tris.len() - 1);
-        let [a, b, c] = tris[f].map(|i| mesh.positions[i as usize]);
-        let (mut u, mut v) = (rng.next(), rng.next());
-        if u + v > 1.0 {
-            (u, v) = (1.0 - u, 1.0 - v);
-        }
-        points.push(
-            [0, 1, 2].map(|k| {
-                a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]) + noise * diag * rng.normal()
-            }),
-        );
-    }
-    for _ in 0..(outliers * n as f64) as usize {
-        points.push([0, 1, 2].map(|k| {
-            let pad = 0.1 * (hi[k] - lo[k]);
-            lo[k] - pad + rng.next() * (hi[k] - lo[k] + 2.0 * pad)
-        }));
-    }
-    points
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let usage = "hard_cases range-scan|holes|noisy|cut IN OUT [options]";
@@ -320,7 +269,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let noise = arg(4).map_or(Ok(0.003), str::parse)?;
             let outliers = arg(5).map_or(Ok(0.03), str::parse)?;
             let seed = arg(6).map_or(Ok(1), str::parse)?;
-            PolyMesh::point_cloud(noisy(&mesh, n, noise, outliers, seed), None)
+            PolyMesh::point_cloud(noisy_scan(&mesh, n, noise, outliers, seed), None)
         }
         "cut" => {
             let axis = match arg(3).unwrap_or("y") {
