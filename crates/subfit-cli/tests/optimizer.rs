@@ -1,14 +1,9 @@
 //! `subfit fit --optimizer adam|lbfgs`: the first-order path of issue 16 runs end to end,
 //! is recorded in report.json, lowers the error, and a bad step size is a usage error.
 
-use std::process::{Command, Output};
+mod common;
 
-fn subfit(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_subfit"))
-        .args(args)
-        .output()
-        .expect("run subfit")
-}
+use common::subfit;
 
 #[test]
 fn first_order_optimizers_fit_and_are_reported() {

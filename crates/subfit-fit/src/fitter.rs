@@ -488,18 +488,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             });
         }
         let opts = self.options.clone();
-        if let Some(a) = &mut self.arap {
-            match &opts.arap_rest {
-                Some(rest) if rest.len() == n => a.ensure(rest),
-                Some(rest) => {
-                    return Err(FitError::BadInput(format!(
-                        "the ARAP rest shape has {} points, the mesh has {n} control points",
-                        rest.len()
-                    )))
-                }
-                None => a.ensure(control),
-            };
-        }
+        self.ensure_arap(control)?;
         self.ensure_fixed(control);
         let mut cur = self.state(control, &mut PhaseTimings::default());
         check_finite(cur.stats.objective, 0, FitPhase::Evaluate, "objective")?;
@@ -629,6 +618,25 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             }
         }
         Ok(report)
+    }
+
+    /// Builds the ARAP regularizer, if on and not built yet, with the rest shape of the options
+    /// or else `control`. Errors: a rest shape of another size than the cage.
+    fn ensure_arap(&mut self, control: &[[f64; 3]]) -> Result<(), FitError> {
+        let n = control.len();
+        if let Some(a) = &mut self.arap {
+            match &self.options.arap_rest {
+                Some(rest) if rest.len() == n => a.ensure(rest),
+                Some(rest) => {
+                    return Err(FitError::BadInput(format!(
+                        "the ARAP rest shape has {} points, the mesh has {n} control points",
+                        rest.len()
+                    )))
+                }
+                None => a.ensure(control),
+            };
+        }
+        Ok(())
     }
 
     /// Evaluates trial control points along `dir` with fresh projections and decides, per the

@@ -159,32 +159,8 @@ fn stages_give_up_when_no_stage_improves_on_the_best() {
 /// not after the last stage that gained at all (19 stages with a gain of 0).
 #[test]
 fn stages_give_up_when_the_gain_is_below_the_stall_gain() {
-    let cloud = Shape::PAPER_ELLIPSOID.sample(6_000, 0.01, 5);
-    let target = Target::from_points(
-        &cloud.positions,
-        cloud.normals.as_deref(),
-        &TargetOptions::default(),
-    )
-    .unwrap();
-    let mesh = normalized(&target, &fourteen_vertex_mesh());
-    let stages = StageOptions {
-        tolerance_rms: 1e-5,
-        max_control_points: 3_000,
-        max_stages: 40,
-        ..StageOptions::default()
-    };
-    let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
+    let (out, rms, _) = noisy_ellipsoid_stages(6_000, 0.01, 3_000);
     let r = &out.report;
-    let rms: Vec<f64> = r
-        .stages
-        .iter()
-        .map(|s| {
-            s.two_sided
-                .data_to_surface
-                .rms
-                .max(s.two_sided.surface_to_data.rms)
-        })
-        .collect();
     let summary: Vec<_> = r
         .stages
         .iter()
@@ -216,32 +192,8 @@ fn stages_give_up_when_the_gain_is_below_the_stall_gain() {
 /// keeps a flip and gains 0.1 %.
 #[test]
 fn a_spent_budget_ends_at_the_first_stage_without_a_real_gain() {
-    let cloud = Shape::PAPER_ELLIPSOID.sample(20_000, 0.002, 5);
-    let target = Target::from_points(
-        &cloud.positions,
-        cloud.normals.as_deref(),
-        &TargetOptions::default(),
-    )
-    .unwrap();
-    let mesh = normalized(&target, &fourteen_vertex_mesh());
-    let stages = StageOptions {
-        tolerance_rms: 1e-5,
-        max_control_points: 150,
-        max_stages: 40,
-        ..StageOptions::default()
-    };
-    let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
+    let (out, rms, stages) = noisy_ellipsoid_stages(20_000, 0.002, 150);
     let r = &out.report;
-    let rms: Vec<f64> = r
-        .stages
-        .iter()
-        .map(|s| {
-            s.two_sided
-                .data_to_surface
-                .rms
-                .max(s.two_sided.surface_to_data.rms)
-        })
-        .collect();
     let summary: Vec<_> = r
         .stages
         .iter()
@@ -265,4 +217,41 @@ fn a_spent_budget_ends_at_the_first_stage_without_a_real_gain() {
     }
     assert_eq!(Some(r.stages.len() - 1), end, "{summary:?}");
     assert!(out.mesh.num_vertices() <= stages.max_control_points);
+}
+
+/// Stages on a noisy sample of the paper ellipsoid (`points`, Gaussian noise `noise` × the
+/// diagonal, seed 5) from the 14-point cage, under a tolerance far below the noise, with the
+/// budget `budget`: the result, each stage's judged two-sided RMS, and the stage options.
+fn noisy_ellipsoid_stages(
+    points: usize,
+    noise: f64,
+    budget: usize,
+) -> (subfit_fit::StagesResult, Vec<f64>, StageOptions) {
+    let cloud = Shape::PAPER_ELLIPSOID.sample(points, noise, 5);
+    let target = Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .unwrap();
+    let mesh = normalized(&target, &fourteen_vertex_mesh());
+    let stages = StageOptions {
+        tolerance_rms: 1e-5,
+        max_control_points: budget,
+        max_stages: 40,
+        ..StageOptions::default()
+    };
+    let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
+    let rms = out
+        .report
+        .stages
+        .iter()
+        .map(|s| {
+            s.two_sided
+                .data_to_surface
+                .rms
+                .max(s.two_sided.surface_to_data.rms)
+        })
+        .collect();
+    (out, rms, stages)
 }

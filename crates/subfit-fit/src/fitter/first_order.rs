@@ -36,9 +36,9 @@ const EPSILON: f64 = 1e-12;
 impl<T: DataTerm> Fitter<'_, T> {
     /// The objective `F` at `control` (as reported in [`crate::ErrorStats::objective`]) and its
     /// gradient with respect to the control points (`n by 3`), over all samples. The ARAP
-    /// regularizer, if on and not yet built, is built with `control` as its rest shape.
+    /// regularizer, if on and not yet built, is built as by [`Fitter::run`].
     ///
-    /// Errors: a wrong number of control points, non-finite values.
+    /// Errors: a wrong number of control points or rest points, non-finite values.
     /// Cost: one projection of the samples, one product with `Cᵀ`, O(nnz(L)) for the
     /// smoothing, one 3×3 SVD per control point for ARAP.
     pub fn objective_and_gradient(
@@ -52,12 +52,7 @@ impl<T: DataTerm> Fitter<'_, T> {
                 self.pattern.num_points()
             )));
         }
-        if let Some(a) = &mut self.arap {
-            match &self.options.arap_rest {
-                Some(rest) if rest.len() == control.len() => a.ensure(rest),
-                _ => a.ensure(control),
-            };
-        }
+        self.ensure_arap(control)?;
         let state = self.full_state(control, &mut PhaseTimings::default());
         let g = self.gradient_at(control, &state);
         check_finite(state.stats.objective, 0, FitPhase::Evaluate, "objective")?;
