@@ -30,6 +30,16 @@
 //! its nearest sample and adds its quadratic to that sample's model and objective share
 //! ([`crate::coverage`]). The measured error ([`DataTerm::squared_error`], and everything
 //! from [`DataTerm::project_fresh`]) stays the surface → data distance.
+//!
+//! With an error power `p > 2` ([`FitOptions::error_power`]) the surface → data part is the
+//! mean of `e_k^p / r^(p−2)` instead of `e_k²`, `r` the RMS error at the term's first
+//! projection of all samples: every projection weights each sample's quadratic by
+//! `w_k = (e_k / r)^(p−2)` (clamped to [[`POWER_WEIGHT_MIN`], [`POWER_WEIGHT_MAX`]]), which
+//! is iteratively reweighted least squares for the `L_p` norm (Lawson's algorithm tends to the
+//! minimax fit as `p` grows). The objective `Σ w_k e_k²` is then a function of the control
+//! points alone (the weights follow the errors), so the step controls compare trials as
+//! before. A larger `p` lowers the largest errors at some cost in RMS: the stages' last
+//! polish ([`crate::StageOptions::polish_power`]).
 
 use std::sync::{Mutex, PoisonError};
 
@@ -40,6 +50,15 @@ use subfit_target::{FootPoint, Target};
 use crate::coverage::{CoverSum, Coverage};
 use crate::options::FitOptions;
 use crate::term::{add_mat, mul, DataTerm, Mat3, IDENTITY};
+
+/// The smallest weight `(e_k / r)^(p−2)` a sample gets with an error power `p > 2` (see the
+/// module docs): samples far below the RMS keep a twentieth of their pull, so the surface
+/// where it fits does not drift while the largest errors are lowered.
+pub const POWER_WEIGHT_MIN: f64 = 0.05;
+
+/// The largest weight a sample gets with an error power `p > 2`: one sample (an outlier the
+/// cleaning left, a spike) cannot take over the fit.
+pub const POWER_WEIGHT_MAX: f64 = 20.0;
 
 /// The error term (distance measure) used to build the quadratic model (Cheng 2007 §II-D).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -103,6 +122,10 @@ pub struct FootPointTerm<'t> {
     /// and which lies beyond the data's edge is pulled point-to-point (see
     /// [`DataTerm::model`]); empty for a closed target.
     rim: Vec<bool>,
+    /// The error power `p` ([`FitOptions::error_power`]; 2: least squares).
+    power: f64,
+    /// With `p > 2`: the mean squared error `r²` at the first projection of all samples.
+    reference: std::sync::OnceLock<f64>,
 }
 
 /// What [`FootPointTerm`] keeps per sample: the foot point and, on projections of all samples
@@ -113,6 +136,9 @@ pub struct FootSample {
     pub foot: FootPoint,
     /// The data points whose nearest sample this is (see [`crate::coverage`]).
     pub cover: Option<Box<CoverSum>>,
+    /// The weight of the sample's own quadratic: 1, or `(e_k / r)^(p−2)` with an error power
+    /// `p > 2` (see the module docs).
+    pub weight: f64,
 }
 
 impl std::ops::Deref for FootSample {
@@ -124,7 +150,11 @@ impl std::ops::Deref for FootSample {
 
 fn plain(feet: Vec<FootPoint>) -> Vec<FootSample> {
     feet.into_iter()
-        .map(|foot| FootSample { foot, cover: None })
+        .map(|foot| FootSample {
+            foot,
+            cover: None,
+            weight: 1.0,
+        })
         .collect()
 }
 
@@ -138,6 +168,43 @@ impl<'t> FootPointTerm<'t> {
             hints: Mutex::new(Vec::new()),
             coverage: None,
             rim: Vec::new(),
+            power: 2.0,
+            reference: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// The term with error power `p` (`2 ≤ p ≤ 8`; see the module docs and
+    /// [`FitOptions::error_power`]).
+    pub fn with_power(mut self, p: f64) -> Self {
+        self.power = p;
+        self
+    }
+
+    /// With an error power `p > 2`: weights every sample `(e_k / r)^(p−2)` by its error `e_k`
+    /// at `xs` (the first call over all samples fixes `r`). Cost: O(#samples).
+    fn weigh(&self, out: &mut [FootSample], xs: &[[f64; 3]], all: bool) {
+        if self.power <= 2.0 || out.is_empty() {
+            return;
+        }
+        let e2: Vec<f64> = out
+            .iter()
+            .zip(xs)
+            .map(|(f, &x)| self.squared_error(f, x))
+            .collect();
+        let mean = e2.iter().sum::<f64>() / e2.len() as f64;
+        let r2 = if all {
+            *self.reference.get_or_init(|| mean)
+        } else {
+            self.reference.get().copied().unwrap_or(mean)
+        };
+        if !(r2 > 0.0 && r2.is_finite()) {
+            return;
+        }
+        let half = 0.5 * (self.power - 2.0);
+        for (f, e) in out.iter_mut().zip(e2) {
+            f.weight = (e / r2)
+                .powf(half)
+                .clamp(POWER_WEIGHT_MIN, POWER_WEIGHT_MAX);
         }
     }
 
@@ -145,7 +212,8 @@ impl<'t> FootPointTerm<'t> {
     /// [`FitOptions::coverage`] > 0 adds the data → surface part, with
     /// [`FitOptions::feature_segments`] fitted by the creases).
     pub fn from_options(target: &'t Target, options: &FitOptions) -> Self {
-        let term = Self::new(target, options.method, options.foot_points);
+        let term =
+            Self::new(target, options.method, options.foot_points).with_power(options.error_power);
         if options.coverage > 0.0 {
             let mut term = term.with_coverage(options.coverage);
             if let Some(f) = &options.feature_segments {
@@ -243,9 +311,10 @@ impl<'t> FootPointTerm<'t> {
 impl DataTerm for FootPointTerm<'_> {
     type Sample = FootSample;
 
-    /// PD without coverage: `Q = I` (coverage adds point-to-plane matrices).
+    /// PD without coverage and error power: `Q = I` (coverage adds point-to-plane matrices,
+    /// a power weights).
     fn isotropic(&self) -> bool {
-        self.method == Method::Pdm && self.coverage.is_none()
+        self.method == Method::Pdm && self.coverage.is_none() && self.power <= 2.0
     }
 
     fn prepare(&mut self, op: &subfit_subdiv::SamplingOperator) {
@@ -260,14 +329,20 @@ impl DataTerm for FootPointTerm<'_> {
         let Some(rows) = rows else {
             let feet = self.foot_points_hinted(xs, &mut hints);
             drop(hints);
-            let Some(c) = &self.coverage else {
-                return plain(feet);
+            let mut out = match &self.coverage {
+                None => plain(feet),
+                Some(c) => feet
+                    .into_iter()
+                    .zip(c.assign(xs))
+                    .map(|(foot, cover)| FootSample {
+                        foot,
+                        cover,
+                        weight: 1.0,
+                    })
+                    .collect(),
             };
-            return feet
-                .into_iter()
-                .zip(c.assign(xs))
-                .map(|(foot, cover)| FootSample { foot, cover })
-                .collect();
+            self.weigh(&mut out, xs, true);
+            return out;
         };
         let need = rows.iter().max().map_or(0, |&k| k as usize + 1);
         if hints.len() < need {
@@ -278,7 +353,9 @@ impl DataTerm for FootPointTerm<'_> {
         for (&k, &h) in rows.iter().zip(&sub) {
             hints[k as usize] = h;
         }
-        plain(feet)
+        let mut out = plain(feet);
+        self.weigh(&mut out, xs, false);
+        out
     }
 
     fn project_fresh(&self, xs: &[[f64; 3]]) -> Vec<FootSample> {
@@ -291,14 +368,15 @@ impl DataTerm for FootPointTerm<'_> {
         (0..3).map(|a| (x[a] - f.point[a]).powi(2)).sum::<f64>()
     }
 
-    /// `‖x − V‖²` plus the assigned data points' share.
+    /// `w ‖x − V‖²` (`w` the sample's weight) plus the assigned data points' share.
     #[inline]
     fn objective_error(&self, f: &FootSample, x: [f64; 3]) -> f64 {
-        let own = self.squared_error(f, x);
+        let own = f.weight * self.squared_error(f, x);
         f.cover.as_ref().map_or(own, |c| own + c.energy(x))
     }
 
-    /// [`error_matrix`] and `Q (x − V)` (PD: `x − V`), plus the assigned data points' model.
+    /// [`error_matrix`] and `Q (x − V)` (PD: `x − V`), times the sample's weight, plus the
+    /// assigned data points' model.
     #[inline]
     fn model(&self, f: &FootSample, x: [f64; 3]) -> (Mat3, [f64; 3]) {
         let e = std::array::from_fn(|a| x[a] - f.point[a]);
@@ -310,6 +388,12 @@ impl DataTerm for FootPointTerm<'_> {
             let q = error_matrix(self.method, f);
             let r = mul(&q, e);
             (q, r)
+        };
+        let (q, r) = if f.weight == 1.0 {
+            (q, r)
+        } else {
+            let w = f.weight;
+            (q.map(|row| row.map(|v| w * v)), r.map(|v| w * v))
         };
         match &f.cover {
             None => (q, r),

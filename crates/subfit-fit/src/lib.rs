@@ -61,6 +61,7 @@ mod imls_term;
 mod options;
 mod ordering;
 mod pcg;
+pub mod polish;
 mod refine_polygons;
 mod remesh;
 mod report;
@@ -77,7 +78,9 @@ pub use arap::Arap;
 pub use coverage::{CoverSum, Coverage, FEATURE_WEIGHT};
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
-pub use foot_point_term::{FootPointSource, FootPointTerm, FootSample};
+pub use foot_point_term::{
+    FootPointSource, FootPointTerm, FootSample, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN,
+};
 pub use imls_term::{ImlsSample, ImlsTerm};
 pub use options::{
     FillOrdering, FitOptions, LinearSolver, Method, Optimizer, StepControl, Variant,

@@ -208,6 +208,14 @@ pub struct FitOptions {
     /// they pull the creases of the limit surface onto them ([`crate::Coverage::with_features`]).
     /// Default `None`; `subfit::fit_scan` sets the features its initial cage was built along.
     pub feature_segments: Option<Arc<Vec<[[f64; 3]; 2]>>>,
+    /// The exponent `p` of the surface → data error the foot-point terms minimize:
+    /// `F = mean_k e_k^p / r^(p−2) + …`, `r` the RMS error at the fit's first projection (so
+    /// `F` stays in squared units). 2 (the default) is least squares, the papers' objective;
+    /// a larger `p` trades a little RMS for a lower maximum (iteratively reweighted least
+    /// squares: each sample's model is weighted by `(e_k / r)^(p−2)`, clamped to
+    /// [[`POWER_WEIGHT_MIN`], [`POWER_WEIGHT_MAX`]]). [`crate::fit_stages`] ends with such a
+    /// polish ([`crate::StageOptions::polish_power`]). Valid: `2 ≤ p ≤ 8`.
+    pub error_power: f64,
     /// [`Method::Imls`]: the kernel support radius `h` (normalized units, the unit cube the
     /// target is scaled into — the units of Xie et al. 2023 §5.1's `h₀`). Default `None`:
     /// chosen from the target ([`crate::ImlsTerm::auto_radius`]: half the point spacing, at
@@ -270,6 +278,7 @@ impl Default for FitOptions {
             pcg_max_iterations: 500,
             foot_points: FootPointSource::Auto,
             coverage: 0.0,
+            error_power: 2.0,
             feature_segments: None,
             imls_radius: None,
             imls_tangential: 0.0,
@@ -332,8 +341,13 @@ impl FitOptions {
     pub(crate) fn validate(&self) -> Result<(), (&'static str, f64)> {
         let h = self.imls_radius.unwrap_or(1.0);
         let w = self.surface_term.as_ref().map_or(0.0, |t| t.weight);
-        let checks: [(&'static str, f64, bool); 14] = [
+        let checks: [(&'static str, f64, bool); 15] = [
             ("surface_term.weight", w, w >= 0.0),
+            (
+                "error_power",
+                self.error_power,
+                (2.0..=8.0).contains(&self.error_power),
+            ),
             ("coverage", self.coverage, self.coverage >= 0.0),
             ("lambda", self.lambda, self.lambda >= 0.0),
             ("imls_radius", h, h > 0.0),

@@ -30,12 +30,13 @@ use crate::any_term::AnyTerm;
 use crate::error::FitError;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
+use crate::polish::polish_best;
 use crate::refine_polygons::refine_polygons;
 use crate::remesh::{
     apply_flips, face_errors, face_owners, independent_flips, refine_red_green_with_parents,
     FaceError, RefineStats,
 };
-use crate::report::{ErrorStats, FitReport, IterationRow};
+use crate::report::{ErrorStats, FitReport, IterationRow, StopReason};
 use crate::term::DataTerm;
 
 /// Options of the stage driver; the per-iteration options (method, step control, sample
@@ -91,6 +92,10 @@ pub struct StageOptions {
     /// Data → surface samples of a mesh target, uniform by area (0 = as many as it has
     /// points; a point cloud always uses its points). Default 0.
     pub data_samples: usize,
+    /// The error power of the last step, a polish of the best cage towards a lower maximum
+    /// error ([`crate::polish`]; [`FitOptions::error_power`]); kept only when it lowers the
+    /// maximum without costing RMS. Default 3; 2 or less turns it off. Valid: `≤ 8`.
+    pub polish_power: f64,
 }
 
 impl Default for StageOptions {
@@ -114,6 +119,7 @@ impl Default for StageOptions {
             local_rings: 2,
             two_sided: true,
             data_samples: 0,
+            polish_power: 3.0,
         }
     }
 }
@@ -138,6 +144,9 @@ impl StageOptions {
         }
         if !(self.tolerance_max >= 0.0 && self.tolerance_max.is_finite()) {
             return bad("tolerance_max", self.tolerance_max);
+        }
+        if self.polish_power.is_nan() || self.polish_power > 8.0 {
+            return bad("polish_power", self.polish_power);
         }
         if !(self.growth > 0.0 && self.growth.is_finite()) {
             return bad("growth", self.growth);
@@ -174,7 +183,7 @@ impl StageOptions {
     }
 
     /// The judged RMS and maximum: the worse direction of `two` when two-sided, else `e`.
-    fn judged(&self, e: &ErrorStats, two: &TwoSided) -> (f64, f64) {
+    pub(crate) fn judged(&self, e: &ErrorStats, two: &TwoSided) -> (f64, f64) {
         if self.two_sided {
             (two.rms(), two.max())
         } else {
@@ -193,7 +202,7 @@ impl StageOptions {
 
     /// How far a cage is from its tolerances: the largest ratio of judged error to tolerance
     /// over those set, or the judged RMS when none is. Lower is better.
-    fn badness(&self, e: &ErrorStats, two: &TwoSided) -> f64 {
+    pub(crate) fn badness(&self, e: &ErrorStats, two: &TwoSided) -> f64 {
         let (rms, max) = self.judged(e, two);
         let mut b: f64 = 0.0;
         if self.tolerance_rms > 0.0 {
@@ -233,6 +242,9 @@ pub struct StageReport {
     /// Control points optimized in this stage when it was local ([`StageOptions::local`]);
     /// `None`: all of them.
     pub active_points: Option<usize>,
+    /// `Some(kept)` for the last step, the polish of the best cage ([`crate::polish`]): whether
+    /// the polished cage replaced it. `None` for the stages before.
+    pub polish: Option<bool>,
     /// Wall time of the stage (fit, flips and refinement).
     pub time: Duration,
 }
@@ -370,13 +382,17 @@ pub enum StageEvent<'a> {
 /// The cage of one topology with what is built for it: the fitter (sampling operator, pattern,
 /// symbolic factorization) and the control face of every face of the sample tessellation.
 /// Rebuilt only when the topology changes (refinement, flips); a `λ` change keeps both.
-struct Topo<'t> {
-    fitter: Fitter<'t, AnyTerm<'t>>,
+pub(crate) struct Topo<'t> {
+    pub(crate) fitter: Fitter<'t, AnyTerm<'t>>,
     owners: Vec<u32>,
 }
 
 impl<'t> Topo<'t> {
-    fn new(target: &'t Target, mesh: &PolyMesh, opts: &FitOptions) -> Result<Self, FitError> {
+    pub(crate) fn new(
+        target: &'t Target,
+        mesh: &PolyMesh,
+        opts: &FitOptions,
+    ) -> Result<Self, FitError> {
         let term = AnyTerm::from_options(target, opts);
         let fitter = Fitter::with_term(term, &mesh.faces, mesh.num_vertices(), opts)?;
         let owners = face_owners(&mesh.faces, fitter.sampling_operator());
@@ -385,8 +401,8 @@ impl<'t> Topo<'t> {
 }
 
 /// Both-way distances of one cage, with per-face errors for refinement.
-struct Measurement {
-    two_sided: TwoSided,
+pub(crate) struct Measurement {
+    pub(crate) two_sided: TwoSided,
     /// Surface → data, per control face.
     surface_faces: Vec<FaceError>,
     /// Data → surface, per control face (the face of each data point's closest point).
@@ -398,7 +414,7 @@ struct Measurement {
 /// sample stands for in the tessellation, as a measurement uniform by area would see them),
 /// and the distance of every data sample to the tessellation of the samples (the
 /// level-`l` limit points; within its chordal error of the limit surface).
-fn measure(
+pub(crate) fn measure(
     topo: &Topo<'_>,
     faces: &Polygons,
     positions: &[[f64; 3]],
@@ -422,13 +438,13 @@ fn measure(
 }
 
 /// The best cage measured so far.
-struct Best {
-    stage: usize,
-    badness: f64,
-    mesh: PolyMesh,
-    tags: Tags,
-    errors: ErrorStats,
-    two_sided: TwoSided,
+pub(crate) struct Best {
+    pub(crate) stage: usize,
+    pub(crate) badness: f64,
+    pub(crate) mesh: PolyMesh,
+    pub(crate) tags: Tags,
+    pub(crate) errors: ErrorStats,
+    pub(crate) two_sided: TwoSided,
 }
 
 /// Fits `mesh` (control points in the target's normalized units; crease and corner tags in
@@ -546,6 +562,7 @@ pub fn fit_stages(
             flips_kept: 0,
             refine: None,
             active_points,
+            polish: None,
             time: Duration::ZERO,
         };
         let badness = stages.badness(&last, &m.two_sided);
@@ -624,6 +641,7 @@ pub fn fit_stages(
         if let Some(p) = progress.as_mut() {
             p(StageEvent::Stage(&report));
         }
+        let ran_out = report.fit.stop == StopReason::MaxIterations;
         reports.push(report);
         if stop == StageStop::Tolerance {
             break;
@@ -638,7 +656,12 @@ pub fn fit_stages(
         // within 1 % of it, at 1.4 s and 17 s; the noisy Lucy's last stage at its 5,000 points
         // gained 0.1 % in 7 s.)
         let spent = n >= stages.max_control_points && next_lambda >= lambda;
-        if !changed || (spent && since_best > 0) || since_best >= STALL_STAGES {
+        // A stage that gained and whose fit ran out of iterations, not of descent, goes on
+        // with more at the same `λ` even when nothing else changes: with a cage at its budget
+        // from the start (`--max-control-points` at the initial cage's size) the stages
+        // otherwise end after the `λ` schedule, two or three stages short of convergence.
+        let going = since_best == 0 && ran_out;
+        if (!changed && !going) || (spent && since_best > 0) || since_best >= STALL_STAGES {
             stop = if mesh.num_vertices() >= stages.max_control_points {
                 StageStop::Budget
             } else {
@@ -649,7 +672,28 @@ pub fn fit_stages(
         lambda = next_lambda;
     }
     let (initial, initial_two_sided) = initial.unwrap_or_default();
-    let best = best.ok_or_else(|| FitError::BadInput("no stage was run".into()))?;
+    let mut best = best.ok_or_else(|| FitError::BadInput("no stage was run".into()))?;
+    let lambda = reports.get(best.stage).map_or(lambda, |r| r.lambda);
+    let left = stages
+        .iterations_per_stage
+        .min(stages.max_iterations.saturating_sub(used));
+    let stage = reports.len();
+    if let Some(r) = polish_best(
+        target,
+        base,
+        stages,
+        &mut best,
+        &data.points,
+        stage,
+        lambda,
+        left,
+        &mut progress,
+    )? {
+        if r.polish == Some(true) && stages.met(&best.errors, &best.two_sided) {
+            stop = StageStop::Tolerance;
+        }
+        reports.push(r);
+    }
     Ok(StagesResult {
         mesh: best.mesh,
         tags: best.tags,

@@ -161,6 +161,7 @@ fn the_model_is_the_gauss_newton_model_of_the_objective_share() {
         let bare = FootSample {
             foot: s.foot,
             cover: None,
+            weight: 1.0,
         };
         let (_, r_foot) = term.model(&bare, x);
         let half = |y: [f64; 3]| 0.5 * s.cover.as_ref().map_or(0.0, |c| c.energy(y));

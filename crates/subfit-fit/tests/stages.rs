@@ -123,6 +123,8 @@ fn stages_give_up_when_no_stage_improves_on_the_best() {
         tolerance_max: 1e-3,
         max_control_points: 100_000,
         max_stages: 40,
+        // The stall rule is the stage loop's; the polish after it has its own test.
+        polish_power: 2.0,
         ..StageOptions::default()
     };
     let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
@@ -239,6 +241,8 @@ fn noisy_ellipsoid_stages(
         tolerance_rms: 1e-5,
         max_control_points: budget,
         max_stages: 40,
+        // The stall rules are the stage loop's; the polish after it has its own test.
+        polish_power: 2.0,
         ..StageOptions::default()
     };
     let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();

@@ -133,8 +133,13 @@ impl Fitted {
     pub fn summary(&self) -> String {
         let r = &self.report;
         let two = &r.r#final.two_sided;
+        let polish = match r.stages.last().and_then(|s| s.polish_kept) {
+            Some(true) => " (the last a max-error polish, kept)",
+            Some(false) => " (the last a max-error polish, not kept)",
+            None => "",
+        };
         format!(
-            "{} → {} control points, {} stages, {} iterations ({}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (surface → data); two-sided E_rms {:.3e}, E_max {:.3e} ({:.2e} / {:.2e} of the diagonal; unit cube)",
+            "{} → {} control points, {} stages{polish}, {} iterations ({}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (surface → data); two-sided E_rms {:.3e}, E_max {:.3e} ({:.2e} / {:.2e} of the diagonal; unit cube)",
             r.init.control_points,
             r.control_points,
             r.stages.len(),

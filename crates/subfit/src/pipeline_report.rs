@@ -287,6 +287,10 @@ pub struct StageSummary {
     pub active_points: Option<usize>,
     /// Refinement after the fit: faces marked, red and green splits, new points.
     pub refine: Option<RefineSummary>,
+    /// The last step only, the polish of the best cage towards a lower maximum error
+    /// (`subfit_fit::polish`): whether the polished cage was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polish_kept: Option<bool>,
     /// Seconds.
     pub time_s: f64,
 }
@@ -327,6 +331,7 @@ impl From<&StageReport> for StageSummary {
                 green: r.green,
                 new_points: r.new_points,
             }),
+            polish_kept: s.polish,
             time_s: s.time.as_secs_f64(),
         }
     }
