@@ -10,8 +10,9 @@
 //! from `L_2` towards the minimax fit), same topology, same `λ`, at most one stage's
 //! iterations from the remaining budget. The polished cage is measured both ways like every
 //! stage and kept only when it lowers the judged maximum by more than [`POLISH_MIN_GAIN`]
-//! while the judged RMS rises by at most [`POLISH_RMS_SLACK`] and every tolerance the cage met
-//! still holds; otherwise the best cage stands as it was.
+//! while the judged RMS and the fitter's own surface → data RMS rise by at most
+//! [`POLISH_RMS_SLACK`] and every tolerance the cage met still holds; otherwise the best cage
+//! stands as it was.
 //!
 //! `p = 3` ([`crate::StageOptions::polish_power`]'s default) was chosen on a dense mesh made
 //! as the Catmull-Clark limit of an artist-like 201-point mixed cage
@@ -96,8 +97,12 @@ pub(crate) fn polish_best(
         let (rms0, max0) = stages.judged(&best.errors, &best.two_sided);
         let (rms1, max1) = stages.judged(&last, &m.two_sided);
         let was_met = stages.met(&best.errors, &best.two_sided);
+        // The fitter's own RMS too: on a cage that already fits to rounding (an L prism with
+        // its creases), the two-sided measure is only the tessellation's chordal error, and a
+        // polish that moved the surface off the data measured "better" there.
         let better = max1 < (1.0 - POLISH_MIN_GAIN) * max0
             && rms1 <= (1.0 + POLISH_RMS_SLACK) * rms0
+            && last.e_rms <= (1.0 + POLISH_RMS_SLACK) * best.errors.e_rms
             && (!was_met || stages.met(&last, &m.two_sided));
         two_sided = m.two_sided;
         rounds += 1;
