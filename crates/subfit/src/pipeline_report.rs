@@ -242,6 +242,9 @@ pub struct OptionsSummary {
     pub local: bool,
     /// Rings around a local change.
     pub local_rings: usize,
+    /// The error power of the last stage's max-error polish (2 or less: none).
+    #[serde(default)]
+    pub polish_power: f64,
     /// `--method imls`: the IMLS kernel support radius `h` in use (normalized units); absent
     /// for the foot-point methods.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -573,6 +573,7 @@ pub fn fit_scan(
             max_depth: st.max_depth,
             local: st.local,
             local_rings: st.local_rings,
+            polish_power: st.polish_power,
             imls_radius: (fit.method == subfit_fit::Method::Imls)
                 .then(|| subfit_fit::ImlsTerm::from_options(&target, &fit).radius()),
             arap: fit.arap,

@@ -97,6 +97,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             local: a.local,
             local_rings: a.local_rings as usize,
             two_sided: !a.one_sided,
+            polish_power: a.polish_power,
             ..StageOptions::default()
         },
         error_scale: a.error_scale,
