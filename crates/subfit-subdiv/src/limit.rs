@@ -180,7 +180,7 @@ fn needs_refinement(topo: &Topology, options: &Options) -> bool {
 }
 
 /// The child mesh's adjacency as the last product reads it: the closed form of module `child`
-/// (Loop, Catmull-Clark), or built from the child faces (quad/triangle).
+/// (Loop, Catmull-Clark), or built from it (quad/triangle).
 enum ChildView<'a> {
     Closed(ChildCorners<'a>),
     Built(Box<Topology>),

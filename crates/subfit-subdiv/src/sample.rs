@@ -11,8 +11,10 @@
 //!
 //! Only the control mesh's adjacency is built from its face list
 //! ([`Topology::new`](crate::Topology::new)); that of each finer level is read off the level
-//! above (module `child`) — for levels `1 … l − 1` as a [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so no adjacency with
-//! one entry per corner of the finest mesh is built, and no intermediate face list.
+//! above (module `child`, for all three schemes) — for levels `1 … l − 1` as a
+//! [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so
+//! no adjacency with one entry per corner of the finest mesh is built, and no intermediate face
+//! list.
 //!
 //! Semi-sharp tags ([`crate::crease`]): the refinement rows blend the sharp and smooth rules.
 //! Where finite sharpness is left around a level-`l` vertex its limit row is computed by local
