@@ -32,7 +32,7 @@
 
 use crate::error::SubdivError;
 use crate::refine::FacePoints;
-use crate::scheme::Scheme;
+use crate::scheme::{FaceKinds, Scheme};
 use crate::topology::{ClosedForm, Topology};
 
 const NONE: u32 = u32::MAX;
@@ -108,9 +108,17 @@ impl<'a> ChildCorners<'a> {
         }
     }
 
-    /// Whether the children are triangles (Loop) rather than quads (Catmull-Clark).
-    pub(crate) fn triangles(&self) -> bool {
-        self.scheme == Split::Triangles
+    /// The kinds of the child faces of a ring of this child (`ring.corners`).
+    pub(crate) fn face_kinds(&self, ring: &ChildRing) -> FaceKinds {
+        match self.scheme {
+            Split::Triangles => FaceKinds::Triangles,
+            Split::Quads => FaceKinds::Polygons,
+            Split::Mixed => FaceKinds::from_triangles(
+                ring.corners
+                    .iter()
+                    .map(|&x| matches!(self.locate(x), Loc::Tri { .. })),
+            ),
+        }
     }
 
     /// Number of child vertices.
@@ -516,27 +524,4 @@ impl ClosedForm for ChildCorners<'_> {
 /// Cost O(#child corners), parallel except for the edge numbering and the face offsets.
 pub(crate) fn refined_topology(parent: &Topology, scheme: Scheme) -> Result<Topology, SubdivError> {
     Topology::from_closed_form(&ChildCorners::new(parent, scheme))
-}
-
-impl ChildRing {
-    /// The ring of vertex `w` of a built adjacency, as [`ChildCorners::ring`] gives it for a
-    /// closed-form child.
-    pub(crate) fn from_topology(topo: &Topology, w: u32, ring: &mut ChildRing) {
-        ring.corners.clear();
-        ring.corners.extend_from_slice(topo.vertex_corners(w));
-        ring.verts.clear();
-        ring.verts.extend_from_slice(topo.vertex_ring(w));
-        ring.boundary.clear();
-        ring.boundary.extend(
-            topo.vertex_edges(w)
-                .iter()
-                .map(|&e| topo.is_boundary_edge(e)),
-        );
-        ring.diagonals.clear();
-        ring.diagonals.extend(
-            topo.vertex_corners(w)
-                .iter()
-                .map(|&c| topo.corner_vertex(topo.corner_next(topo.corner_next(c)))),
-        );
-    }
 }

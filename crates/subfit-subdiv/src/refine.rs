@@ -794,6 +794,11 @@ mod tests {
                             assert_eq!(ring.corners, c.vertex_corners(w), "{what}");
                             assert_eq!(ring.boundary, b, "{what}");
                             assert_eq!(ring.diagonals, d, "{what}");
+                            // (Loop and Catmull-Clark name their one kind even for a vertex
+                            // without faces.)
+                            if scheme == Scheme::QuadTriangle {
+                                assert_eq!(k.face_kinds(&ring), face_kinds(c, w), "{what}");
+                            }
                         }
                     }
                 }
