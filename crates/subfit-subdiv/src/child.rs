@@ -142,8 +142,8 @@ impl<'a> ChildCorners<'a> {
         let t = self.topo;
         let nc = u32::try_from(self.num_corners()).expect("more than u32::MAX child corners");
         match self.scheme {
-            Split::Quads => (0..=nc).step_by(4).collect(),
-            Split::Triangles => (0..=nc).step_by(3).collect(),
+            Split::Quads => (0..=nc / 4).map(|f| 4 * f).collect(),
+            Split::Triangles => (0..=nc / 3).map(|f| 3 * f).collect(),
             Split::Mixed => {
                 let mut out = Vec::with_capacity(nc as usize / 4 + 1);
                 for f in 0..t.num_faces() {
@@ -173,6 +173,16 @@ impl<'a> ChildCorners<'a> {
     /// Where child corner `x` lies.
     #[inline]
     fn locate(&self, x: u32) -> Loc {
+        if self.scheme == Split::Triangles {
+            // The general path below, with the parent triangle's first corner `3 (x / 12)`
+            // known without looking up its face (Loop's every corner query goes through here).
+            let l = x % 12;
+            return Loc::Tri {
+                c0: 3 * (x / 12),
+                j: l / 3,
+                i: l % 3,
+            };
+        }
         let c = x / 4;
         match self.triangle_of(c) {
             Some(c0) => {
@@ -236,6 +246,10 @@ impl<'a> ChildCorners<'a> {
     /// The corner after child corner `x` in its (child) face.
     #[inline]
     pub(crate) fn next(&self, x: u32) -> u32 {
+        if self.scheme == Split::Triangles {
+            // Loop's child triangles start at multiples of 3: no need to locate the parent.
+            return x - x % 3 + (x + 1) % 3;
+        }
         match self.locate(x) {
             Loc::Quad { c, k } => 4 * c + (k + 1) % 4,
             Loc::Tri { c0, j, i } => 4 * c0 + 3 * j + (i + 1) % 3,
@@ -291,7 +305,9 @@ impl<'a> ChildCorners<'a> {
                 if c == NONE {
                     continue;
                 }
-                out.extend(self.edge_side(c).entries().iter().map(|s| s.0));
+                let mut side = [(0, 0, 0); 3];
+                let n = self.edge_side(c, &mut side);
+                out.extend(side[..n].iter().map(|s| s.0));
             }
         } else {
             let f = self.points.face((w - nv - ne) as usize);
@@ -301,12 +317,13 @@ impl<'a> ChildCorners<'a> {
     }
 
     /// The child edges leaving the edge point of parent corner `c`'s edge into `c`'s face, in
-    /// counter-clockwise order about the edge point, as `(child corner, far end, diagonal)`:
-    /// under Catmull-Clark's pattern, toward the vertex point of `next(c)`'s vertex and toward
-    /// the face point; under Loop's (corner `c0 + k`), toward the vertex point of `v_{k+1}` and
-    /// the edge points of `e_{k+1}` and `e_{k+2}`.
+    /// counter-clockwise order about the edge point, as `(child corner, far end, diagonal)`
+    /// written to the front of `out`; returns how many (2 or 3). Under Catmull-Clark's pattern
+    /// they go toward the vertex point of `next(c)`'s vertex and toward the face point; under
+    /// Loop's (corner `c0 + k`), toward the vertex point of `v_{k+1}` and the edge points of
+    /// `e_{k+1}` and `e_{k+2}`.
     #[inline]
-    fn edge_side(&self, c: u32) -> Side {
+    fn edge_side(&self, c: u32, out: &mut [(u32, u32, u32)]) -> usize {
         let t = self.topo;
         let nv = self.nv;
         match self.triangle_of(c) {
@@ -314,22 +331,24 @@ impl<'a> ChildCorners<'a> {
                 let k = c - c0;
                 let (k1, k2) = (c0 + (k + 1) % 3, c0 + (k + 2) % 3);
                 let (e1, e2) = (nv + t.corner_edge(k1), nv + t.corner_edge(k2));
-                Side::Three([
+                out[..3].copy_from_slice(&[
                     (4 * c0 + 3 * (k1 - c0) + 2, t.corner_vertex(k1), e1),
                     (4 * c0 + 9 + k, e1, e2),
                     (4 * c0 + 3 * k + 1, e2, t.corner_vertex(c)),
-                ])
+                ]);
+                3
             }
             None => {
                 let n = t.corner_next(c);
-                Side::Two([
+                out[..2].copy_from_slice(&[
                     (4 * n + 3, t.corner_vertex(n), nv + t.corner_edge(n)),
                     (
                         4 * c + 1,
                         self.face_point(t.corner_face(c)),
                         nv + t.corner_edge(t.corner_prev(c)),
                     ),
-                ])
+                ]);
+                2
             }
         }
     }
@@ -360,19 +379,16 @@ impl<'a> ChildCorners<'a> {
             }
         } else if w < nv + ne {
             let [c0, c1] = t.edge_corners(w - nv);
-            let first = self.edge_side(c0);
+            let mut sides = [(0, 0, 0); 6];
+            let n0 = self.edge_side(c0, &mut sides);
             if c1 == NONE {
-                ring.push_rotated(first.entries(), false);
+                ring.push_rotated(&sides[..n0], false);
                 ring.verts.push(t.corner_vertex(c0));
                 ring.boundary[0] = true;
                 ring.boundary.push(true);
             } else {
-                let (first, second) = (first.entries(), self.edge_side(c1));
-                let second = second.entries();
-                let mut both = [(0, 0, 0); 6];
-                both[..first.len()].copy_from_slice(first);
-                both[first.len()..first.len() + second.len()].copy_from_slice(second);
-                ring.push_rotated(&both[..first.len() + second.len()], true);
+                let n1 = self.edge_side(c1, &mut sides[n0..]);
+                ring.push_rotated(&sides[..n0 + n1], true);
             }
         } else {
             // Face point (not a triangle): one child edge per parent edge, starting at the
@@ -432,22 +448,6 @@ impl<'a> ChildCorners<'a> {
             assert!(ring.corners.len() <= outgoing.len());
         }
         assert_eq!(ring.corners.len(), outgoing.len());
-    }
-}
-
-/// The child edges on one side of a parent edge ([`ChildCorners::edge_side`]): two in a face
-/// split into quads, three in a triangle.
-enum Side {
-    Two([(u32, u32, u32); 2]),
-    Three([(u32, u32, u32); 3]),
-}
-
-impl Side {
-    fn entries(&self) -> &[(u32, u32, u32)] {
-        match self {
-            Side::Two(e) => e,
-            Side::Three(e) => e,
-        }
     }
 }
 
