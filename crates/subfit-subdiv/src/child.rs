@@ -17,7 +17,7 @@
 //!   schemes the child corners of the parent face whose first corner is `c0` start at `4 c0`
 //!   (Loop's `12f`, Catmull-Clark's `4c`): a child corner's parent face is that of parent
 //!   corner `x / 4`, and only the pattern inside it depends on the face's size. Face points
-//!   are numbered over the non-triangles ([`crate::refine`]).
+//!   are numbered over the non-triangles ([`mod@crate::refine`]).
 //!
 //! Rings are then walked exactly as [`Topology::new`] walks them (counter-clockwise from the
 //! leading boundary edge, or from the vertex's lowest-numbered corner), so a child ring here

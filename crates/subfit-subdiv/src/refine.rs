@@ -240,7 +240,7 @@ pub fn refine(
 pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
     Refinement {
         faces: child_faces(topo, options.scheme),
-        num_vertices: child_num_vertices(topo, options.scheme),
+        num_vertices: ChildCorners::new(topo, options.scheme).num_vertices(),
         tags: child_tags(topo, tags),
         matrix: refine_matrix(topo, tags, options),
     }
@@ -397,18 +397,6 @@ impl FacePoints {
             _ => k,
         }
     }
-}
-
-/// Number of child vertices of `topo` under `scheme` (module docs). Cost O(#F).
-pub(crate) fn child_num_vertices(topo: &Topology, scheme: Scheme) -> usize {
-    let faces = match scheme {
-        Scheme::Loop => 0,
-        Scheme::CatmullClark => topo.num_faces(),
-        Scheme::QuadTriangle => (0..topo.num_faces())
-            .filter(|&f| topo.face(f).len() != 3)
-            .count(),
-    };
-    topo.num_vertices() + topo.num_edges() + faces
 }
 
 impl<'a> RefineRows<'a> {
