@@ -40,7 +40,7 @@ use crate::refine::{
     topology_for, RefineRows, VertexMaskCache,
 };
 use crate::regular::{is_regular, Regular, Tables};
-use crate::scheme::{FaceKinds, Neighborhood};
+use crate::scheme::Neighborhood;
 use crate::scheme::{Options, Scheme};
 use crate::semi_limit::{ring_faces, semi_sharp_at, semi_sharp_limit_row};
 use crate::stencil::{compose_rows, MultiRows, SparseSum, Stacked, StencilMatrix};
@@ -179,75 +179,35 @@ fn needs_refinement(topo: &Topology, options: &Options) -> bool {
     }
 }
 
-/// The child mesh's adjacency as the last product reads it: the closed form of module `child`
-/// (Loop, Catmull-Clark), or built from the child faces (quad/triangle).
-enum ChildView<'a> {
-    Closed(ChildCorners<'a>),
-    Built(Box<Topology>),
+/// Whether child vertex `w` (ring `ring`) has a finite sharpness at it or on a ring edge in
+/// `tags`. Cost O(valence) hash lookups.
+fn child_semi_sharp_at(w: u32, ring: &ChildRing, tags: &Tags) -> bool {
+    let semi = |s: f64| crate::crease::is_semi_sharp(crate::crease::sharpness(s));
+    semi(tags.corner(w))
+        || ring
+            .verts
+            .iter()
+            .zip(&ring.boundary)
+            .any(|(&u, &b)| !b && semi(tags.crease(w, u)))
 }
 
-impl ChildView<'_> {
-    fn num_vertices(&self) -> usize {
-        match self {
-            ChildView::Closed(c) => c.num_vertices(),
-            ChildView::Built(t) => t.num_vertices(),
-        }
-    }
-
-    /// Whether child vertex `w` (ring `ring`) has a finite sharpness at it or on a ring edge in
-    /// `tags`. Cost O(valence) hash lookups.
-    fn semi_sharp_at(&self, w: u32, ring: &ChildRing, tags: &Tags) -> bool {
-        let semi = |s: f64| crate::crease::is_semi_sharp(crate::crease::sharpness(s));
-        semi(tags.corner(w))
-            || ring
-                .verts
-                .iter()
-                .zip(&ring.boundary)
-                .any(|(&u, &b)| !b && semi(tags.crease(w, u)))
-    }
-
-    /// The faces of the child mesh around a child vertex whose ring is `ring` (child ids).
-    fn ring_faces(&self, ring: &ChildRing) -> Polygons {
-        let mut out = Polygons::new();
-        let mut face = Vec::new();
-        for &c in &ring.corners {
-            face.clear();
-            let mut x = c;
-            loop {
-                face.push(match self {
-                    ChildView::Closed(k) => k.vertex(x),
-                    ChildView::Built(t) => t.corner_vertex(x),
-                });
-                x = match self {
-                    ChildView::Closed(k) => k.next(x),
-                    ChildView::Built(t) => t.corner_next(x),
-                };
-                if x == c {
-                    break;
-                }
-            }
-            out.push(&face);
-        }
-        out
-    }
-
-    /// The ring of child vertex `w` and the kinds of its faces.
-    fn ring(&self, w: u32, ring: &mut ChildRing) -> FaceKinds {
-        match self {
-            ChildView::Closed(c) => {
-                c.ring(w, ring);
-                if c.triangles() {
-                    FaceKinds::Triangles
-                } else {
-                    FaceKinds::Polygons
-                }
-            }
-            ChildView::Built(t) => {
-                ChildRing::from_topology(t, w, ring);
-                face_kinds(t, w)
+/// The faces of the child mesh around a child vertex whose ring is `ring` (child ids).
+fn child_ring_faces(child: &ChildCorners<'_>, ring: &ChildRing) -> Polygons {
+    let mut out = Polygons::new();
+    let mut face = Vec::new();
+    for &c in &ring.corners {
+        face.clear();
+        let mut x = c;
+        loop {
+            face.push(child.vertex(x));
+            x = child.next(x);
+            if x == c {
+                break;
             }
         }
+        out.push(&face);
     }
+    out
 }
 
 /// Limit position and tangent weights sharing one support per vertex (`#V` rows over the same
@@ -331,13 +291,7 @@ fn limit_refine_compose_with(
         parent.num_vertices(),
         "inner dimensions differ"
     );
-    let child = match options.scheme {
-        Scheme::QuadTriangle => ChildView::Built(Box::new(
-            crate::child::refined_topology(parent, options.scheme)
-                .expect("the child of a valid mesh is valid"),
-        )),
-        s => ChildView::Closed(ChildCorners::new(parent, s)),
-    };
+    let child = ChildCorners::new(parent, options.scheme);
     let refine = RefineRows::new(parent, parent_tags, options);
     let regular = match options.scheme {
         // The tables assume the rules of the parent's infinitely sharp tags only.
@@ -366,10 +320,10 @@ fn limit_refine_compose_with(
             let mut hood = None;
             if child_semi {
                 child.ring(w, ring);
-                if child.semi_sharp_at(w, ring, child_tags) {
+                if child_semi_sharp_at(w, ring, child_tags) {
                     // Finite sharpness left around the child vertex: its limit row over the
                     // child vertices comes from local refinement of its one-ring.
-                    let faces = child.ring_faces(ring);
+                    let faces = child_ring_faces(&child, ring);
                     *child_row = semi_sharp_limit_row(&faces, w, child_tags, options);
                     accumulate_child_row(parent, &refine, child_row, vertex_masks, sum);
                     sum.drain_into(row);
@@ -377,7 +331,8 @@ fn limit_refine_compose_with(
                 }
             }
             let child_hood = |ring: &mut ChildRing| {
-                let kinds = child.ring(w, ring);
+                child.ring(w, ring);
+                let kinds = child.face_kinds(ring);
                 // As `sharp_edges` and `neighborhoods` on the child: boundary edges and edges
                 // tagged infinitely sharp.
                 let sharp = ring

@@ -240,7 +240,7 @@ pub fn refine(
 pub(crate) fn refine_topology(topo: &Topology, tags: &Tags, options: &Options) -> Refinement {
     Refinement {
         faces: child_faces(topo, options.scheme),
-        num_vertices: child_num_vertices(topo, options.scheme),
+        num_vertices: ChildCorners::new(topo, options.scheme).num_vertices(),
         tags: child_tags(topo, tags),
         matrix: refine_matrix(topo, tags, options),
     }
@@ -397,18 +397,6 @@ impl FacePoints {
             _ => k,
         }
     }
-}
-
-/// Number of child vertices of `topo` under `scheme` (module docs). Cost O(#F).
-pub(crate) fn child_num_vertices(topo: &Topology, scheme: Scheme) -> usize {
-    let faces = match scheme {
-        Scheme::Loop => 0,
-        Scheme::CatmullClark => topo.num_faces(),
-        Scheme::QuadTriangle => (0..topo.num_faces())
-            .filter(|&f| topo.face(f).len() != 3)
-            .count(),
-    };
-    topo.num_vertices() + topo.num_edges() + faces
 }
 
 impl<'a> RefineRows<'a> {
@@ -593,41 +581,11 @@ impl<'a> RefineRows<'a> {
 /// If the child has `u32::MAX` or more face indices.
 #[track_caller]
 pub(crate) fn child_faces(topo: &Topology, scheme: Scheme) -> Polygons {
-    if scheme == Scheme::QuadTriangle {
-        return mixed_child_faces(topo);
-    }
     let child = ChildCorners::new(topo, scheme);
-    let (size, nf) = (child.face_size(), child.num_faces());
-    let nc = u32::try_from(nf * size as usize).expect("more than u32::MAX child face indices");
+    let offsets = child.face_offsets();
+    let nc = *offsets.last().expect("offsets");
     let indices = (0..nc).into_par_iter().map(|x| child.vertex(x)).collect();
-    let offsets = (0..=nf as u32).map(|f| f * size).collect();
-    Polygons::from_raw(offsets, indices).expect("offsets are those of equal-size faces")
-}
-
-/// Quad/triangle child faces: Loop's pattern for triangles, Catmull-Clark's for the others
-/// (module docs). Cost O(#corners), serial.
-fn mixed_child_faces(topo: &Topology) -> Polygons {
-    let (nv, ne) = (topo.num_vertices() as u32, topo.num_edges() as u32);
-    let points = FacePoints::new(topo, Scheme::QuadTriangle);
-    let mut out = Polygons::new();
-    for f in 0..topo.num_faces() {
-        let v = topo.face(f);
-        let e = topo.face_edges(f);
-        let n = v.len();
-        if n == 3 {
-            let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
-            out.push(&[v[0], ab, ca]);
-            out.push(&[v[1], bc, ab]);
-            out.push(&[v[2], ca, bc]);
-            out.push(&[ab, bc, ca]);
-        } else {
-            let fp = nv + ne + points.index(f);
-            for i in 0..n {
-                out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
-            }
-        }
-    }
-    out
+    Polygons::from_raw(offsets, indices).expect("offsets of the child faces")
 }
 
 /// The tags of the child of `topo` (see [`Refinement::tags`]). Cost O(#tags · valence).
@@ -676,19 +634,21 @@ mod tests {
             let v = topo.face(f);
             let e = topo.face_edges(f);
             let n = v.len();
-            match scheme {
-                Scheme::Loop => {
-                    let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
-                    out.push(&[v[0], ab, ca]);
-                    out.push(&[v[1], bc, ab]);
-                    out.push(&[v[2], ca, bc]);
-                    out.push(&[ab, bc, ca]);
-                }
-                Scheme::CatmullClark | Scheme::QuadTriangle => {
-                    let fp = nv + ne + f as u32;
-                    for i in 0..n {
-                        out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
-                    }
+            if scheme == Scheme::Loop || (scheme == Scheme::QuadTriangle && n == 3) {
+                let (ab, bc, ca) = (nv + e[0], nv + e[1], nv + e[2]);
+                out.push(&[v[0], ab, ca]);
+                out.push(&[v[1], bc, ab]);
+                out.push(&[v[2], ca, bc]);
+                out.push(&[ab, bc, ca]);
+            } else {
+                // Face points of the faces that have one, in face order.
+                let fp = nv
+                    + ne
+                    + (0..f)
+                        .filter(|&g| scheme == Scheme::CatmullClark || topo.face(g).len() != 3)
+                        .count() as u32;
+                for i in 0..n {
+                    out.push(&[v[i], nv + e[i], fp, nv + e[(i + n - 1) % n]]);
                 }
             }
         }
@@ -711,6 +671,29 @@ mod tests {
             }
         }
         (((n + 1) * (n + 1) + 1) as usize, faces)
+    }
+
+    /// An open grid of `n × n` cells, every third a pair of triangles, with a pentagon (a
+    /// boundary vertex added on the first cell's lower edge): the three kinds of quad/triangle
+    /// parent faces side by side, in both orders along edges.
+    fn mixed_grid(n: u32) -> (usize, Polygons) {
+        let id = |i: u32, j: u32| i * (n + 1) + j;
+        let extra = (n + 1) * (n + 1);
+        let mut faces = Polygons::new();
+        for i in 0..n {
+            for j in 0..n {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if i == 0 && j == 0 {
+                    faces.push(&[q[0], extra, q[1], q[2], q[3]]);
+                } else if (i * n + j) % 3 == 1 {
+                    faces.push(&[q[0], q[1], q[2]]);
+                    faces.push(&[q[0], q[2], q[3]]);
+                } else {
+                    faces.push(&q);
+                }
+            }
+        }
+        (extra as usize + 1, faces)
     }
 
     /// A closed cube-like mesh with a pentagon, a triangle and valence-3 and -5 vertices (an
@@ -744,9 +727,13 @@ mod tests {
 
     #[test]
     fn child_corners_rings_and_refined_topology_equal_the_child_topology() {
-        for scheme in [Scheme::Loop, Scheme::CatmullClark] {
+        for scheme in [Scheme::Loop, Scheme::CatmullClark, Scheme::QuadTriangle] {
             let tris = scheme == Scheme::Loop;
-            for (nv, faces) in [grid(3, tris), closed(tris)] {
+            let meshes = [grid(3, tris), closed(tris), mixed_grid(4)];
+            for (nv, faces) in meshes
+                .into_iter()
+                .filter(|(_, f)| !tris || f.iter().all(|f| f.len() == 3))
+            {
                 let o = Options::new(scheme);
                 let parent = Topology::new(&faces, nv).unwrap();
                 let r = refine(&faces, nv, &Tags::new(), &o).unwrap();
@@ -777,7 +764,7 @@ mod tests {
                             .map(|&e| c.is_boundary_edge(e))
                             .collect();
                         let d: Vec<u32> = match scheme {
-                            Scheme::CatmullClark => c
+                            Scheme::CatmullClark | Scheme::QuadTriangle => c
                                 .vertex_corners(w)
                                 .iter()
                                 .map(|&x| c.corner_vertex(c.corner_next(c.corner_next(x))))
@@ -795,6 +782,11 @@ mod tests {
                             assert_eq!(ring.corners, c.vertex_corners(w), "{what}");
                             assert_eq!(ring.boundary, b, "{what}");
                             assert_eq!(ring.diagonals, d, "{what}");
+                            // (Loop and Catmull-Clark name their one kind even for a vertex
+                            // without faces.)
+                            if scheme == Scheme::QuadTriangle {
+                                assert_eq!(k.face_kinds(&ring), face_kinds(c, w), "{what}");
+                            }
                         }
                     }
                 }

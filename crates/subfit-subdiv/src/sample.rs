@@ -11,8 +11,10 @@
 //!
 //! Only the control mesh's adjacency is built from its face list
 //! ([`Topology::new`](crate::Topology::new)); that of each finer level is read off the level
-//! above (module `child`) — for levels `1 … l − 1` as a [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so no adjacency with
-//! one entry per corner of the finest mesh is built, and no intermediate face list.
+//! above (module `child`, for all three schemes) — for levels `1 … l − 1` as a
+//! [`Topology`](crate::Topology), for level `l` vertex by vertex as its limit rows need it, so
+//! no adjacency with one entry per corner of the finest mesh is built, and no intermediate face
+//! list.
 //!
 //! Semi-sharp tags ([`crate::crease`]): the refinement rows blend the sharp and smooth rules.
 //! Where finite sharpness is left around a level-`l` vertex its limit row is computed by local
@@ -71,7 +73,8 @@ pub struct LimitSamples {
 /// (Loop) – 15 (Catmull-Clark) control points per row, plus `P_{l−1}` (about a quarter of one
 /// of them). Measured (`benches/stencils.rs`, 2 threads, quiet machine): a 10k-face
 /// Catmull-Clark control mesh at level 3 (686k rows, 30M entries) in ≈ 0.37 s, the first build
-/// of a process included. Most of the time is the last product (scattered reads of `P_{l−1}`
+/// of a process included; the quad/triangle scheme on the same mesh with every 7th quad split
+/// in two triangles within ≈ 10 % of that (CPU time; shared machine). Most of the time is the last product (scattered reads of `P_{l−1}`
 /// rows and scattered accumulation) and the page faults on the ~0.4 GB output. Each level-`l`
 /// vertex with finite sharpness left around it costs one local refinement of its one-ring per
 /// remaining unit of sharpness (module docs).

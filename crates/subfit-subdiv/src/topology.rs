@@ -22,19 +22,19 @@ struct RingPart {
     corners: Vec<u32>,
 }
 
-/// A mesh whose adjacency is known in closed form, for [`Topology::from_closed_form`]: all faces
-/// have [`Self::face_size`] corners, corner `c` of face `f` is `f · face_size + i`, and rings
-/// are in the order [`Topology::new`] gives them (counter-clockwise, from the leading boundary
-/// edge or the lowest-numbered corner).
+/// A mesh whose adjacency is known in closed form, for [`Topology::from_closed_form`]: corner
+/// `i` of face `f` is `face_offsets[f] + i`, and rings are in the order [`Topology::new`] gives
+/// them (counter-clockwise, from the leading boundary edge or the lowest-numbered corner).
 pub(crate) trait ClosedForm: Sync {
     /// Reusable buffers of [`Self::ring`].
     type Ring: Default;
     /// Number of vertices.
     fn num_vertices(&self) -> usize;
-    /// Number of faces.
-    fn num_faces(&self) -> usize;
-    /// Corners per face.
-    fn face_size(&self) -> u32;
+    /// Number of corners.
+    fn num_corners(&self) -> usize;
+    /// Where each face's corners start, and the number of corners last (`#F + 1` entries);
+    /// called only with fewer than `u32::MAX` corners.
+    fn face_offsets(&self) -> Vec<u32>;
     /// The vertex of corner `c`.
     fn vertex(&self, c: u32) -> u32;
     /// The next corner of `c`'s face.
@@ -160,23 +160,27 @@ impl Topology {
     /// Errors: [`SubdivError::TooLarge`] if the mesh has `u32::MAX` or more vertices or
     /// corners. Cost O(#corners), parallel except for the edge numbering.
     pub(crate) fn from_closed_form<C: ClosedForm>(child: &C) -> Result<Self, SubdivError> {
-        let (size, nf) = (child.face_size(), child.num_faces());
-        let (nv, nc) = (child.num_vertices(), nf * size as usize);
+        let (nv, nc) = (child.num_vertices(), child.num_corners());
         if nv >= NONE as usize || nc >= NONE as usize {
             return Err(SubdivError::TooLarge {
                 what: "vertices or face indices",
                 count: nv.max(nc),
             });
         }
+        let offsets = child.face_offsets();
         let corners = || (0..nc as u32).into_par_iter();
         let indices: Vec<u32> = corners().map(|x| child.vertex(x)).collect();
         let next_vertex = corners().map(|x| indices[child.next(x) as usize]).collect();
         let twin: Vec<u32> = corners().map(|x| child.twin(x)).collect();
+        let mut corner_face = vec![0u32; nc];
+        for (f, w) in offsets.windows(2).enumerate() {
+            corner_face[w[0] as usize..w[1] as usize].fill(f as u32);
+        }
         let mut t = Topology {
             num_vertices: nv,
-            offsets: (0..=nf as u32).map(|f| f * size).collect(),
+            offsets,
             indices,
-            corner_face: corners().map(|x| x / size).collect(),
+            corner_face,
             next_vertex,
             corner_edge: vec![NONE; nc],
             edge_verts: Vec::new(),
