@@ -5,10 +5,11 @@
 //! model's does (4.97e-4, 2.18e-3). Measured by `subfit compare` (exact closest points on the
 //! limit surface, both ways), `subfit fit --max-control-points 201` with both quad schemes
 //! beats the artist's RMS with a cage of ≥ 70 % quads. The issue asks for the Hausdorff
-//! distance too, and that is **not met**: the fits' is 1.6× the artist's here (2.83e-3 with
-//! Catmull-Clark), the largest errors at the legs' junctions with the body, where the
-//! simplified cage has fewer points than the artist gave them. The test holds it within 2×,
-//! so that it cannot get worse unseen.
+//! distance too, and that is **not met** here: the fits' is 2.09e-3 (Catmull-Clark) and
+//! 1.95e-3 (quad/tri), 1.2× and 1.1× the artist's — below the hidden artist's 2.18e-3, but the
+//! hidden model is not this one. (Started at the budget, as before `subfit::QUAD_BUDGET_START`,
+//! they were at 2.83e-3, the largest errors at the legs' junctions with the body.) The test
+//! holds the Hausdorff distance within 1.5× of the artist's, so that it cannot get worse unseen.
 
 #![allow(clippy::print_stdout)]
 
@@ -170,7 +171,7 @@ fn at_201_control_points_both_quad_schemes_beat_the_artists_rms() {
             "{scheme}: RMS {rms} vs the artist's {artist_rms}"
         );
         assert!(
-            max < 2.0 * artist_max,
+            max < 1.5 * artist_max,
             "{scheme}: Hausdorff {max} vs the artist's {artist_max}"
         );
     }

@@ -40,6 +40,7 @@ pub use outputs::{log_csv, OUTPUTS};
 pub use pipeline_report::Report;
 pub use scan::{
     fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
+    QUAD_BUDGET_START,
 };
 pub use sequence::{
     fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence,
