@@ -41,8 +41,10 @@ pub const POLISH_MIN_GAIN: f64 = 0.02;
 /// ... and raises the judged RMS error by at most this fraction.
 pub const POLISH_RMS_SLACK: f64 = 0.03;
 
-/// Rounds of the polish at most; a round is one stage's iterations, and the polish goes on
-/// only while a round's cage is kept.
+/// Rounds of the polish at most. The polish has one stage's iterations in all
+/// ([`crate::fit_stages`] gives it at most [`crate::StageOptions::iterations_per_stage`]); a
+/// round whose fit stopped before using them (it stalled) and whose cage was kept is followed by
+/// another on the same fitter with what is left (a fresh Levenberg-Marquardt damping).
 pub const POLISH_ROUNDS: usize = 3;
 
 /// Polishes `best` (see the module docs) with `iterations` iterations at `λ = lambda` and
@@ -78,8 +80,8 @@ pub(crate) fn polish_best(
     let mut left = iterations;
     let mut fit = None;
     let mut two_sided = best.two_sided;
-    // Rounds of one stage's iterations on the same fitter (the weights' reference stays that
-    // of the first projection), while a round gains.
+    // Rounds on the same fitter (the weights' reference stays that of the first projection)
+    // while a round is kept and iterations are left.
     while left > 0 && rounds < POLISH_ROUNDS {
         let n = left.min(stages.iterations_per_stage.max(1));
         t.fitter.set_stage(lambda, n, 0.0, 0.0, stages.stall);
