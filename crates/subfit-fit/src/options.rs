@@ -213,8 +213,8 @@ pub struct FitOptions {
     /// `F` stays in squared units). 2 (the default) is least squares, the papers' objective;
     /// a larger `p` trades a little RMS for a lower maximum (iteratively reweighted least
     /// squares: each sample's model is weighted by `(e_k / r)^(p−2)`, clamped to
-    /// [[`crate::POWER_WEIGHT_MIN`], [`crate::POWER_WEIGHT_MAX`]]). [`crate::fit_stages`] ends with such a
-    /// polish ([`crate::StageOptions::polish_power`]). Valid: `2 ≤ p ≤ 8`.
+    /// [[`crate::POWER_WEIGHT_MIN`], [`crate::POWER_WEIGHT_MAX`]]). [`crate::fit_stages`]
+    /// ends with such a polish ([`crate::StageOptions::polish_power`]). Valid: `2 ≤ p ≤ 8`.
     pub error_power: f64,
     /// [`Method::Imls`]: the kernel support radius `h` (normalized units, the unit cube the
     /// target is scaled into — the units of Xie et al. 2023 §5.1's `h₀`). Default `None`:
