@@ -5,11 +5,12 @@
 //! model's does (4.97e-4, 2.18e-3). Measured by `subfit compare` (exact closest points on the
 //! limit surface, both ways), `subfit fit --max-control-points 201` with both quad schemes
 //! beats the artist's RMS with a cage of ≥ 70 % quads. The issue asks for the Hausdorff
-//! distance too, and that is **not met** here: the fits' is 2.09e-3 (Catmull-Clark) and
-//! 1.95e-3 (quad/tri), 1.2× and 1.1× the artist's — below the hidden artist's 2.18e-3, but the
-//! hidden model is not this one. (Started at the budget, as before `subfit::QUAD_BUDGET_START`,
-//! they were at 2.83e-3, the largest errors at the legs' junctions with the body.) The test
-//! holds the Hausdorff distance within 1.5× of the artist's, so that it cannot get worse unseen.
+//! distance too, and that is **not met** here: the fits' is 2.20e-3 (Catmull-Clark) and
+//! 1.80e-3 (quad/tri), 1.27× and 1.04× the artist's (the hidden artist's is 2.18e-3, but the
+//! hidden model is not this one). Started at the budget, as before `subfit::QUAD_BUDGET_START`,
+//! Catmull-Clark was at 3.11e-3, the largest errors at the legs' junctions with the body. The
+//! test holds the Hausdorff distance within 1.5× of the artist's, so that it cannot get worse
+//! unseen.
 
 #![allow(clippy::print_stdout)]
 
@@ -20,7 +21,7 @@ use std::path::Path;
 use common::subfit;
 use subfit::io::{read_file, write_file, ReadOptions, WriteOptions};
 use subfit::mesh::shapes::{creature_cage, XorShift};
-use subfit::mesh::vec3::{cross, dot};
+use subfit::mesh::vec3::dot;
 
 /// `(two-sided RMS, Hausdorff)` of `a` against `b` as fractions of the diagonal
 /// (`subfit compare --json`).
@@ -48,7 +49,7 @@ fn compare(a: &Path, b: &Path, scheme: &str) -> (f64, f64) {
 }
 
 /// The model: the cage's Catmull-Clark limit at level 4 (55k points), every point moved along
-/// its normal by a sum of 12 plane waves of random directions and phases (wavelength 0.08 ×
+/// its limit normal by a sum of 12 plane waves of random directions and phases (wavelength 0.08 ×
 /// the diagonal, ±30 %), scaled to RMS 5e-4 of the diagonal.
 fn sculpt(cage: &Path, model: &Path, dir: &Path) {
     let base = dir.join("base.ply");
@@ -69,30 +70,9 @@ fn sculpt(cage: &Path, model: &Path, dir: &Path) {
         String::from_utf8_lossy(&out.stderr)
     );
     let (mut m, _) = read_file(&base, &ReadOptions::default()).unwrap();
-    let mut normals = vec![[0.0; 3]; m.positions.len()];
-    for f in m.faces.iter() {
-        for k in 1..f.len() - 1 {
-            let [a, b, c] = [f[0], f[k], f[k + 1]].map(|v| m.positions[v as usize]);
-            let n = cross(
-                std::array::from_fn(|i| b[i] - a[i]),
-                std::array::from_fn(|i| c[i] - a[i]),
-            );
-            for &v in f {
-                for i in 0..3 {
-                    normals[v as usize][i] += n[i];
-                }
-            }
-        }
-    }
-    let (lo, hi) = m.positions.iter().fold(
-        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-        |(lo, hi), p| {
-            (
-                std::array::from_fn(|i| lo[i].min(p[i])),
-                std::array::from_fn(|i| hi[i].max(p[i])),
-            )
-        },
-    );
+    // `--limit` writes the limit surface's own unit normals.
+    let normals = m.normals.take().expect("limit normals in base.ply");
+    let (lo, hi) = m.bounding_box().unwrap();
     let diagonal = (0..3).map(|i| (hi[i] - lo[i]).powi(2)).sum::<f64>().sqrt();
     let mut rng = XorShift::new(1);
     let waves: Vec<([f64; 3], f64, f64)> = (0..12)
@@ -120,9 +100,8 @@ fn sculpt(cage: &Path, model: &Path, dir: &Path) {
     let rms = (h.iter().map(|x| x * x).sum::<f64>() / h.len() as f64).sqrt();
     let scale = 5e-4 * diagonal / rms;
     for ((p, n), h) in m.positions.iter_mut().zip(&normals).zip(&h) {
-        let l = dot(*n, *n).sqrt().max(1e-300);
         for i in 0..3 {
-            p[i] += scale * h * n[i] / l;
+            p[i] += scale * h * n[i];
         }
     }
     write_file(model, &m, &WriteOptions::default()).unwrap();

@@ -7,8 +7,8 @@
 mod common;
 
 use subfit_fit::{
-    fit_stages, DataTerm, FitOptions, FootPointSource, FootPointTerm, Method, StageOptions,
-    StagesResult, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN,
+    fit_stages, DataTerm, FitOptions, FootPointSource, FootPointTerm, FootSample, Method,
+    StageOptions, StagesResult, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN,
 };
 use subfit_mesh::shapes::torus_mesh;
 use subfit_target::{Target, TargetOptions};
@@ -47,7 +47,8 @@ fn the_error_power_weights_samples_by_their_error_over_the_first_rms() {
             .map(|(f, &x)| term.squared_error(f, x))
             .collect();
         let r2 = e2.iter().sum::<f64>() / e2.len() as f64;
-        for ((f, &e), &x) in first.iter().zip(&e2).zip(&xs) {
+        // The weight the module docs give an error `e` (squared), against `f`'s.
+        let check = |f: &FootSample, e: f64| -> f64 {
             let w = (e / r2)
                 .powf(0.5 * (p - 2.0))
                 .clamp(POWER_WEIGHT_MIN, POWER_WEIGHT_MAX);
@@ -56,6 +57,10 @@ fn the_error_power_weights_samples_by_their_error_over_the_first_rms() {
                 "p {p}: {} vs {w}",
                 f.weight
             );
+            w
+        };
+        for ((f, &e), &x) in first.iter().zip(&e2).zip(&xs) {
+            let w = check(f, e);
             let obj = term.objective_error(f, x);
             assert!((obj - w * e).abs() <= 1e-12 * obj.max(1e-300));
         }
@@ -64,15 +69,7 @@ fn the_error_power_weights_samples_by_their_error_over_the_first_rms() {
         let xs2 = points(2.0);
         let second = term.project(None, &xs2);
         for (f, &x) in second.iter().zip(&xs2) {
-            let e = term.squared_error(f, x);
-            let w = (e / r2)
-                .powf(0.5 * (p - 2.0))
-                .clamp(POWER_WEIGHT_MIN, POWER_WEIGHT_MAX);
-            assert!(
-                (f.weight - w).abs() <= 1e-12 * w,
-                "p {p}: {} vs {w}",
-                f.weight
-            );
+            check(f, term.squared_error(f, x));
         }
     }
     // Least squares weighs nothing.
