@@ -63,7 +63,7 @@ use rayon::prelude::*;
 use subfit_mesh::vec3::{cross, dot, normalize, sub};
 use subfit_mesh::{Polygons, SHARPNESS_INFINITE};
 use subfit_subdiv::SamplingOperator;
-use subfit_target::{PointIndex, Target};
+use subfit_target::{boundary_vertices, PointIndex, Target};
 
 use crate::term::Mat3;
 
@@ -498,31 +498,6 @@ fn mean_edge_length(faces: &Polygons, xs: &[[f64; 3]]) -> f64 {
     } else {
         sum / count as f64
     }
-}
-
-/// Vertices on edges used by exactly one triangle. Cost O(T log T).
-pub(crate) fn boundary_vertices(tris: &[[u32; 3]]) -> Vec<u32> {
-    let mut edges: Vec<(u32, u32)> = tris
-        .iter()
-        .flat_map(|t| (0..3).map(move |i| (t[i].min(t[(i + 1) % 3]), t[i].max(t[(i + 1) % 3]))))
-        .collect();
-    edges.par_sort_unstable();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j] == edges[i] {
-            j += 1;
-        }
-        if j - i == 1 {
-            out.push(edges[i].0);
-            out.push(edges[i].1);
-        }
-        i = j;
-    }
-    out.sort_unstable();
-    out.dedup();
-    out
 }
 
 /// Unit vertex normals of the polygon mesh `faces` over `xs` (Newell normals of the faces,

@@ -230,7 +230,7 @@ impl<'t> FootPointTerm<'t> {
     pub fn with_coverage(mut self, weight: f64) -> Self {
         self.coverage = Some(Coverage::new(self.target, weight));
         if let Some(bvh) = self.target.mesh() {
-            let b = crate::coverage::boundary_vertices(bvh.triangles());
+            let b = subfit_target::boundary_vertices(bvh.triangles());
             if !b.is_empty() {
                 self.rim = vec![false; self.target.len()];
                 for v in b {

@@ -54,6 +54,7 @@ mod arap;
 mod assemble;
 mod coverage;
 mod error;
+mod error_field;
 mod fitter;
 mod foot_point_term;
 mod grouped_fill;
@@ -68,6 +69,7 @@ mod report;
 pub mod silhouette;
 mod smooth;
 mod solve;
+mod stage_refine;
 mod stages;
 mod surface_term;
 mod term;
@@ -91,8 +93,8 @@ pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};
 pub use remesh::RefineStats;
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
-    fit_stages, StageEvent, StageOptions, StageReport, StageStop, StagesReport, StagesResult,
-    STALL_GAIN, STALL_STAGES,
+    fit_stages, judged_with_boundary, StageEvent, StageOptions, StageReport, StageStop,
+    StagesReport, StagesResult, STALL_GAIN, STALL_STAGES,
 };
 pub use surface_term::{fan_triangles, SurfaceTerm, WeightedSurfaceTerm};
 pub use term::{DataTerm, Mat3};

@@ -27,6 +27,7 @@
 
 use std::time::Instant;
 
+use subfit_report::data_samples::DataSamples;
 use subfit_target::Target;
 
 use crate::error::FitError;
@@ -57,7 +58,7 @@ pub(crate) fn polish_best(
     base: &FitOptions,
     stages: &StageOptions,
     best: &mut Best,
-    data: &[[f64; 3]],
+    data: &DataSamples,
     stage: usize,
     lambda: f64,
     iterations: usize,
@@ -94,27 +95,28 @@ pub(crate) fn polish_best(
             t.fitter.run(&mut positions, Some(&mut cb))?
         };
         left -= round.iterations.len().max(1).min(left);
-        let m = measure(&t, &best.mesh.faces, &positions, data);
+        let m = measure(&t, &best.mesh.faces, &positions, data, stages);
         let last = round.last();
-        let (rms0, max0) = stages.judged(&best.errors, &best.two_sided);
-        let (rms1, max1) = stages.judged(&last, &m.two_sided);
-        let was_met = stages.met(&best.errors, &best.two_sided);
+        let (rms0, max0) = stages.judged(&best.errors, &best.judged);
+        let (rms1, max1) = stages.judged(&last, &m.judged);
+        let was_met = stages.met(&best.errors, &best.judged);
         // The fitter's own RMS too: on a cage that already fits to rounding (an L prism with
         // its creases), the two-sided measure is only the tessellation's chordal error, and a
         // polish that moved the surface off the data measured "better" there.
         let better = max1 < (1.0 - POLISH_MIN_GAIN) * max0
             && rms1 <= (1.0 + POLISH_RMS_SLACK) * rms0
             && last.e_rms <= (1.0 + POLISH_RMS_SLACK) * best.errors.e_rms
-            && (!was_met || stages.met(&last, &m.two_sided));
+            && (!was_met || stages.met(&last, &m.judged));
         two_sided = m.two_sided;
         rounds += 1;
         if better {
             kept = true;
             best.stage = stage;
-            best.badness = stages.badness(&last, &m.two_sided);
+            best.badness = stages.badness(&last, &m.judged);
             best.mesh.positions.clone_from(&positions);
             best.errors = last;
             best.two_sided = m.two_sided;
+            best.judged = m.judged;
         }
         match fit.as_mut() {
             None => fit = Some(round),

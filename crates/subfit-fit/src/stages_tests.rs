@@ -1,8 +1,11 @@
-//! Unit tests of the stage driver's private helpers (tag carrying, refinement order).
+//! Unit tests of the stage driver's private helpers and of [`crate::stage_refine`] (tag carrying,
+//! refinement order).
 
 use super::*;
 use crate::remesh::refine_red_green;
+use crate::stage_refine::{carry_tags, FEATURE_PRIORITY};
 use subfit_mesh::shapes::octahedron_mesh;
+use subfit_mesh::SHARPNESS_INFINITE;
 
 /// A crease on a split edge passes to both halves; one on an unsplit edge stays.
 #[test]
@@ -73,4 +76,78 @@ fn refinement_prefers_crease_faces() {
     );
     // A semi-sharp tag is no sharp feature: the worse face first, the tagged edge kept.
     assert_eq!(creases_after(2.0), 1);
+}
+
+/// Near the RMS tolerance a refinement grows the cage by what the error's order predicts,
+/// not by the full growth; far from it, or for a missed maximum only, by the full growth.
+#[test]
+fn refinement_near_the_tolerance_grows_by_what_is_needed() {
+    let stages = StageOptions {
+        tolerance_rms: 1.0,
+        ..StageOptions::default()
+    };
+    let g = |rms: f64, unmet| needed_growth(&stages, rms, unmet);
+    // 5 % above: 1.05^(4/3) · 1.05 − 1 ≈ 12 %.
+    let near = g(1.05, (true, false));
+    assert!((near - (1.05f64.powf(1.0 / RMS_ORDER) * 1.05 - 1.0)).abs() < 1e-12);
+    assert!(near > 0.1 && near < 0.15, "{near}");
+    assert_eq!(g(2.0, (true, false)), stages.growth);
+    assert_eq!(g(1.05, (false, true)), stages.growth);
+    // At the tolerance (rounding): the margin.
+    assert!((g(1.0, (true, false)) - GROWTH_MARGIN).abs() < 1e-12);
+}
+
+/// A boundary vertex is judged by the boundary tolerance through the maximum: its distance is
+/// scaled by `tolerance_max / tolerance_boundary`, the reported figures are not.
+#[test]
+fn boundary_vertices_are_judged_by_their_own_tolerance() {
+    let stages = StageOptions {
+        tolerance_rms: 1.0,
+        tolerance_max: 7.0,
+        tolerance_boundary: 3.5,
+        ..StageOptions::default()
+    };
+    let two = TwoSided {
+        surface_to_data: subfit_report::DistanceStats::of(&[1.0, 2.0]),
+        data_to_surface: subfit_report::DistanceStats::of(&[1.0, 5.0, 4.0]),
+    };
+    // The last distance (4.0) is a boundary vertex: judged as 8 against 7.
+    let judged = judged_with_boundary(&two, &[4.0], &stages);
+    assert_eq!(judged.data_to_surface.max, 8.0);
+    assert_eq!(two.data_to_surface.max, 5.0);
+    assert!(!judged.within(1e9, stages.tolerance_max));
+    assert!(judged_with_boundary(&two, &[3.0], &stages).within(1e9, 7.0));
+    // Without a boundary tolerance nothing changes.
+    let plain = StageOptions {
+        tolerance_boundary: 0.0,
+        ..stages.clone()
+    };
+    assert_eq!(
+        judged_with_boundary(&two, &[4.0], &plain)
+            .data_to_surface
+            .max,
+        5.0
+    );
+}
+
+/// On a noisy scan the noise is taken out of the ratio: an RMS at 1.02 × a noise-floored
+/// tolerance can still be far from the tolerance's noise-free part.
+#[test]
+fn the_noise_is_taken_out_of_the_growth() {
+    let stages = StageOptions {
+        tolerance_rms: 1.0f64.hypot(3.0),
+        noise_rms: 3.0,
+        ..StageOptions::default()
+    };
+    // rms² − 9 = 1.02² · 10 − 9 ≈ 1.40: 1.18 × the noise-free tolerance.
+    let g = needed_growth(&stages, 1.02 * 10f64.sqrt(), (true, false));
+    let plain = needed_growth(
+        &StageOptions {
+            noise_rms: 0.0,
+            ..stages.clone()
+        },
+        1.02 * 10f64.sqrt(),
+        (true, false),
+    );
+    assert!(g > 0.2 && plain < 0.1, "{g} vs {plain}");
 }

@@ -6,7 +6,7 @@
 //! which is what an independent measurement over the surface sees.
 
 use serde::{Deserialize, Serialize};
-use subfit_target::Target;
+use subfit_target::{boundary_vertices, Target};
 
 /// Where the data → surface samples come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -25,31 +25,52 @@ pub struct DataSamples {
     pub points: Vec<[f64; 3]>,
     /// Their source.
     pub kind: SampleKind,
+    /// How many of the samples, at the end of [`Self::points`], are boundary vertices of a
+    /// mesh target (0 for a point cloud).
+    pub boundary: usize,
 }
 
 /// The seed of the area samples (fixed: the same target gives the same samples).
 const SEED: u64 = 0x5eed_da7a;
 
+/// Area samples of a mesh target at least, when the count is left to [`data_samples`]: the
+/// largest data → surface distance is judged on them, and a coarse mesh's own point count
+/// misses where it is (a fertility statue cut open at its base, 4,429 points: the largest
+/// distance over as many area samples 3.4e-3 of the diagonal, `subfit compare` over 50,000
+/// 6.7e-3).
+pub const MIN_AREA_SAMPLES: usize = 50_000;
+
 /// The data → surface samples of `target`: its points for a point cloud; for a mesh,
-/// `count` points uniform by area on its triangles (`count = 0`: as many as it has points).
+/// `count` points uniform by area on its triangles (`count = 0`: as many as it has points,
+/// and at least [`MIN_AREA_SAMPLES`]) and its boundary vertices.
 ///
 /// Cost: O(#triangles + count log #triangles).
 pub fn data_samples(target: &Target, count: usize) -> DataSamples {
     let cloud = || DataSamples {
         points: target.points().to_vec(),
         kind: SampleKind::Points,
+        boundary: 0,
     };
     let Some(bvh) = target.mesh() else {
         return cloud();
     };
-    let count = if count == 0 { target.len() } else { count };
-    let points = area_samples(bvh.vertices(), bvh.triangles(), count, SEED);
+    let count = if count == 0 {
+        target.len().max(MIN_AREA_SAMPLES)
+    } else {
+        count
+    };
+    let mut points = area_samples(bvh.vertices(), bvh.triangles(), count, SEED);
     if points.is_empty() {
         return cloud();
     }
+    // The boundary vertices too: a rim is where an open fit misses most, and area samples
+    // land on it with probability zero.
+    let rim = boundary_vertices(bvh.triangles());
+    points.extend(rim.iter().map(|&v| bvh.vertices()[v as usize]));
     DataSamples {
         points,
         kind: SampleKind::MeshArea,
+        boundary: rim.len(),
     }
 }
 

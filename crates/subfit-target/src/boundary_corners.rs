@@ -12,6 +12,7 @@
 //! Cost: O(#triangles log #triangles) for the loops, O(B · k) for the turns with `B` boundary
 //! vertices and `k` of them within `s`.
 
+use rayon::prelude::*;
 use subfit_mesh::vec3::{dot, norm, sub};
 
 /// Sharp turns along the boundary of a triangle mesh.
@@ -137,6 +138,32 @@ fn loop_corners(points: &[[f64; 3]], l: &[u32], min_turn: f64, scale: f64) -> Ve
         })
         .map(|i| l[i])
         .collect()
+}
+
+/// Vertices on edges used by exactly one triangle (a mesh target's boundary), sorted. Cost
+/// O(T log T).
+pub fn boundary_vertices(tris: &[[u32; 3]]) -> Vec<u32> {
+    let mut edges: Vec<(u32, u32)> = tris
+        .iter()
+        .flat_map(|t| (0..3).map(move |i| (t[i].min(t[(i + 1) % 3]), t[i].max(t[(i + 1) % 3]))))
+        .collect();
+    edges.par_sort_unstable();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j] == edges[i] {
+            j += 1;
+        }
+        if j - i == 1 {
+            out.push(edges[i].0);
+            out.push(edges[i].1);
+        }
+        i = j;
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 #[cfg(test)]

@@ -53,7 +53,7 @@ mod regularize;
 mod target;
 mod winding;
 
-pub use boundary_corners::{boundary_corners, BoundaryCorners};
+pub use boundary_corners::{boundary_corners, boundary_vertices, BoundaryCorners};
 pub use closest::{MeshClosestPoint, TriangleBvh};
 pub use cloud_features::{
     detect_cloud_features, detect_cloud_features_in, CloudFeatures, FeaturePolyline,
