@@ -47,9 +47,9 @@ fn options(
     scheme_name: &str,
     method: &str,
     step: &str,
-    tolerance: f64,
+    tolerance: Option<f64>,
     max_error: Option<f64>,
-    max_control_points: i64,
+    max_control_points: Option<i64>,
     control_points: Option<i64>,
     as_points: bool,
     lambda_start: f64,
@@ -112,9 +112,12 @@ fn options(
             lambda_end: lambda_end.unwrap_or(lambda_start.min(1e-5)),
             iterations_per_stage: range("stage_iterations", stage_iterations, 1, 10_000)?,
             max_iterations: range("max_iterations", max_iterations, 1, 10_000)?,
-            tolerance_rms: tolerance,
+            tolerance_rms: tolerance.unwrap_or(StageOptions::default().tolerance_rms),
             tolerance_max: max_error.unwrap_or(0.0),
-            max_control_points: range("max_control_points", max_control_points, 4, 10_000_000)?,
+            max_control_points: match max_control_points {
+                Some(n) => range("max_control_points", n, 4, 10_000_000)?,
+                None => StageOptions::default().max_control_points,
+            },
             refine,
             edge_flips: refine && edge_flips,
             max_depth: range("max_depth", max_depth, 1, 12)? as u8,
@@ -124,6 +127,9 @@ fn options(
             ..StageOptions::default()
         },
         error_scale,
+        target_tolerances: tolerance.is_none()
+            && max_error.is_none()
+            && max_control_points.is_none(),
         ..FitScanOptions::default()
     })
 }
@@ -172,7 +178,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
 #[pyfunction]
 #[pyo3(signature = (
     points, faces=None, normals=None, *, scheme="loop", method="sdm", step="lm",
-    tolerance=5e-4, max_error=None, max_control_points=5000, control_points=None,
+    tolerance=None, max_error=None, max_control_points=None, control_points=None,
     as_points=false, init=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
@@ -187,9 +193,9 @@ pub fn fit(
     scheme: &str,
     method: &str,
     step: &str,
-    tolerance: f64,
+    tolerance: Option<f64>,
     max_error: Option<f64>,
-    max_control_points: i64,
+    max_control_points: Option<i64>,
     control_points: Option<i64>,
     as_points: bool,
     init: Option<(PyReadonlyArray2<'_, f64>, FaceArrays<'_>)>,

@@ -33,6 +33,7 @@ pub mod pipeline_report;
 mod scan;
 mod sequence;
 mod sequence_tracking;
+pub mod tolerance;
 
 pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};

@@ -483,6 +483,10 @@ pub struct Report {
     /// one raised to the noise floor `√(tol² + (1.25 σ)²)` (unit cube); `None` otherwise.
     #[serde(default)]
     pub noise_floored_tolerance: Option<f64>,
+    /// Which defaults set the tolerances, relative to the target's diagonal
+    /// ([`crate::tolerance`]); `None` when they were given.
+    #[serde(default)]
+    pub tolerance_kind: Option<crate::tolerance::ToleranceKind>,
     /// The target mesh's topology (`None` for a point cloud).
     pub target_topology: Option<Topology>,
     /// Faces of the target re-oriented to agree with their neighbours, if any.

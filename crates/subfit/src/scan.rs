@@ -13,8 +13,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use subfit_fit::{
-    fit_stages, DataTerm, FitOptions, FootPointTerm, IterationRow, StageEvent, StageOptions,
-    StageReport, StagesResult,
+    fit_stages, judged_with_boundary, DataTerm, FitOptions, FootPointTerm, IterationRow,
+    StageEvent, StageOptions, StageReport, StagesResult,
 };
 use subfit_init::{
     default_control_points, initial_control_mesh, pair_triangles, InitOptions, InitReport,
@@ -25,6 +25,10 @@ use subfit_subdiv::Scheme;
 use subfit_target::{FeatureOptions, Target, TargetOptions};
 
 use crate::error::Error;
+use crate::tolerance::{
+    edge_count, noise_floored, target_tolerances, with_sampling_margin, ToleranceKind,
+    NOISE_FLOOR_FACTOR,
+};
 use subfit_report::{
     data_samples, limit_tessellation, vertex_areas, DistanceStats, MeshDistance, TwoSided,
 };
@@ -100,6 +104,11 @@ pub struct FitScanOptions {
     pub fit: FitOptions,
     /// The stages: `λ` schedule, tolerances (two-sided by default), budgets, refinement.
     pub stages: StageOptions,
+    /// Replace the tolerances of [`Self::stages`] by the defaults for the target
+    /// ([`crate::tolerance`]: fractions of its bounding-box diagonal, by whether it is a scan,
+    /// a CAD part with sharp creases or a noisy scan), as `subfit fit` does when no tolerance is
+    /// given. Default false: the tolerances of `stages` (unit cube).
+    pub target_tolerances: bool,
     /// Target analysis options.
     pub target: TargetOptions,
     /// Initial-mesh options (`expected_genus` and `expected_boundary_loops` are set from the faces
@@ -127,6 +136,7 @@ impl Default for FitScanOptions {
                 ..FitOptions::default()
             },
             stages: StageOptions::default(),
+            target_tolerances: false,
             target: TargetOptions::default(),
             init_options: InitOptions {
                 features: Some(FeatureOptions::default()),
@@ -431,7 +441,17 @@ pub fn fit_scan(
         ..options.fit.clone()
     };
 
-    let (stages, noise_floor) = noise_floored(&options.stages, target.stats());
+    let tolerance_kind = options
+        .target_tolerances
+        .then(|| ToleranceKind::of(target.stats(), &fit.tags, edge_count(&control.faces)));
+    let judged = match tolerance_kind {
+        Some(kind) => {
+            let diagonal = FootPointTerm::from_options(&target, &fit).bbox_diagonal();
+            target_tolerances(&options.stages, kind, diagonal)
+        }
+        None => options.stages.clone(),
+    };
+    let (stages, noise_floor) = noise_floored(&judged, target.stats());
     if let Some(t) = noise_floor {
         warn(
             format!(
@@ -454,7 +474,13 @@ pub fn fit_scan(
                 }
             }
         };
-        fit_stages(&target, &control, &fit, &stages, Some(&mut on_event)).map_err(|e| match e {
+        // The target's maxima are met by the stages with a margin: the final tessellation is
+        // finer than the stages' samples and finds higher peaks.
+        let working = match tolerance_kind {
+            Some(_) => with_sampling_margin(&stages),
+            None => stages.clone(),
+        };
+        fit_stages(&target, &control, &fit, &working, Some(&mut on_event)).map_err(|e| match e {
             subfit_fit::FitError::Interrupted => Error::Interrupted,
             e => Error::Fit {
                 name: name.clone(),
@@ -525,9 +551,11 @@ pub fn fit_scan(
     };
     let measure_time = t_measure.elapsed().as_secs_f64();
     let two = TwoSidedErrors::new(&final_two, diagonal, unit);
-    let reached = stages.met(&last, &final_two);
+    let rim = &to_surface[to_surface.len() - data.boundary.min(to_surface.len())..];
+    let judged_two = judged_with_boundary(&final_two, rim, &stages);
+    let reached = stages.met(&last, &judged_two);
     let reached_one_sided = stages.reached(&last);
-    let reached_two_sided = final_two.within(stages.tolerance_rms, stages.tolerance_max);
+    let reached_two_sided = judged_two.within(stages.tolerance_rms, stages.tolerance_max);
     let cage = PolyMesh::new(
         result
             .mesh
@@ -537,7 +565,7 @@ pub fn fit_scan(
             .collect(),
         result.mesh.faces.clone(),
     );
-    let st = &options.stages;
+    let st = &judged;
     let report = Report {
         target: name,
         target_points: target.len(),
@@ -545,6 +573,7 @@ pub fn fit_scan(
         target_noise_level: target.stats().noise_level,
         target_point_spacing: target.stats().point_spacing,
         noise_floored_tolerance: noise_floor,
+        tolerance_kind,
         target_topology,
         reoriented,
         normalized_unit_in_original_units: unit,
@@ -880,32 +909,6 @@ pub fn read_cage(path: &Path) -> Result<InitialCage, Error> {
         tags: Tags::new(),
         name: path.display().to_string(),
     })
-}
-
-/// Factor on a noisy scan's noise level in its RMS tolerance ([`noise_floored`]).
-pub const NOISE_FLOOR_FACTOR: f64 = 1.25;
-
-/// `stages` with the RMS tolerance raised to `√(tol² + (1.25 σ)²)` when the target is a noisy
-/// point cloud ([`subfit_target::TargetStats::is_noisy`], σ its estimated noise level): the
-/// data's own noise keeps the data → surface RMS of the true surface near σ, so a tolerance below
-/// it can be met only by fitting the noise — refinement to the budget, a rougher surface, no
-/// closer to the scanned object (Cheng et al. 2007 §V name noisy data as SDM's limit). 0.3 %
-/// noise and 3 % outliers on 150k points of Igea: σ = 3.6e-3 and data → surface 3.85e-3 unit
-/// cube at every stage from 578 to 5,000 control points, 77 s, while the distance to the clean
-/// mesh stayed near 8e-4 of its diagonal. Returns the options and the raised tolerance (unit
-/// cube), if it was raised.
-fn noise_floored(
-    stages: &StageOptions,
-    stats: &subfit_target::TargetStats,
-) -> (StageOptions, Option<f64>) {
-    let mut options = stages.clone();
-    if !stats.is_noisy() || stages.tolerance_rms <= 0.0 {
-        return (options, None);
-    }
-    let sigma = NOISE_FLOOR_FACTOR * stats.noise_level;
-    options.tolerance_rms = stages.tolerance_rms.hypot(sigma);
-    let floor = options.tolerance_rms;
-    (options, Some(floor))
 }
 
 /// Where a quad cage (Catmull-Clark, quad/triangle) starts when the control-point budget caps

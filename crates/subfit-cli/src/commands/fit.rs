@@ -16,6 +16,12 @@ use crate::cli::{quad_dominant_flag, FitArgs, MethodArg, OptimizerArg, SchemeArg
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
     let fitted = execute(&a)?;
     eprintln!("subfit: {}", init_line(&fitted.report.init));
+    if let Some(kind) = fitted.report.tolerance_kind {
+        eprintln!(
+            "subfit: {} (--tolerance / --max-error set others, in unit-cube units)",
+            kind.describe()
+        );
+    }
     println!(
         "{}; wrote {} (look at {})",
         fitted.summary(),
@@ -88,9 +94,11 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             lambda_end: a.lambda_end.unwrap_or(a.lambda.min(1e-5)),
             iterations_per_stage: a.stage_iterations as usize,
             max_iterations: a.max_iterations as usize,
-            tolerance_rms: a.tolerance,
+            tolerance_rms: a.tolerance.unwrap_or(StageOptions::default().tolerance_rms),
             tolerance_max: a.max_error.unwrap_or(0.0),
-            max_control_points: a.max_control_points as usize,
+            max_control_points: a
+                .max_control_points
+                .map_or(StageOptions::default().max_control_points, |n| n as usize),
             refine: !a.no_refine,
             edge_flips: !(a.no_refine || a.no_flips),
             max_depth: a.max_depth,
@@ -111,6 +119,9 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             },
             ..FitScanOptions::default().init_options
         },
+        target_tolerances: a.tolerance.is_none()
+            && a.max_error.is_none()
+            && a.max_control_points.is_none(),
         ..FitScanOptions::default()
     })
 }
