@@ -448,7 +448,6 @@ pub(crate) fn measure(
     let mut data_faces = vec![FaceError::default(); faces.len()];
     let rim_from = to_surface.len() - data.boundary.min(to_surface.len());
     let scale = rim_scale(stages);
-    let mut judged = two_sided;
     for (i, p) in to_surface.iter().enumerate() {
         let e = &mut data_faces[topo.owners[p.face as usize] as usize];
         e.sum_sq += p.distance * p.distance;
@@ -459,8 +458,9 @@ pub(crate) fn measure(
             p.distance
         };
         e.max = e.max.max(d);
-        judged.data_to_surface.max = judged.data_to_surface.max.max(d);
     }
+    let rim: Vec<f64> = to_surface[rim_from..].iter().map(|p| p.distance).collect();
+    let judged = judged_with_boundary(&two_sided, &rim, stages);
     Measurement {
         two_sided,
         judged,
