@@ -141,3 +141,42 @@ fn noisy_sphere_without_wider_neighbourhoods_still_orients_within_the_field_budg
     let f = outward(&t, |_| [0.0; 3]);
     assert!(f >= 0.99, "{:.4} outward", f);
 }
+
+/// A clean range scan is sparse where the surface turns away from the scanner: one pixel apart
+/// along the rim, several across it. Those points are kept; points scattered in space are not.
+#[test]
+fn a_clean_scans_sparse_rim_is_data_and_stray_points_are_not() {
+    // A plane sampled one unit apart, then three rim rows six units apart across, one along.
+    let mut p: Vec<[f64; 3]> = Vec::new();
+    for i in 0..80 {
+        for j in 0..80 {
+            p.push([i as f64, j as f64, 0.0]);
+        }
+    }
+    let rim_from = p.len();
+    for row in 1..=3 {
+        for i in 0..80 {
+            p.push([i as f64, 79.0 + 6.0 * row as f64, 0.0]);
+        }
+    }
+    let rim_to = p.len();
+    // Stray returns, each at least 8 units from the plane and from the others.
+    let strays: [[f64; 3]; 6] = [
+        [10.0, 10.0, 9.0],
+        [40.0, 30.0, -12.0],
+        [70.0, 60.0, 15.0],
+        [25.0, 70.0, -9.5],
+        [55.0, 5.0, 20.0],
+        [5.0, 50.0, 11.0],
+    ];
+    p.extend_from_slice(&strays);
+    let t = Target::from_points(&p, None, &options()).unwrap();
+    let removed = t.removed_outliers();
+    let rim_removed = removed
+        .iter()
+        .filter(|&&i| (rim_from..rim_to).contains(&(i as usize)))
+        .count();
+    assert_eq!(rim_removed, 0, "rim points dropped: {removed:?}");
+    let strays_removed = removed.iter().filter(|&&i| i as usize >= rim_to).count();
+    assert_eq!(strays_removed, strays.len(), "{removed:?}");
+}
