@@ -54,8 +54,8 @@ mod local;
 pub mod patch;
 
 pub use eval::{
-    random_samples, EvalError, EvalKind, EvalWeights, Evaluator, SurfaceParam, SurfacePoint,
-    DEFAULT_CACHE_BYTES,
+    area_weights, random_samples, EvalError, EvalKind, EvalWeights, Evaluator, SurfaceParam,
+    SurfacePoint, DEFAULT_CACHE_BYTES,
 };
 pub mod closest;
 pub use closest::{ClosestOptions, ClosestPoint, ClosestPointFinder};

@@ -6,8 +6,12 @@
 //! fraction of B's bounding-box diagonal: RMS, mean and max in each direction, the two-sided RMS
 //! over both sample sets, and the Hausdorff distance (the larger max). With `--scheme`, A is a
 //! control mesh and its exact limit surface is used: samples are exact limit points at random
-//! `(face, u, v)` (uniform in each patch's parameters, not by area), and distances to it are
-//! exact closest points on the limit surface (BVH start, Newton in `(u, v)`).
+//! `(face, u, v)` (a patch drawn uniformly, then uniform in its parameters), each weighted by
+//! the area it stands for (`|S_u × S_v|`, [`subfit::subdiv::area_weights`]) so that A → B's RMS
+//! and mean are area-uniform like a mesh's; distances to it are exact closest points on the
+//! limit surface (BVH start, Newton in `(u, v)`). Unweighted, small patches (rims, around
+//! extraordinary vertices) counted as much as large ones: a range-scan fit's distance to the
+//! true mesh read 3.4e-4 against 2.1e-4 area-uniform.
 
 use std::process::ExitCode;
 
@@ -17,7 +21,9 @@ use serde::Serialize;
 use subfit::mesh::PolyMesh;
 use subfit::report::data_samples::area_samples;
 use subfit::report::DistanceStats;
-use subfit::subdiv::{random_samples, ClosestOptions, ClosestPointFinder, Evaluator, Options};
+use subfit::subdiv::{
+    area_weights, random_samples, ClosestOptions, ClosestPointFinder, Evaluator, Options,
+};
 use subfit::target::{PointIndex, TriangleBvh};
 
 use crate::commands::subdivide::pick_scheme;
@@ -65,6 +71,8 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| a.b.display().to_string())?;
     let sp = crate::progress::spinner("measuring distances");
     let mut shown_a_options = None;
+    // Area weights of A's samples (its limit surface is sampled per patch, not by area).
+    let mut weights_ab = None;
     let (dab, dba): (Vec<f64>, Vec<f64>) = if let Some(scheme) = a.scheme {
         if ma.faces.is_empty() {
             bail!(
@@ -78,8 +86,9 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         // The cage's own creases and corners (an OBJ's `t` lines, as control.obj has them).
         let tags = subfit::io::read_tags_file(&a.a, ma.num_vertices())?;
         let ev = Evaluator::new(&ma.faces, ma.num_vertices(), &tags, &options).with_context(ctx)?;
-        let (_, points) =
+        let (params, points) =
             random_samples(&ev, &ma.positions, a.samples as usize, a.seed).with_context(ctx)?;
+        weights_ab = Some(area_weights(&ev, &params, &points));
         let finder = ClosestPointFinder::new(&ev, &ma.positions, ClosestOptions::default())
             .with_context(ctx)?;
         let dab = points
@@ -109,7 +118,11 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         (dab, dba)
     };
     sp.finish_and_clear();
-    let (ab, ba) = (DistanceStats::of(&dab), DistanceStats::of(&dba));
+    let ab = match &weights_ab {
+        Some(w) => DistanceStats::of_weighted(&dab, w),
+        None => DistanceStats::of(&dab),
+    };
+    let ba = DistanceStats::of(&dba);
     let n = (dab.len() + dba.len()) as f64;
     let two_sided_rms =
         ((ab.rms * ab.rms * dab.len() as f64 + ba.rms * ba.rms * dba.len() as f64) / n).sqrt();
@@ -138,6 +151,8 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
             &mb,
             shown_a_options.as_ref(),
             |x| sb.query.distance(x),
+            &ab,
+            &ba,
             &dab,
             &dba,
             diag,

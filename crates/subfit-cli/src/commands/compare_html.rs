@@ -75,7 +75,8 @@ fn layer(name: &str, s: &Shown, distances: &[f64], scale: f64, color: &str) -> L
     l
 }
 
-/// The page; `to_b` measures a distance to B, `dab`/`dba` are the comparison's distances.
+/// The page; `to_b` measures a distance to B, `ab`/`ba` are the comparison's statistics and
+/// `dab`/`dba` its distances.
 #[allow(clippy::too_many_arguments)]
 pub fn page(
     a: &CompareArgs,
@@ -83,6 +84,8 @@ pub fn page(
     mb: &PolyMesh,
     scheme: Option<&Options>,
     to_b: impl Fn([f64; 3]) -> f64 + Sync,
+    ab: &DistanceStats,
+    ba: &DistanceStats,
     dab: &[f64],
     dba: &[f64],
     diagonal: f64,
@@ -115,7 +118,6 @@ pub fn page(
             .map(|&x| bvh.closest(x).map_or(f64::INFINITY, |c| c.distance))
             .collect()
     };
-    let (ab, ba) = (DistanceStats::of(dab), DistanceStats::of(dba));
     let scale = ab.max.max(ba.max).max(f64::MIN_POSITIVE);
     let name_a = a.a.display().to_string();
     let name_b = a.b.display().to_string();

@@ -60,5 +60,5 @@ mod types;
 pub use descend::MAX_DEPTH;
 pub use evaluator::Evaluator;
 pub use memo::{CACHE_DEPTH, DEFAULT_CACHE_BYTES};
-pub use random::random_samples;
+pub use random::{area_weights, random_samples};
 pub use types::{EvalError, EvalKind, EvalWeights, SurfaceParam, SurfacePoint};

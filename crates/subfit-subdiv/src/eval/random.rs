@@ -1,6 +1,6 @@
 //! Seeded random parameters over the patches of an [`Evaluator`], and the limit points there.
 
-use super::types::{EvalError, SurfaceParam, SurfacePoint};
+use super::types::{EvalError, EvalKind, SurfaceParam, SurfacePoint};
 use super::Evaluator;
 
 impl Evaluator {
@@ -56,4 +56,45 @@ pub fn random_samples(
     let params = evaluator.random_params(n, seed);
     let pts = evaluator.evaluate_batch(positions, &params)?;
     Ok((params, pts))
+}
+
+/// Area weights of samples drawn by [`Evaluator::random_params`]: each sample stands for
+/// `|S_u × S_v|` times its patch's domain area (½ for a triangle patch, 1 for a square), so
+/// that statistics weighted by them are area-uniform over the limit surface (importance
+/// sampling: the patches are drawn uniformly, whatever their size). Samples exactly at an
+/// irregular vertex ([`EvalKind::Vertex`], no parametric derivatives; a null set) get the mean
+/// weight of the others. `params` and `points` are parallel. Cost O(n).
+pub fn area_weights(
+    evaluator: &Evaluator,
+    params: &[SurfaceParam],
+    points: &[SurfacePoint],
+) -> Vec<f64> {
+    use subfit_mesh::vec3::{cross, norm};
+    let mut w: Vec<f64> = params
+        .iter()
+        .zip(points)
+        .map(|(q, p)| match p.kind {
+            EvalKind::Patch => {
+                let domain = if evaluator.triangle_patch(q.face) {
+                    0.5
+                } else {
+                    1.0
+                };
+                domain * norm(cross(p.du, p.dv))
+            }
+            EvalKind::Vertex => f64::NAN,
+        })
+        .collect();
+    let known: Vec<f64> = w.iter().copied().filter(|x| x.is_finite()).collect();
+    let mean = if known.is_empty() {
+        1.0
+    } else {
+        known.iter().sum::<f64>() / known.len() as f64
+    };
+    for x in &mut w {
+        if !x.is_finite() {
+            *x = mean;
+        }
+    }
+    w
 }
