@@ -6,6 +6,18 @@
 
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
+/// `println!` for the commands' results: when the reader has gone away (`subfit compare A B |
+/// head -3`) the process ends quietly with exit 0, as Unix tools do, instead of panicking on
+/// the broken pipe; another write error is a one-line error with exit 2.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout().lock(), $($arg)*) {
+            $crate::stdout_failed(e);
+        }
+    }};
+}
+
 mod cli;
 mod commands;
 mod interrupt;
@@ -37,6 +49,15 @@ fn main() -> ExitCode {
             ExitCode::from(EXIT_BAD_INPUT)
         }
     }
+}
+
+/// Ends the process after a failed write to stdout (see `out!`).
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("subfit: error: cannot write to stdout: {e}");
+    std::process::exit(EXIT_BAD_INPUT.into());
 }
 
 /// The error and its causes on one line.

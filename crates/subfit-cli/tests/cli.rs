@@ -748,3 +748,25 @@ fn analyze_writes_the_sharp_features_of_a_mesh() {
     let r = subfit(&["analyze", cube.to_str().unwrap(), "--feature-angle", "200"]);
     assert_eq!(r.status.code(), Some(2));
 }
+
+/// A reader that goes away (`subfit compare … | head -1`) ends the command quietly: exit 0,
+/// no panic on the broken pipe. The read end is closed before the command has measured
+/// anything; if it were slower than the command, the output would fit in the pipe and the
+/// result would be the same.
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    let d = tempfile::tempdir().unwrap();
+    let cube = write(d.path(), "cube.obj", CUBE_OBJ.as_bytes());
+    let mut child = Command::new(env!("CARGO_BIN_EXE_subfit"))
+        .args(["compare", cube.to_str().unwrap(), cube.to_str().unwrap()])
+        .args(["--samples", "2000"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(out.status.code(), Some(0), "{err}");
+}

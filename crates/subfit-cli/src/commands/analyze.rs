@@ -271,11 +271,11 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         _ => {}
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        out!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print_text(&summary, a.output.as_deref());
         if let Some(out) = &a.features {
-            println!("wrote         {}", out.display());
+            out!("wrote         {}", out.display());
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -380,8 +380,8 @@ fn write_cloud_features(
 }
 
 fn print_text(s: &Summary, out: Option<&std::path::Path>) {
-    println!("file          {}", s.file);
-    println!(
+    out!("file          {}", s.file);
+    out!(
         "points        {} ({} in the input, {} exact duplicates merged{})",
         s.points,
         s.input_points,
@@ -392,23 +392,23 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
             String::new()
         }
     );
-    println!("outliers      {} removed", s.outliers_removed);
-    println!(
+    out!("outliers      {} removed", s.outliers_removed);
+    out!(
         "noise         {:.3e} normalized units ({:.3} x the point spacing {:.3e}); fits use k = {}",
         s.noise_level,
         s.noise_level / s.point_spacing.max(f64::MIN_POSITIVE),
         s.point_spacing,
         s.neighborhood_k
     );
-    println!(
+    out!(
         "normals       {}; {} flipped by orientation, {} ambiguous, {} degenerate fits, {} orientation component(s)",
         s.normal_origin, s.flipped_normals, s.ambiguous_normals, s.degenerate_fits, s.orientation_components
     );
-    println!(
+    out!(
         "quadrics      {} disagree with their neighbours' (foot points blended next to them)",
         s.untrusted_quadrics
     );
-    println!(
+    out!(
         "neighbours    k min/mean/max {:.0}/{:.1}/{:.0}; radius min/median/max {:.5}/{:.5}/{:.5}",
         s.neighborhood_size[0],
         s.neighborhood_size[1],
@@ -423,31 +423,31 @@ fn print_text(s: &Summary, out: Option<&std::path::Path>) {
             v[0], v[1], v[2], v[3], v[4]
         )
     };
-    println!("k1            {}", q(&s.k1_quantiles));
-    println!("k2            {}", q(&s.k2_quantiles));
-    println!(
+    out!("k1            {}", q(&s.k1_quantiles));
+    out!("k2            {}", q(&s.k2_quantiles));
+    out!(
         "units         1 normalized unit = {:.6} original units",
         s.scale_to_original
     );
     if let Some(f) = &s.features {
         match f.feature_points {
-            None => println!(
+            None => out!(
                 "features      {} sharp edges (≥ {}°; {} before cleaning) in {} curves ({} closed), {} corners, {} darts",
                 f.sharp_edges, f.angle_deg, f.sharp_edges_before_cleaning, f.curves, f.closed_curves, f.corners, f.darts
             ),
-            Some(p) => println!(
+            Some(p) => out!(
                 "features      {} curves ({} closed, {} segments; normals ≥ {}° apart at {} points), {} corners, {} darts",
                 f.curves, f.closed_curves, f.sharp_edges, f.angle_deg, p, f.corners, f.darts
             ),
         }
     }
     let t = &s.timings;
-    println!(
+    out!(
         "time (s)      read {:.3}, validate {:.3}, normalize {:.3}, merge {:.3}, index {:.3}, outliers {:.3}, estimate {:.3}, orient {:.3} (propagate {:.3}, winding {:.3}, field {:.3} in {} iterations), mesh index {:.3}; analysis total {:.3}",
         t.read, t.validate, t.normalize, t.merge, t.index, t.outliers, t.estimate, t.orient,
         t.orient_propagate, t.orient_winding, t.orient_field, s.field_iterations, t.mesh_index, t.total
     );
     if let Some(o) = out {
-        println!("wrote         {}", o.display());
+        out!("wrote         {}", o.display());
     }
 }

@@ -132,9 +132,14 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
     let bar = crate::progress::bar(total_runs as u64, "fitting");
     let mut summary = Vec::new();
     let mut figures = Vec::new();
-    println!(
+    out!(
         "{:<8} {:<14} {:>10} {:>12} {:>12} {:>10}",
-        "example", "run", "iters<.002", "E_rms first", "E_rms last", "monotone"
+        "example",
+        "run",
+        "iters<.002",
+        "E_rms first",
+        "E_rms last",
+        "monotone"
     );
     for ex in chosen {
         let [ax, by, cz] = ex.axes;
@@ -172,7 +177,7 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
             let reached = report.iterations_to_rms(TOLERANCE);
             let monotone = is_monotone(&report);
             bar.suspend(|| {
-                println!(
+                out!(
                     "{:<8} {:<14} {:>10} {:>12.3e} {:>12.3e} {:>10}",
                     ex.number,
                     label,
@@ -281,7 +286,7 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
         &a.output.join("summary.json"),
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
-    println!(
+    out!(
         "wrote {} (look at {})",
         a.output.display(),
         a.output.join("report.html").display()

@@ -256,7 +256,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
             "timings_s": r.timings_s,
         }));
     }
-    println!(
+    out!(
         "{:<15} {:>7} {:>13} {:>5} {:>10} {:>10} {:>10} {:>10} {:>4} {:>4} {:>6} {:>6} {:>6} {:>6} {:>6} {:>7}",
         "model",
         "points",
@@ -276,9 +276,9 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
         "total s"
     );
     for r in rows {
-        println!("{r}");
+        out!("{r}");
     }
-    println!("(errors in unit-cube units; E_max/E_rms surface → data as in the papers, 2s: the worse of both directions; `met`: the row's tolerances held surface → data, `2s`: both ways; fitted {})", if a.one_sided { "to the one-sided tolerance (--one-sided)" } else { "to the two-sided tolerance" });
+    out!("(errors in unit-cube units; E_max/E_rms surface → data as in the papers, 2s: the worse of both directions; `met`: the row's tolerances held surface → data, `2s`: both ways; fitted {})", if a.one_sided { "to the one-sided tolerance (--one-sided)" } else { "to the two-sided tolerance" });
     crate::interrupt::watch_dir(&a.output.join("summary.json"));
     subfit::io::write_atomic(
         &a.output.join("summary.json"),

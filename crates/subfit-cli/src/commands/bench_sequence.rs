@@ -35,9 +35,11 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
             ("large", DeformingParams::large_tangential_motion()),
         ],
     };
-    println!(
+    out!(
         "subfit bench sequence: {} frames of ~{} vertices, {} control points",
-        a.frames, a.vertices, a.control_points
+        a.frames,
+        a.vertices,
+        a.control_points
     );
     let mut rows = Vec::new();
     for (name, params) in motions {
@@ -59,8 +61,8 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
             rows.push(run_one(&a, name, &seq, views)?);
         }
     }
-    println!();
-    println!(
+    out!();
+    out!(
         "{:<9} {:>5} {:>12} {:>12} {:>11} {:>11} {:>9} {:>10}",
         "motion",
         "views",
@@ -72,7 +74,7 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
         "template s"
     );
     for r in &rows {
-        println!(
+        out!(
             "{:<9} {:>5} {:>11.4}% {:>11.4}% {:>10.3}% {:>10.3}% {:>9.2} {:>10.2}",
             r.motion,
             r.views,
@@ -84,7 +86,7 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
             r.template_seconds
         );
     }
-    println!(
+    out!(
         "(fractions of each frame's bounding-box diagonal; goals: RMS ≤ 0.1%, drift ≤ 1%, ≤ 2 s per frame; Xie et al. 2023: 12.9–17 s per frame on a GPU)"
     );
     Ok(ExitCode::SUCCESS)
@@ -153,7 +155,7 @@ fn run_one(
     let r = &fitted.report;
     for f in &r.frames {
         let d = &drift.frames[f.index];
-        println!(
+        out!(
             "{motion:<9} views {views:>2} frame {:>3}: two-sided E_rms {:.4}% E_max {:.4}%, drift max {:.3}% RMS {:.3}%, tangential motion {:.3}%, {} iterations, {:.2} s",
             f.index,
             100.0 * f.two_sided.e_rms_fraction_of_diagonal,

@@ -162,15 +162,18 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         sp.finish_and_clear();
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&c)?);
+        out!("{}", serde_json::to_string_pretty(&c)?);
     } else {
         for (name, d) in [("A → B", &c.a_to_b), ("B → A", &c.b_to_a)] {
-            println!(
+            out!(
                 "{name}   {} samples: RMS {:.6e}  mean {:.6e}  max {:.6e}",
-                d.samples, d.rms, d.mean, d.max
+                d.samples,
+                d.rms,
+                d.mean,
+                d.max
             );
         }
-        println!(
+        out!(
             "two-sided RMS {:.6e} ({:.3e} of the diagonal); Hausdorff {:.6e} ({:.3e} of the diagonal)",
             c.two_sided_rms, c.two_sided_rms_fraction, c.hausdorff, c.hausdorff_fraction
         );

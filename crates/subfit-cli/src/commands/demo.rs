@@ -83,12 +83,15 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         ));
     }
     if a.no_fit {
-        println!(
+        out!(
             "{:<10} {:>5} {:>9} {:>8}  file",
-            "shape", "genus", "points", "noise"
+            "shape",
+            "genus",
+            "points",
+            "noise"
         );
     } else {
-        println!(
+        out!(
             "{:<10} {:>5} {:>5} {:>9} {:>15} {:>6} {:>10} {:>10} {:>10} {:>10} {:>7}  output",
             "shape",
             "genus",
@@ -104,14 +107,14 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
         );
     }
     for r in rows {
-        println!("{r}");
+        out!("{r}");
     }
     if !a.no_fit {
-        println!("reports to look at (open in a browser; preview.png beside each):");
+        out!("reports to look at (open in a browser; preview.png beside each):");
         for r in &reports {
-            println!("  {}", r.display());
+            out!("  {}", r.display());
         }
-        println!("(errors in unit-cube units: the shape scaled so that its longest side is 1; E_rms/E_max surface → data, 2s: the worse of both directions)");
+        out!("(errors in unit-cube units: the shape scaled so that its longest side is 1; E_rms/E_max surface → data, 2s: the worse of both directions)");
     }
     Ok(if all_reached {
         ExitCode::SUCCESS

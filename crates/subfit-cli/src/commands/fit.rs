@@ -22,7 +22,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
             kind.describe()
         );
     }
-    println!(
+    out!(
         "{}; wrote {} (look at {})",
         fitted.summary(),
         a.output.display(),

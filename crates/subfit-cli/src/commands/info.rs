@@ -204,7 +204,7 @@ pub fn run(a: InfoArgs) -> anyhow::Result<ExitCode> {
     };
     let info = describe(&a.file, &mesh, &fi);
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        out!("{}", serde_json::to_string_pretty(&info)?);
     } else {
         print!("{}", text(&info));
     }

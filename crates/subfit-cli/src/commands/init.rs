@@ -156,19 +156,19 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
 
     print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
     if report.concave.creases > 0 {
-        println!(
+        out!(
             "note: {} concave corner sector(s) split by a crease so the limit surface does not fold there ({} control point(s) added)",
             report.concave.creases, report.concave.inserted
         );
     }
     if let Some(r) = report.carve_radius {
-        println!(
+        out!(
             "note: the implicit surface missed genus {}; used the space-carving fallback \
              (normals ignored, radius {r:.4} unit cube; the cage sits about that far outside)",
             report.genus_target
         );
     }
-    println!(
+    out!(
         "time: read {:.3} s, target {:.3} s, contour {:.3} s, simplify {:.3} s, pair {:.3} s, write {:.3} s, total {:.3} s",
         read_time.as_secs_f64(),
         target_time.as_secs_f64(),
@@ -178,7 +178,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         write_time.as_secs_f64(),
         t0.elapsed().as_secs_f64()
     );
-    println!("wrote {}", a.output.display());
+    out!("wrote {}", a.output.display());
     if !report.simplify.reached_target {
         eprintln!(
             "subfit: warning: no legal collapse left at {} vertices ({n} requested)",
@@ -207,21 +207,21 @@ fn print_summary(
         None => format!("genus unknown (not a manifold), {loops} boundary loop(s)"),
     };
     match input {
-        Some(d) => println!(
+        Some(d) => out!(
             "target {}: {} points, {} faces, {}",
             a.target.display(),
             target.len(),
             d.num_faces,
             topo(d.genus, d.boundary_loops)
         ),
-        None => println!(
+        None => out!(
             "target {}: {} points (point cloud)",
             a.target.display(),
             target.len()
         ),
     }
     match (r.source, &r.contour) {
-        (InitSource::Contour, Some(c)) => println!(
+        (InitSource::Contour, Some(c)) => out!(
             "contour: octree of {} points and {} leaves, finest {}x{}x{} (cell {:.4} unit cube), \
              {} vertices, {} faces, genus {}, {} of {} components kept",
             c.octree_nodes,
@@ -236,13 +236,14 @@ fn print_summary(
             c.components_kept,
             c.components_found
         ),
-        _ => println!(
+        _ => out!(
             "simplified the mesh: {} vertices, {} faces",
-            r.simplify.vertices_before, r.simplify.faces_before
+            r.simplify.vertices_before,
+            r.simplify.faces_before
         ),
     }
     if let Some(t) = r.trim.as_ref().filter(|t| t.open) {
-        println!(
+        out!(
             "open cloud: {} of {} contour faces trimmed (no data within the support distance, median {:.4} unit cube), \
              {} boundary loop(s), genus {}",
             t.faces_trimmed, t.faces_before, t.support_distance, t.boundary_loops, t.genus
@@ -259,7 +260,7 @@ fn print_summary(
     };
     let quads = out.faces.iter().filter(|f| f.len() == 4).count();
     let triangles = out.faces.iter().filter(|f| f.len() == 3).count();
-    println!(
+    out!(
         "cage: {} vertices ({requested} requested), {} faces ({quads} quads, {triangles} triangles{}), {}, {} component(s); {versus}",
         out.num_vertices(),
         out.num_faces(),

@@ -50,7 +50,7 @@ pub fn run(a: SequenceArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("{}: cannot move the outputs into place", a.output.display()))?;
     let r = &sequence.report;
     let reached = r.frames.iter().filter(|f| f.tolerance_reached).count();
-    println!(
+    out!(
         "{} frames, {} control points ({:?}): worst two-sided E_rms {:.3}% and E_max {:.3}% of a frame's diagonal, {reached}/{} frames within the tolerance, {:.2} s per frame after the first; wrote {}",
         r.frames_fitted,
         r.control_points,
