@@ -187,7 +187,7 @@ pub fn page(
                         ]
                         .map(String::from)
                         .to_vec(),
-                        rows: vec![row("A → B", &ab), row("B → A", &ba)],
+                        rows: vec![row("A → B", ab), row("B → A", ba)],
                     },
                     Block::Text(if scheme.is_some() {
                         "A is a control mesh: its exact limit surface is measured (exact closest points) and shown tessellated.".into()
