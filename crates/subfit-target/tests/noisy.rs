@@ -143,14 +143,19 @@ fn noisy_sphere_without_wider_neighbourhoods_still_orients_within_the_field_budg
 }
 
 /// A clean range scan is sparse where the surface turns away from the scanner: one pixel apart
-/// along the rim, several across it. Those points are kept; points scattered in space are not.
+/// along the rim, several across it, and a single return in a gap (a bit of surface seen
+/// through an occlusion). Those points are kept; points scattered in space are not.
 #[test]
 fn a_clean_scans_sparse_rim_is_data_and_stray_points_are_not() {
-    // A plane sampled one unit apart, then three rim rows six units apart across, one along.
+    // A plane sampled one unit apart with a 16 × 16 gap, then three rim rows six units apart
+    // across, one along.
     let mut p: Vec<[f64; 3]> = Vec::new();
+    let hole = |i: usize, j: usize| (32..48).contains(&i) && (32..48).contains(&j);
     for i in 0..80 {
         for j in 0..80 {
-            p.push([i as f64, j as f64, 0.0]);
+            if !hole(i, j) {
+                p.push([i as f64, j as f64, 0.0]);
+            }
         }
     }
     let rim_from = p.len();
@@ -159,6 +164,8 @@ fn a_clean_scans_sparse_rim_is_data_and_stray_points_are_not() {
             p.push([i as f64, 79.0 + 6.0 * row as f64, 0.0]);
         }
     }
+    // A single return in the middle of a gap in the sampling, on the plane.
+    p.push([39.5, 39.5, 0.0]);
     let rim_to = p.len();
     // Stray returns, each at least 8 units from the plane and from the others.
     let strays: [[f64; 3]; 6] = [
