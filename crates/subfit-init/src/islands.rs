@@ -10,7 +10,7 @@
 //! uncovered has not reached its tolerance (DESIGN.md decision 11). A blob around stray points
 //! sits next to data the kept surface already covers; an island is the only surface near its
 //! points. So a component that would be dropped is kept when at least [`MIN_ISLAND_POINTS`] data
-//! points lie farther than a gap from every kept component and nearest to it.
+//! points lie farther than a gap ([`island_gap`]) from every kept component and nearest to it.
 //! [`keep_components`] applies the size rule and this one to a contour's triangles.
 
 use subfit_mesh::{face_components, PolyMesh, Polygons};
@@ -20,6 +20,22 @@ use subfit_target::PointIndex;
 /// that survived outlier removal, fewer than the smallest real piece of a range scan (18
 /// points on a 33k-point scan of the bunny).
 pub const MIN_ISLAND_POINTS: usize = 8;
+
+/// The distance beyond which a data point counts as uncovered by the kept components: the
+/// contour's band half-width `band_width`, or on a clean cloud at most one point spacing
+/// ([`subfit_target::TargetStats::point_spacing`], the median distance to the 16th neighbour).
+/// The band is 2–4 % of the diagonal on a 400 × 400 range scan of the bunny, so a piece of
+/// 15 points seen through a gap 2.6 % from the surface counted as covered and was dropped;
+/// one spacing (0.7 % there) is about the fits' default largest error. On a noisy cloud the
+/// noise's tail lies beyond a spacing, so the band stays.
+pub(crate) fn island_gap(target: &subfit_target::Target, band_width: f64) -> f64 {
+    let stats = target.stats();
+    if stats.is_noisy() || stats.point_spacing <= 0.0 {
+        band_width
+    } else {
+        band_width.min(stats.point_spacing)
+    }
+}
 
 /// For every component (`vertex_labels` over `positions`, `u32::MAX` for unused vertices;
 /// `count` components), the number of `points` farther than `gap` from every vertex of a

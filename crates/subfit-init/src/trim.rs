@@ -196,8 +196,14 @@ pub fn trim_unsupported(
     report.holes_kept = holes;
     report.hole_faces_kept = hole_faces;
     report.cleanup_faces_removed = clean(&he, &mut keep);
-    report.components_dropped =
-        drop_small_components(target, contour, &he, &mut keep, options, band_width);
+    report.components_dropped = drop_small_components(
+        target,
+        contour,
+        &he,
+        &mut keep,
+        options,
+        crate::islands::island_gap(target, band_width),
+    );
     let kept = keep.iter().filter(|&&k| k).count();
     if kept == 0 {
         return unchanged(report);
