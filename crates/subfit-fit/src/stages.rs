@@ -216,21 +216,25 @@ impl StageOptions {
         )
     }
 
-    /// How far a cage is from its tolerances: the largest ratio of judged error to tolerance
-    /// over those set, or the judged RMS when none is. Lower is better.
+    /// How far a cage is from its tolerances; lower is better. With one tolerance set, the
+    /// ratio of judged error to it (the judged RMS when none is). With both: the larger ratio
+    /// while both are met, else the geometric mean of the two ratios, each floored at 1, so that
+    /// progress on either miss counts. With the larger ratio alone, a maximum that no cage of
+    /// the topology reaches (the rim of a single-view range scan) made every stage equal but
+    /// for it: the best cage and the stall rule ignored the RMS, and a simulated scan of the
+    /// bunny ended at its initial 271 control points with a two-sided RMS of 1.3e-3 of the
+    /// diagonal where refinement reached 9.8e-4 two stages later.
     pub(crate) fn badness(&self, e: &ErrorStats, two: &TwoSided) -> f64 {
         let (rms, max) = self.judged(e, two);
-        let mut b: f64 = 0.0;
-        if self.tolerance_rms > 0.0 {
-            b = b.max(rms / self.tolerance_rms);
+        let r = (self.tolerance_rms > 0.0).then(|| rms / self.tolerance_rms);
+        let m = (self.tolerance_max > 0.0).then(|| max / self.tolerance_max);
+        match (r, m) {
+            (Some(r), Some(m)) if r > 1.0 || m > 1.0 => (r.max(1.0) * m.max(1.0)).sqrt(),
+            (Some(r), Some(m)) => r.max(m),
+            (Some(r), None) => r,
+            (None, Some(m)) => m,
+            (None, None) => rms,
         }
-        if self.tolerance_max > 0.0 {
-            b = b.max(max / self.tolerance_max);
-        }
-        if self.tolerance_rms <= 0.0 && self.tolerance_max <= 0.0 {
-            b = rms;
-        }
-        b
     }
 }
 

@@ -151,3 +151,46 @@ fn the_noise_is_taken_out_of_the_growth() {
     );
     assert!(g > 0.2 && plain < 0.1, "{g} vs {plain}");
 }
+
+/// The badness ranks a cage meeting both tolerances above any that misses one, and counts
+/// progress on either miss when both are missed: a stage at 1.3× the RMS tolerance and 2.2×
+/// the maximum beats one at 1.7× and 2.1× (the larger ratio alone ranked them the other way).
+#[test]
+fn badness_counts_progress_on_either_missed_tolerance() {
+    let stages = StageOptions {
+        tolerance_rms: 1.0,
+        tolerance_max: 10.0,
+        two_sided: false,
+        ..StageOptions::default()
+    };
+    let two = TwoSided {
+        surface_to_data: subfit_report::DistanceStats::of(&[0.0]),
+        data_to_surface: subfit_report::DistanceStats::of(&[0.0]),
+    };
+    let bad = |rms: f64, max: f64| {
+        let e = ErrorStats {
+            e_rms: rms,
+            e_max: max,
+            ..ErrorStats::default()
+        };
+        stages.badness(&e, &two)
+    };
+    assert!(bad(1.3, 22.0) < bad(1.7, 21.0));
+    assert!((bad(1.3, 22.0) - (1.3f64 * 2.2).sqrt()).abs() < 1e-12);
+    // Both met: the larger ratio, below 1 and so below any miss.
+    assert_eq!(bad(0.9, 5.0), 0.9);
+    assert!(bad(0.99, 9.9) < bad(0.1, 10.01));
+    // One missed: its ratio's square root, in the same order as the ratio.
+    assert!(bad(0.5, 12.0) < bad(0.9, 13.0));
+    // One tolerance set: its ratio.
+    let rms_only = StageOptions {
+        tolerance_max: 0.0,
+        ..stages.clone()
+    };
+    let e = ErrorStats {
+        e_rms: 1.5,
+        e_max: 99.0,
+        ..ErrorStats::default()
+    };
+    assert_eq!(rms_only.badness(&e, &two), 1.5);
+}
