@@ -21,6 +21,7 @@ mod edges;
 pub mod halfedge;
 pub mod ids;
 pub mod polygons;
+pub mod range_scan;
 pub mod reorient;
 pub mod shapes;
 pub mod tags;

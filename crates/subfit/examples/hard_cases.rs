@@ -9,7 +9,7 @@
 //! cargo run --release -p subfit --example hard_cases -- noisy IN.obj OUT.ply [N] [NOISE] [OUTLIERS] [SEED]
 //! ```
 //!
-//! * `range-scan`: an orthographic depth camera of `RES × RES` pixels (default 400) looking
+//! * `range-scan` ([`subfit::mesh::range_scan::range_scan`]): an orthographic depth camera of `RES × RES` pixels (default 400) looking
 //!   along `VIEW` or a direction drawn from `SEED` (default 1), framing the bounding sphere; per pixel the
 //!   nearest triangle's depth (z-buffer); returns seen at more than 80° from the face normal are
 //!   dropped, as scanners drop them; the depth gets Gaussian noise of `NOISE` × the diagonal
@@ -27,103 +27,14 @@
 use std::collections::VecDeque;
 use std::path::Path;
 
+use subfit::mesh::range_scan::range_scan;
 use subfit::mesh::shapes::{noisy_scan, XorShift};
-use subfit::mesh::vec3::{self, cross, dot, norm, sub};
+use subfit::mesh::vec3::{self, norm, sub};
 use subfit::mesh::{PolyMesh, Polygons};
 
 /// The bounding box of a mesh's positions (an input mesh has some).
 fn bounds(mesh: &PolyMesh) -> ([f64; 3], [f64; 3]) {
     mesh.bounding_box().expect("a mesh with vertices")
-}
-
-/// `a` scaled to unit length (a view direction, never zero here).
-fn unit(a: [f64; 3]) -> [f64; 3] {
-    vec3::unit(a).expect("a non-zero direction")
-}
-
-fn range_scan(
-    mesh: &PolyMesh,
-    res: usize,
-    noise: f64,
-    view: Option<[f64; 3]>,
-    seed: u64,
-) -> Vec<[f64; 3]> {
-    let mut rng = XorShift::new(seed);
-    let (lo, hi) = bounds(mesh);
-    let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-    let diag = norm(sub(hi, lo));
-    let view = unit(view.unwrap_or_else(|| [rng.normal(), rng.normal(), rng.normal()]));
-    let up = if view[2].abs() < 0.9 {
-        [0.0, 0.0, 1.0]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let right = unit(cross(view, up));
-    let up = cross(right, view);
-    let half = 0.5 * diag;
-    let pixel = 2.0 * half / res as f64;
-    // Camera coordinates: (x along right, y along up, depth along view).
-    let cam: Vec<[f64; 3]> = mesh
-        .positions
-        .iter()
-        .map(|&p| {
-            let d = sub(p, centre);
-            [dot(d, right), dot(d, up), dot(d, view)]
-        })
-        .collect();
-    let mut depth = vec![f64::INFINITY; res * res];
-    let mut facing = vec![0.0f64; res * res];
-    for tri in mesh.faces.triangulate_fan() {
-        let [a, b, c] = tri.map(|i| cam[i as usize]);
-        let n = unit(cross(sub(b, a), sub(c, a)));
-        let to_px = |q: [f64; 3]| [(q[0] + half) / pixel - 0.5, (q[1] + half) / pixel - 0.5];
-        let (pa, pb, pc) = (to_px(a), to_px(b), to_px(c));
-        let area = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]);
-        if area.abs() < 1e-300 {
-            continue;
-        }
-        let x0 = pa[0].min(pb[0]).min(pc[0]).ceil().max(0.0) as usize;
-        let x1 = (pa[0].max(pb[0]).max(pc[0]).floor() as isize).min(res as isize - 1);
-        let y0 = pa[1].min(pb[1]).min(pc[1]).ceil().max(0.0) as usize;
-        let y1 = (pa[1].max(pb[1]).max(pc[1]).floor() as isize).min(res as isize - 1);
-        if x1 < 0 || y1 < 0 {
-            continue;
-        }
-        for y in y0..=y1 as usize {
-            for x in x0..=x1 as usize {
-                let (px, py) = (x as f64, y as f64);
-                let w1 = ((px - pa[0]) * (pc[1] - pa[1]) - (py - pa[1]) * (pc[0] - pa[0])) / area;
-                let w2 = ((pb[0] - pa[0]) * (py - pa[1]) - (pb[1] - pa[1]) * (px - pa[0])) / area;
-                let w0 = 1.0 - w1 - w2;
-                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
-                    continue;
-                }
-                let z = w0 * a[2] + w1 * b[2] + w2 * c[2];
-                let i = y * res + x;
-                if z < depth[i] {
-                    depth[i] = z;
-                    facing[i] = n[2].abs();
-                }
-            }
-        }
-    }
-    let mut points = Vec::new();
-    for y in 0..res {
-        for x in 0..res {
-            let i = y * res + x;
-            // cos 80°: grazing returns are lost.
-            if !depth[i].is_finite() || facing[i] < 0.17 {
-                continue;
-            }
-            let (cx, cy) = (
-                (x as f64 + 0.5) * pixel - half,
-                (y as f64 + 0.5) * pixel - half,
-            );
-            let z = depth[i] + noise * diag * rng.normal();
-            points.push([0, 1, 2].map(|k| centre[k] + cx * right[k] + cy * up[k] + z * view[k]));
-        }
-    }
-    points
 }
 
 /// Faces around each vertex.
