@@ -770,3 +770,71 @@ fn a_closed_stdout_is_not_a_panic() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(out.status.code(), Some(0), "{err}");
 }
+
+/// `subdivide` and `eval` honour the crease and corner tags of the cage they read (an OBJ's
+/// `t` lines, as `fit` writes control.obj): a cube with every edge an infinitely sharp crease
+/// and every vertex a corner has the cube itself as its Catmull-Clark limit, where the
+/// untagged cube rounds to a blob well inside it.
+#[test]
+fn subdivide_and_eval_honour_the_cages_tags() {
+    let d = tempfile::tempdir().unwrap();
+    let mut obj = CUBE_OBJ.to_string();
+    for (a, b) in [
+        (0, 1),
+        (1, 2),
+        (2, 3),
+        (3, 0),
+        (4, 5),
+        (5, 6),
+        (6, 7),
+        (7, 4),
+        (0, 4),
+        (1, 5),
+        (2, 6),
+        (3, 7),
+    ] {
+        obj.push_str(&format!("t crease 2/1/0 {a} {b} 10\n"));
+    }
+    for v in 0..8 {
+        obj.push_str(&format!("t corner 1/1/0 {v} 10\n"));
+    }
+    let tagged = write(d.path(), "tagged.obj", obj.as_bytes());
+    let plain = write(d.path(), "plain.obj", CUBE_OBJ.as_bytes());
+    // Distance of a point inside the unit cube to its surface.
+    let inside = |p: &[f64]| {
+        p.iter()
+            .map(|&c| c.min(1.0 - c))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let worst = |cage: &Path, command: &[&str]| -> f64 {
+        let out = d.path().join("out.obj");
+        let mut args = vec![command[0], cage.to_str().unwrap()];
+        args.extend_from_slice(&command[1..]);
+        args.extend_from_slice(&["-o", out.to_str().unwrap()]);
+        let r = subfit(&args);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        let text = std::fs::read_to_string(&out).unwrap();
+        text.lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|xyz| {
+                let p: Vec<f64> = xyz
+                    .split_whitespace()
+                    .take(3)
+                    .map(|t| t.parse().unwrap())
+                    .collect();
+                inside(&p)
+            })
+            .fold(0.0, f64::max)
+    };
+    for command in [
+        &["subdivide", "--levels", "3", "--limit"][..],
+        &["subdivide", "--levels", "2"][..],
+        &["eval", "--samples", "500"][..],
+    ] {
+        let sharp = worst(&tagged, command);
+        let round = worst(&plain, command);
+        println!("{command:?}: tagged {sharp:.2e}, untagged {round:.2e} inside the cube");
+        assert!(sharp < 1e-12, "{command:?}: {sharp}");
+        assert!(round > 0.05, "{command:?}: {round}");
+    }
+}

@@ -82,10 +82,10 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         }
         let ctx = || format!("{}: cannot evaluate its limit surface", a.a.display());
         let options = Options::new(pick_scheme(scheme, &ma));
-        shown_a_options = Some(options);
         // The cage's own creases and corners (an OBJ's `t` lines, as control.obj has them).
         let tags = subfit::io::read_tags_file(&a.a, ma.num_vertices())?;
         let ev = Evaluator::new(&ma.faces, ma.num_vertices(), &tags, &options).with_context(ctx)?;
+        shown_a_options = Some((options, tags));
         let (params, points) =
             random_samples(&ev, &ma.positions, a.samples as usize, a.seed).with_context(ctx)?;
         weights_ab = Some(area_weights(&ev, &params, &points));
@@ -149,7 +149,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
             &a,
             &ma,
             &mb,
-            shown_a_options.as_ref(),
+            shown_a_options.as_ref().map(|(o, t)| (o, t)),
             |x| sb.query.distance(x),
             &ab,
             &ba,

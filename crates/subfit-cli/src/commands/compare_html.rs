@@ -22,8 +22,8 @@ struct Shown {
 }
 
 /// A's limit surface (with `scheme`) or A itself, within the viewer's budget.
-fn shown(mesh: &PolyMesh, scheme: Option<&Options>) -> anyhow::Result<Shown> {
-    if let Some(options) = scheme {
+fn shown(mesh: &PolyMesh, scheme: Option<(&Options, &Tags)>) -> anyhow::Result<Shown> {
+    if let Some((options, tags)) = scheme {
         let per_level = |l: u32| mesh.faces.len() * 4usize.pow(l) * 2;
         let level = (1..=6u32)
             .take_while(|&l| per_level(l) <= VIEW_TRIANGLES)
@@ -32,7 +32,7 @@ fn shown(mesh: &PolyMesh, scheme: Option<&Options>) -> anyhow::Result<Shown> {
         let op = sampling_operator(
             &mesh.faces,
             mesh.positions.len(),
-            &Tags::new(),
+            tags,
             options,
             level as usize,
         )
@@ -82,7 +82,7 @@ pub fn page(
     a: &CompareArgs,
     ma: &PolyMesh,
     mb: &PolyMesh,
-    scheme: Option<&Options>,
+    scheme: Option<(&Options, &Tags)>,
     to_b: impl Fn([f64; 3]) -> f64 + Sync,
     ab: &DistanceStats,
     ba: &DistanceStats,

@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context};
 use subfit::io::ply::VertexProperty;
 use subfit::io::{Encoding, Format, WriteOptions};
-use subfit::mesh::{PolyMesh, Tags};
+use subfit::mesh::PolyMesh;
 use subfit::subdiv::{random_samples, Evaluator, Options};
 
 use crate::cli::EvalArgs;
@@ -37,13 +37,10 @@ pub fn run(a: EvalArgs) -> anyhow::Result<ExitCode> {
         Options::new(pick_scheme(a.scheme, &control)).with_boundary(boundary_rule(a.boundary));
     let ctx = || format!("{}: cannot evaluate", a.control.display());
     let sp = crate::progress::spinner("evaluating the limit surface");
-    let evaluator = Evaluator::new(
-        &control.faces,
-        control.num_vertices(),
-        &Tags::new(),
-        &options,
-    )
-    .with_context(ctx)?;
+    // The cage's own creases and corners (an OBJ's `t` lines, as control.obj has them).
+    let tags = subfit::io::read_tags_file(&a.control, control.num_vertices())?;
+    let evaluator = Evaluator::new(&control.faces, control.num_vertices(), &tags, &options)
+        .with_context(ctx)?;
     let (params, points) =
         random_samples(&evaluator, &control.positions, a.samples as usize, a.seed)
             .with_context(ctx)?;

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context};
 use subfit::io::{Encoding, Format, WriteOptions};
-use subfit::mesh::{PolyMesh, Tags};
+use subfit::mesh::PolyMesh;
 use subfit::subdiv::{refine, sampling_operator, BoundaryRule, Options, Scheme};
 
 use crate::cli::{BoundaryArg, SchemeArg, SubdivideArgs};
@@ -46,7 +46,8 @@ pub fn run(a: SubdivideArgs) -> anyhow::Result<ExitCode> {
     }
     let scheme = pick_scheme(a.scheme, &control);
     let options = Options::new(scheme).with_boundary(boundary_rule(a.boundary));
-    let tags = Tags::new();
+    // The cage's own creases and corners (an OBJ's `t` lines, as control.obj has them).
+    let tags = subfit::io::read_tags_file(&a.control, control.num_vertices())?;
     let ctx = || format!("{}: cannot subdivide", a.control.display());
 
     let sp = crate::progress::spinner("subdividing");
