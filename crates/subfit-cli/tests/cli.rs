@@ -833,7 +833,6 @@ fn subdivide_and_eval_honour_the_cages_tags() {
     ] {
         let sharp = worst(&tagged, command);
         let round = worst(&plain, command);
-        println!("{command:?}: tagged {sharp:.2e}, untagged {round:.2e} inside the cube");
         assert!(sharp < 1e-12, "{command:?}: {sharp}");
         assert!(round > 0.05, "{command:?}: {round}");
     }
