@@ -114,6 +114,9 @@ pub struct CompareArgs {
     /// to the other.
     #[arg(long, value_name = "OUT.html")]
     pub html: Option<PathBuf>,
+    /// Also list the N samples of each side farthest from the other (where the error is).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub worst: u32,
 }
 
 /// `subfit bench …`.

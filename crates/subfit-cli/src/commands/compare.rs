@@ -62,6 +62,21 @@ struct Comparison {
     reference_diagonal: f64,
     two_sided_rms_fraction: f64,
     hausdorff_fraction: f64,
+    /// With `--worst N`: A's samples farthest from B, farthest first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    worst_a_to_b: Vec<Worst>,
+    /// With `--worst N`: B's samples farthest from A, farthest first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    worst_b_to_a: Vec<Worst>,
+}
+
+/// A sample and its distance to the other surface (`--worst`).
+#[derive(Serialize)]
+struct Worst {
+    point: [f64; 3],
+    distance: f64,
+    /// `distance` over B's diagonal.
+    fraction: f64,
 }
 
 pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
@@ -73,7 +88,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
     let mut shown_a_options = None;
     // Area weights of A's samples (its limit surface is sampled per patch, not by area).
     let mut weights_ab = None;
-    let (dab, dba): (Vec<f64>, Vec<f64>) = if let Some(scheme) = a.scheme {
+    let (a_points, dab, dba): (Vec<[f64; 3]>, Vec<f64>, Vec<f64>) = if let Some(scheme) = a.scheme {
         if ma.faces.is_empty() {
             bail!(
                 "{}: --scheme needs a control mesh with faces",
@@ -101,7 +116,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
             .map(|&x| finder.closest(x).map(|c| c.distance))
             .collect::<Result<Vec<f64>, _>>()
             .with_context(ctx)?;
-        (dab, dba)
+        (points.iter().map(|p| p.position).collect(), dab, dba)
     } else {
         let sa =
             surface(&ma, a.samples as usize, a.seed).with_context(|| a.a.display().to_string())?;
@@ -115,7 +130,7 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
             .par_iter()
             .map(|&x| sa.query.distance(x))
             .collect();
-        (dab, dba)
+        (sa.samples, dab, dba)
     };
     sp.finish_and_clear();
     let ab = match &weights_ab {
@@ -132,7 +147,27 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
         .map(|(lo, hi)| (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt())
         .unwrap_or(0.0);
     let frac = |v: f64| if diag > 0.0 { v / diag } else { f64::NAN };
+    let worst = |points: &[[f64; 3]], d: &[f64]| -> Vec<Worst> {
+        let mut order: Vec<usize> = (0..d.len()).collect();
+        let n = (a.worst as usize).min(d.len());
+        if n == 0 {
+            return Vec::new();
+        }
+        order.select_nth_unstable_by(n - 1, |&i, &j| d[j].total_cmp(&d[i]));
+        order.truncate(n);
+        order.sort_by(|&i, &j| d[j].total_cmp(&d[i]));
+        order
+            .into_iter()
+            .map(|i| Worst {
+                point: points[i],
+                distance: d[i],
+                fraction: frac(d[i]),
+            })
+            .collect()
+    };
     let c = Comparison {
+        worst_a_to_b: worst(&a_points, &dab),
+        worst_b_to_a: worst(&sb.samples, &dba),
         a: a.a.display().to_string(),
         b: a.b.display().to_string(),
         two_sided_rms,
@@ -177,6 +212,18 @@ pub fn run(a: CompareArgs) -> anyhow::Result<ExitCode> {
             "two-sided RMS {:.6e} ({:.3e} of the diagonal); Hausdorff {:.6e} ({:.3e} of the diagonal)",
             c.two_sided_rms, c.two_sided_rms_fraction, c.hausdorff, c.hausdorff_fraction
         );
+        for (name, w) in [("A → B", &c.worst_a_to_b), ("B → A", &c.worst_b_to_a)] {
+            for x in w {
+                out!(
+                    "{name} worst: ({:.6}, {:.6}, {:.6}) at {:.6e} ({:.3e} of the diagonal)",
+                    x.point[0],
+                    x.point[1],
+                    x.point[2],
+                    x.distance,
+                    x.fraction
+                );
+            }
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
