@@ -249,6 +249,50 @@ impl TriangleBvh {
     }
 }
 
+impl TriangleBvh {
+    /// Every triangle within `radius` of `x` with its closest point, in no particular order
+    /// (e.g. the other candidates when the nearest one is not enough). Cost: the nodes whose
+    /// boxes are within `radius`, and one allocation.
+    pub fn within(&self, x: [f64; 3], radius: f64) -> Vec<MeshClosestPoint> {
+        let mut out = Vec::new();
+        if self.nodes.is_empty() || radius.is_nan() || radius < 0.0 {
+            return out;
+        }
+        let r2 = radius * radius;
+        let mut stack = vec![0u32];
+        while let Some(ni) = stack.pop() {
+            let node = self.nodes[ni as usize];
+            if box_dist2(&node, x) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                let s = node.first as usize;
+                let slots = s..s + node.count as usize;
+                for (&t, &[a, b, c]) in self.order[slots.clone()].iter().zip(&self.corners[slots]) {
+                    let (point, barycentric) = closest_on_triangle(x, a, b, c);
+                    let dd = sub(x, point);
+                    let d2 = dot(dd, dd);
+                    if d2 <= r2 {
+                        let face_normal =
+                            normalize(cross(sub(b, a), sub(c, a))).unwrap_or([0.0; 3]);
+                        out.push(MeshClosestPoint {
+                            point,
+                            triangle: t,
+                            barycentric,
+                            distance: d2.sqrt(),
+                            face_normal,
+                        });
+                    }
+                }
+            } else {
+                stack.push(node.first);
+                stack.push(node.first + 1);
+            }
+        }
+        out
+    }
+}
+
 /// Squared distance from `x` to the box of node `n` (0 inside).
 #[inline]
 fn box_dist2(n: &Node, x: [f64; 3]) -> f64 {
@@ -363,6 +407,23 @@ mod tests {
         };
         for _ in 0..200 {
             let x = [rnd() * 1.4 - 0.2, rnd() * 1.4 - 0.2, rnd() - 0.5];
+            // `within` finds exactly the triangles a scan of all finds within the radius.
+            let radius = 0.05 + 0.2 * rnd();
+            let mut near: Vec<u32> = bvh.within(x, radius).iter().map(|h| h.triangle).collect();
+            near.sort_unstable();
+            let all: Vec<u32> = (0..t.len() as u32)
+                .filter(|&k| {
+                    let tr = t[k as usize];
+                    let (p, _) = closest_on_triangle(
+                        x,
+                        v[tr[0] as usize],
+                        v[tr[1] as usize],
+                        v[tr[2] as usize],
+                    );
+                    dist2(x, p) <= radius * radius
+                })
+                .collect();
+            assert_eq!(near, all);
             let hit = bvh.closest(x).unwrap();
             let brute = t
                 .iter()

@@ -29,6 +29,16 @@ use std::collections::HashMap;
 use subfit_mesh::bvh::TriangleBvh;
 use subfit_mesh::vec3::{dot, sub};
 
+/// Other patches [`ClosestPointFinder::closest`] descends from when the starts near the
+/// nearest tessellation triangle stop short of a stationary point.
+const MAX_OTHER_PATCHES: usize = 16;
+
+/// A descent that ends farther than twice the query's distance to the tessellation plus this
+/// fraction of the mesh size is retried ([`ClosestPointFinder::closest`]): it stopped at a
+/// stationary point across a crease (the rounded prism's cap, 2.5e-3 from a point on it).
+/// Below it the tessellation's own chordal error could be the difference.
+const SUSPECT: f64 = 1e-4;
+
 /// Options of the closest-point search.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClosestOptions {
@@ -194,7 +204,32 @@ impl<'a> ClosestPointFinder<'a> {
     /// Starting parameters: the nearest tessellation point, then (for a search that gets stuck)
     /// the corners of its triangle and the centre of its patch; all moved slightly towards the
     /// centre, off the patch corners where the parametrisation may be singular.
-    fn starts(&self, q: [f64; 3]) -> Option<[SurfaceParam; 5]> {
+    /// The parameters of the point with `barycentric` coordinates in tessellation triangle
+    /// `triangle`, nudged 1e-3 towards its patch's centre (off a corner, where the
+    /// parametrisation may be singular).
+    fn param_at(&self, triangle: u32, barycentric: [f64; 3]) -> SurfaceParam {
+        let ps = &self.tri_params[triangle as usize];
+        let (mut u, mut v) = (0.0, 0.0);
+        for (p, w) in ps.iter().zip(barycentric) {
+            u += w * p.u;
+            v += w * p.v;
+        }
+        let (cu, cv) = if self.ev.triangle_patch(ps[0].face) {
+            (1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            (0.5, 0.5)
+        };
+        let e = 1e-3;
+        SurfaceParam {
+            u: u + e * (cu - u),
+            v: v + e * (cv - v),
+            ..ps[0]
+        }
+    }
+
+    /// The starts of a descent towards `q` (see [`Self::closest`]) and `q`'s distance to the
+    /// tessellation.
+    fn starts(&self, q: [f64; 3]) -> Option<([SurfaceParam; 5], f64)> {
         let n = self.bvh.closest(q)?;
         let ps = &self.tri_params[n.triangle as usize];
         let (mut u, mut v) = (0.0, 0.0);
@@ -213,13 +248,16 @@ impl<'a> ClosestPointFinder<'a> {
             v: v + e * (cv - v),
             ..ps[0]
         };
-        Some([
-            at(u, v),
-            at(ps[0].u, ps[0].v),
-            at(ps[1].u, ps[1].v),
-            at(ps[2].u, ps[2].v),
-            at(cu, cv),
-        ])
+        Some((
+            [
+                at(u, v),
+                at(ps[0].u, ps[0].v),
+                at(ps[1].u, ps[1].v),
+                at(ps[2].u, ps[2].v),
+                at(cu, cv),
+            ],
+            n.distance,
+        ))
     }
 
     fn eval(&self, p: SurfaceParam) -> Result<SurfacePoint, EvalError> {
@@ -249,7 +287,7 @@ impl<'a> ClosestPointFinder<'a> {
     /// Errors: evaluation failures (none are expected for a valid mesh); an empty mesh gives
     /// [`EvalError::FaceOutOfRange`].
     pub fn closest(&self, q: [f64; 3]) -> Result<ClosestPoint, EvalError> {
-        let starts = self.starts(q).ok_or(EvalError::FaceOutOfRange {
+        let (starts, near) = self.starts(q).ok_or(EvalError::FaceOutOfRange {
             face: 0,
             num_faces: 0,
         })?;
@@ -257,20 +295,63 @@ impl<'a> ClosestPointFinder<'a> {
         // Stuck short of a stationary point (at a crease or a singular corner of the
         // parametrisation): try again from the other corners of the starting triangle and the
         // patch's centre, and keep the nearest point found.
+        let better = |c: &ClosestPoint, best: &ClosestPoint| {
+            c.distance < best.distance || (c.converged && c.distance <= best.distance)
+        };
         for &p in &starts[1..] {
             if best.converged {
                 break;
             }
             let c = self.descend(q, p)?;
-            if c.distance < best.distance || (c.converged && c.distance <= best.distance) {
+            if better(&c, &best) {
                 best = c;
+            }
+        }
+        // Stuck (short of a stationary point, or at one on the wrong side of a crease: the
+        // descent can step over the crease into a neighbouring patch and stop at its edge,
+        // farther than the tessellation from the query): descend again from the start
+        // patches without leaving them, and from the other patches that come that near.
+        if !best.converged || best.distance > 2.0 * near + SUSPECT * self.scale {
+            for &p in &starts {
+                let c = self.descend_within(q, p, false)?;
+                if better(&c, &best) {
+                    best = c;
+                }
+            }
+            let first = (starts[0].face, starts[0].sub);
+            let mut tried = vec![first];
+            let mut others = self.bvh.within(q, best.distance * (1.0 + 1e-9));
+            others.sort_by(|a, b| a.distance.total_cmp(&b.distance));
+            for n in others {
+                if tried.len() > MAX_OTHER_PATCHES || best.distance <= 2.0 * near {
+                    break;
+                }
+                let p = self.param_at(n.triangle, n.barycentric);
+                if tried.contains(&(p.face, p.sub)) {
+                    continue;
+                }
+                tried.push((p.face, p.sub));
+                let c = self.descend(q, p)?;
+                if better(&c, &best) {
+                    best = c;
+                }
             }
         }
         Ok(best)
     }
 
     /// The descent of [`Self::closest`] from the parameters `p`.
-    fn descend(&self, q: [f64; 3], mut p: SurfaceParam) -> Result<ClosestPoint, EvalError> {
+    fn descend(&self, q: [f64; 3], p: SurfaceParam) -> Result<ClosestPoint, EvalError> {
+        self.descend_within(q, p, true)
+    }
+
+    /// [`Self::descend`], crossing into neighbouring patches only when `cross`.
+    fn descend_within(
+        &self,
+        q: [f64; 3],
+        mut p: SurfaceParam,
+        cross: bool,
+    ) -> Result<ClosestPoint, EvalError> {
         let mut s = self.eval(p)?;
         let mut f = half_norm2(sub(s.position, q));
         let mut mu = 0.0f64;
@@ -371,7 +452,7 @@ impl<'a> ClosestPointFinder<'a> {
                         mu = 0.0;
                     }
                     accepted = progressed;
-                    if let Some(edge) = exit {
+                    if let Some(edge) = exit.filter(|_| cross) {
                         if let Some((np, left)) = self.cross(p, edge) {
                             let target = self.ev.patch_index(np.face, np.sub) as u32;
                             if progressed || came_from != Some(target) || f < f_at_cross {
