@@ -370,9 +370,10 @@ pub struct FeatureArgs {
     /// Mesh targets: dihedral angle (degrees) from which an edge of the data is a sharp
     /// feature. The initial cage keeps the feature curves as edges tagged as infinitely sharp
     /// creases, and their corners as corners (control.usda; control.obj as OpenSubdiv `t`
-    /// lines).
-    #[arg(long, default_value_t = 40.0, value_parser = feature_angle)]
-    pub feature_angle: f64,
+    /// lines). Default 40; `fit` with its default tolerances detects a CAD part's features
+    /// again from 20° (a coarse fillet's facets meet at kinks).
+    #[arg(long, value_parser = feature_angle)]
+    pub feature_angle: Option<f64>,
     /// A smooth cage for a mesh target: no feature detection, no crease or corner tags.
     #[arg(long)]
     pub no_features: bool,
@@ -390,9 +391,12 @@ pub struct FeatureArgs {
 impl FeatureArgs {
     /// The library's feature options (`None`: off).
     pub fn options(&self) -> Option<subfit::target::FeatureOptions> {
-        (!self.no_features).then(|| subfit::target::FeatureOptions {
-            angle_deg: self.feature_angle,
-            ..subfit::target::FeatureOptions::default()
+        (!self.no_features).then(|| {
+            let default = subfit::target::FeatureOptions::default();
+            subfit::target::FeatureOptions {
+                angle_deg: self.feature_angle.unwrap_or(default.angle_deg),
+                ..default
+            }
         })
     }
 }

@@ -109,6 +109,12 @@ pub struct FitScanOptions {
     /// a CAD part with sharp creases or a noisy scan), as `subfit fit` does when no tolerance is
     /// given. Default false: the tolerances of `stages` (unit cube).
     pub target_tolerances: bool,
+    /// With [`Self::target_tolerances`], a mesh target whose initial cage makes it a CAD part
+    /// ([`ToleranceKind::CadPart`]) has its sharp features detected again from this dihedral
+    /// angle (degrees) when the features' angle is larger, and its cage built again
+    /// ([`crate::tolerance::CAD_FEATURE_ANGLE`] by default; `None`: never). `subfit fit` sets
+    /// `None` when `--feature-angle` is given.
+    pub cad_feature_angle: Option<f64>,
     /// Target analysis options.
     pub target: TargetOptions,
     /// Initial-mesh options (`expected_genus` and `expected_boundary_loops` are set from the faces
@@ -137,6 +143,7 @@ impl Default for FitScanOptions {
             },
             stages: StageOptions::default(),
             target_tolerances: false,
+            cad_feature_angle: Some(crate::tolerance::CAD_FEATURE_ANGLE),
             target: TargetOptions::default(),
             init_options: InitOptions {
                 features: Some(FeatureOptions::default()),
@@ -395,15 +402,38 @@ pub fn fit_scan(
             } else {
                 budget
             };
-            let (m, r) = initial_control_mesh(&target, dense, n, &init_options).map_err(|e| {
-                match e {
+            let build = |init_options: &InitOptions| {
+                initial_control_mesh(&target, dense, n, init_options).map_err(|e| match e {
                     subfit_init::InitError::TooFewForTopology { .. } if options.control_points.is_none() => {
                         Error::Budget(format!("{name}: the budget of {budget} control points is too small for this target: {e}"))
                     }
                     subfit_init::InitError::Interrupted => Error::Interrupted,
                     e => Error::Init { name: name.clone(), source: e },
+                })
+            };
+            let (mut m, mut r) = build(&init_options)?;
+            // A CAD part: its features again from a smaller angle (the facets of a coarsely
+            // tessellated fillet meet at kinks the default angle leaves to the smooth surface).
+            let cad_angle = options
+                .cad_feature_angle
+                .filter(|_| options.target_tolerances)
+                .filter(|&a| {
+                    init_options
+                        .features
+                        .as_ref()
+                        .is_some_and(|f| f.angle_deg > a)
+                });
+            if let Some(angle) = cad_angle {
+                let kind = ToleranceKind::of(target.stats(), &r.tags, edge_count(&m.faces));
+                if kind == ToleranceKind::CadPart {
+                    let mut again = init_options.clone();
+                    if let Some(f) = again.features.as_mut() {
+                        f.angle_deg = angle;
+                    }
+                    (m, r) = build(&again)?;
+                    init_options = again;
                 }
-            })?;
+            }
             if m.num_vertices() > budget {
                 return Err(Error::Budget(format!(
                     "{name}: the initial control mesh keeps {} control points (no legal simplification below it for this topology), more than the budget of {budget}",

@@ -122,6 +122,10 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         target_tolerances: a.tolerance.is_none()
             && a.max_error.is_none()
             && a.max_control_points.is_none(),
+        // An angle given is the angle used.
+        cad_feature_angle: FitScanOptions::default()
+            .cad_feature_angle
+            .filter(|_| a.features.feature_angle.is_none()),
         ..FitScanOptions::default()
     })
 }
