@@ -51,7 +51,9 @@ fn cage_topology(dir: &Path) -> serde_json::Value {
 /// Cheng 2007 Table IV's Igea row, from the scan's points alone: E_rms ≤ 0.0005 and
 /// E_max ≤ 0.0036 (unit cube, the fitter's own foot points) with ≤ 2,385 control points. Then an
 /// independent check against the exact distance from the limit surface to Igea's triangles,
-/// which the fit never saw: RMS within the same 0.0005; the maximum is bounded by scanner debris
+/// which the fit never saw: its RMS (area-weighted) within 10 % of the fit's own area-weighted
+/// surface → data RMS (Cheng's E_rms counts every limit sample alike, as the fit's E_rms does:
+/// 3.8e-4, where area-weighted both measure 5.6e-4); the maximum is bounded by scanner debris
 /// at the base rim and a crevice under the chin that the triangles bridge (measured 0.0036 to
 /// 0.0043 over stage lengths and depths; bounded here by 0.005).
 #[test]
@@ -150,8 +152,11 @@ fn igea_as_a_point_cloud_reaches_table_iv_within_its_control_point_budget() {
         j["a_to_b"]["rms"].as_f64().unwrap() / unit,
         j["a_to_b"]["max"].as_f64().unwrap() / unit,
     );
-    println!("igea (points): exact distance to the triangles RMS {rms:.3e}, max {max:.3e}");
-    assert!(rms <= 0.0005, "{rms}");
+    // The fit's own surface → data figures, area-weighted as compare's are.
+    let s2d = &rep["final"]["two_sided"]["surface_to_data"];
+    let (own_rms, own_max) = (s2d["rms"].as_f64().unwrap(), s2d["max"].as_f64().unwrap());
+    println!("igea (points): exact distance to the triangles RMS {rms:.3e}, max {max:.3e}; the fit's own surface -> points RMS {own_rms:.3e}, max {own_max:.3e}");
+    assert!(rms <= 1.1 * own_rms, "{rms} vs {own_rms}");
     assert!(max <= 0.005, "{max}");
 }
 

@@ -256,10 +256,7 @@ pub fn contour(
         positions,
         &tris,
         options.min_component_fraction,
-        Some((
-            target.points(),
-            crate::islands::island_gap(target, band_width),
-        )),
+        Some((target.points(), band_width)),
     );
     let he =
         HalfEdgeMesh::from_mesh(&mesh).map_err(|e| ContourError::NotManifold(e.to_string()))?;
