@@ -10,7 +10,7 @@
 //! uncovered has not reached its tolerance (DESIGN.md decision 11). A blob around stray points
 //! sits next to data the kept surface already covers; an island is the only surface near its
 //! points. So a component that would be dropped is kept when at least [`MIN_ISLAND_POINTS`] data
-//! points lie farther than a gap ([`island_gap`]) from every kept component and nearest to it.
+//! points lie farther than a gap (`island_gap`) from every kept component and nearest to it.
 //! [`keep_components`] applies the size rule and this one to a contour's triangles.
 
 use subfit_mesh::{face_components, PolyMesh, Polygons};
