@@ -120,8 +120,8 @@ fn open_meshes_keep_their_loops_and_are_covered_both_ways() {
 /// A single-view range scan of the bunny (400 × 400 pixels, noise 2e-4 of the diagonal, views
 /// of seeds 1 and 2), fitted with the defaults: the cage is open, the scan's points are covered
 /// (RMS ≤ 1e-3, max ≤ 1 % of the scan's diagonal) and the surface lies on the true mesh (RMS
-/// ≤ 1e-3 of the scan's diagonal). Measured 6.7e-4 / 0.52 % / 6.6e-4 and 7.2e-4 / 0.59 % /
-/// 7.7e-4. Before the clean-scan outlier exemptions, the island gap and the badness change:
+/// ≤ 1e-3 of the scan's diagonal). Measured 6.8e-4 / 0.66 % / 6.7e-4 and 6.8e-4 / 0.51 % /
+/// 7.1e-4. Before the clean-scan outlier exemptions, the island gap and the badness change:
 /// 1.06e-3 / 4.0 % and 1.04e-3 / 4.6 % (sparse rim returns dropped, a stall at the initial
 /// cage). Other views still miss the maximum: a lone return with no other within 1.4–2.6 %
 /// of the diagonal is dropped as an outlier (seeds 4–6 of the same scans).
