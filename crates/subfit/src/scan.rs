@@ -430,8 +430,16 @@ pub fn fit_scan(
                     if let Some(f) = again.features.as_mut() {
                         f.angle_deg = angle;
                     }
-                    (m, r) = build(&again)?;
-                    init_options = again;
+                    // A cage the smaller angle cannot give within the budget (too many
+                    // feature curves for it) leaves the first one.
+                    match build(&again) {
+                        Ok(second) if second.0.num_vertices() <= budget => {
+                            (m, r) = second;
+                            init_options = again;
+                        }
+                        Err(Error::Interrupted) => return Err(Error::Interrupted),
+                        _ => {}
+                    }
                 }
             }
             if m.num_vertices() > budget {
