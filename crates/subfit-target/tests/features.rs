@@ -209,6 +209,35 @@ fn smooth_torus_has_no_features() {
     assert!(f.is_empty(), "{} edges", f.edges.len());
 }
 
+/// A UV sphere of 48 × 24 (triangles, fans at the poles) has no sharp feature either, at the
+/// poles included, where 48 thin triangles meet.
+#[test]
+fn smooth_sphere_has_no_features() {
+    let (nu, nv) = (48usize, 24usize);
+    let mut p = vec![[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    for j in 1..nv {
+        let t = std::f64::consts::PI * j as f64 / nv as f64;
+        for i in 0..nu {
+            let a = std::f64::consts::TAU * i as f64 / nu as f64;
+            p.push([t.sin() * a.cos(), t.sin() * a.sin(), t.cos()]);
+        }
+    }
+    let id = |j: usize, i: usize| (2 + (j - 1) * nu + i % nu) as u32;
+    let mut f = Polygons::new();
+    for i in 0..nu {
+        f.push(&[0, id(1, i), id(1, i + 1)]);
+        f.push(&[1, id(nv - 1, i + 1), id(nv - 1, i)]);
+    }
+    for j in 1..nv - 1 {
+        for i in 0..nu {
+            f.push(&[id(j, i), id(j + 1, i), id(j + 1, i + 1)]);
+            f.push(&[id(j, i), id(j + 1, i + 1), id(j, i + 1)]);
+        }
+    }
+    let f = detect(&PolyMesh::new(p, f));
+    assert!(f.is_empty(), "{} edges", f.edges.len());
+}
+
 #[test]
 fn a_short_gap_in_a_crease_is_bridged() {
     // One vertex of a crease pushed inward: the dihedral angles of its two crease edges fall
