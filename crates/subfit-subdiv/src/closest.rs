@@ -200,13 +200,29 @@ impl<'a> ClosestPointFinder<'a> {
         })
     }
 
-    /// The starting guess for `q`: parameters of the nearest tessellation point.
-    /// Starting parameters: the nearest tessellation point, then (for a search that gets stuck)
-    /// the corners of its triangle and the centre of its patch; all moved slightly towards the
-    /// centre, off the patch corners where the parametrisation may be singular.
+    /// The centre of `face`'s parameter domain (triangle or square).
+    fn centre(&self, face: u32) -> (f64, f64) {
+        if self.ev.triangle_patch(face) {
+            (1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            (0.5, 0.5)
+        }
+    }
+
+    /// `(u, v)` on `base`'s patch, moved 1e-3 of the way towards its centre (off a corner,
+    /// where the parametrisation may be singular).
+    fn nudged(&self, base: SurfaceParam, u: f64, v: f64) -> SurfaceParam {
+        let (cu, cv) = self.centre(base.face);
+        let e = 1e-3;
+        SurfaceParam {
+            u: u + e * (cu - u),
+            v: v + e * (cv - v),
+            ..base
+        }
+    }
+
     /// The parameters of the point with `barycentric` coordinates in tessellation triangle
-    /// `triangle`, nudged 1e-3 towards its patch's centre (off a corner, where the
-    /// parametrisation may be singular).
+    /// `triangle`, [`Self::nudged`].
     fn param_at(&self, triangle: u32, barycentric: [f64; 3]) -> SurfaceParam {
         let ps = &self.tri_params[triangle as usize];
         let (mut u, mut v) = (0.0, 0.0);
@@ -214,47 +230,26 @@ impl<'a> ClosestPointFinder<'a> {
             u += w * p.u;
             v += w * p.v;
         }
-        let (cu, cv) = if self.ev.triangle_patch(ps[0].face) {
-            (1.0 / 3.0, 1.0 / 3.0)
-        } else {
-            (0.5, 0.5)
-        };
-        let e = 1e-3;
-        SurfaceParam {
-            u: u + e * (cu - u),
-            v: v + e * (cv - v),
-            ..ps[0]
-        }
+        self.nudged(ps[0], u, v)
     }
 
-    /// The starts of a descent towards `q` (see [`Self::closest`]) and `q`'s distance to the
-    /// tessellation.
+    /// Starting parameters: the nearest tessellation point, then (for a search that gets stuck)
+    /// the corners of its triangle and the centre of its patch; all moved slightly towards the
+    /// centre, off the patch corners where the parametrisation may be singular.
+    ///
+    /// Also returns `q`'s distance to the tessellation.
     fn starts(&self, q: [f64; 3]) -> Option<([SurfaceParam; 5], f64)> {
         let n = self.bvh.closest(q)?;
         let ps = &self.tri_params[n.triangle as usize];
-        let (mut u, mut v) = (0.0, 0.0);
-        for (p, w) in ps.iter().zip(n.barycentric) {
-            u += w * p.u;
-            v += w * p.v;
-        }
-        let (cu, cv) = if self.ev.triangle_patch(ps[0].face) {
-            (1.0 / 3.0, 1.0 / 3.0)
-        } else {
-            (0.5, 0.5)
-        };
-        let e = 1e-3;
-        let at = |u: f64, v: f64| SurfaceParam {
-            u: u + e * (cu - u),
-            v: v + e * (cv - v),
-            ..ps[0]
-        };
+        let (cu, cv) = self.centre(ps[0].face);
+        let corner = |k: usize| self.nudged(ps[0], ps[k].u, ps[k].v);
         Some((
             [
-                at(u, v),
-                at(ps[0].u, ps[0].v),
-                at(ps[1].u, ps[1].v),
-                at(ps[2].u, ps[2].v),
-                at(cu, cv),
+                self.param_at(n.triangle, n.barycentric),
+                corner(0),
+                corner(1),
+                corner(2),
+                self.nudged(ps[0], cu, cv),
             ],
             n.distance,
         ))
@@ -266,11 +261,7 @@ impl<'a> ClosestPointFinder<'a> {
             return Ok(r);
         }
         // Exactly at an irregular vertex there are no parametric derivatives: nudge inside.
-        let (cu, cv) = if self.ev.triangle_patch(p.face) {
-            (1.0 / 3.0, 1.0 / 3.0)
-        } else {
-            (0.5, 0.5)
-        };
+        let (cu, cv) = self.centre(p.face);
         let e = 1e-9;
         self.ev.evaluate(
             &self.positions,
