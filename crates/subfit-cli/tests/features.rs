@@ -62,6 +62,18 @@ fn fit_and_compare(
     (report, cmp)
 }
 
+/// `shapes::rounded_prism(0.08, 40)` (fillets of two facets, sharp rims) written to `dir`.
+fn rounded_prism(dir: &Path) -> std::path::PathBuf {
+    let prism = dir.join("rounded.obj");
+    subfit::io::write_file(
+        &prism,
+        &subfit::mesh::shapes::rounded_prism(0.08, 40),
+        &Default::default(),
+    )
+    .unwrap();
+    prism
+}
+
 #[test]
 fn boxes_fit_with_creased_cages_of_few_control_points() {
     let d = tempfile::tempdir().unwrap();
@@ -258,13 +270,7 @@ fn a_washer_keeps_its_sharp_rims_with_fewer_control_points() {
 #[test]
 fn semi_sharp_creases_follow_the_fillets() {
     let d = tempfile::tempdir().unwrap();
-    let prism = d.path().join("rounded.obj");
-    subfit::io::write_file(
-        &prism,
-        &subfit::mesh::shapes::rounded_prism(0.08, 40),
-        &Default::default(),
-    )
-    .unwrap();
+    let prism = rounded_prism(d.path());
     let out = d.path().join("semi");
     let (report, cmp) = fit_and_compare(&prism, &out, &["--semi-sharp", "--tolerance", "5e-4"], 0);
     let cp = report["control_points"].as_u64().unwrap() as usize;
@@ -314,13 +320,7 @@ fn semi_sharp_creases_follow_the_fillets() {
 #[test]
 fn a_cad_part_with_sharp_rims_meets_the_cad_tolerances_with_the_defaults() {
     let d = tempfile::tempdir().unwrap();
-    let prism = d.path().join("rounded.obj");
-    subfit::io::write_file(
-        &prism,
-        &subfit::mesh::shapes::rounded_prism(0.08, 40),
-        &Default::default(),
-    )
-    .unwrap();
+    let prism = rounded_prism(d.path());
     let out = d.path().join("fit");
     let (report, cmp) = fit_and_compare(&prism, &out, &[], 0);
     let (rms, hausdorff) = (
