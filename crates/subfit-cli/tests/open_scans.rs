@@ -118,13 +118,13 @@ fn open_meshes_keep_their_loops_and_are_covered_both_ways() {
 }
 
 /// A single-view range scan of the bunny (400 × 400 pixels, noise 2e-4 of the diagonal, views
-/// of seeds 1 and 2), fitted with the defaults: the cage is open, the scan's points are covered
+/// of seeds 1 and 4), fitted with the defaults: the cage is open, the scan's points are covered
 /// (RMS ≤ 1e-3, max ≤ 1 % of the scan's diagonal) and the surface lies on the true mesh (RMS
-/// ≤ 1e-3 of the scan's diagonal). Measured 6.8e-4 / 0.66 % / 6.7e-4 and 6.8e-4 / 0.51 % /
-/// 7.1e-4. Before the clean-scan outlier exemptions, the island gap and the badness change:
-/// 1.06e-3 / 4.0 % and 1.04e-3 / 4.6 % (sparse rim returns dropped, a stall at the initial
-/// cage). Other views still miss the maximum: a lone return with no other within 1.4–2.6 %
-/// of the diagonal is dropped as an outlier (seeds 4–6 of the same scans).
+/// ≤ 1e-3 of the scan's diagonal). Measured (release build) 6.8e-4 / 0.66 % / 6.7e-4 and
+/// 8.5e-4 / 0.88 % / 8.4e-4. Before the clean-scan outlier exemptions, the island gap and the
+/// badness change: 1.06e-3 / 4.0 % and 1.36e-3 / 5.4 % (sparse rim returns dropped, a stall at
+/// the initial cage); before the past-the-edge rule, view 4 still missed its lone returns
+/// (2.2 %). Views 2, 3, 5 and 6 of the same scans: 0.51 %, 0.76 %, 0.65 %, 0.47 %.
 ///
 /// The fit's own default tolerance is stricter (two-sided, surface → scan included, where the
 /// surface spans the scan's occlusion gaps), so its exit code is 0 or 1.
@@ -133,7 +133,10 @@ fn a_single_view_range_scan_is_an_open_surface_on_the_scan_and_the_mesh() {
     let Some(data) = data_dir() else { return };
     let bunny = data.join("bunny.off");
     let (mesh, _) = subfit::io::read_file(&bunny, &Default::default()).unwrap();
-    for seed in [1, 2] {
+    // View 4 has lone returns 1–3.5 spacings past the silhouette's last row, which the
+    // outlier rules dropped before their fourth rule (subfit-target `outliers`): the surface
+    // then ended 2.2 % of the diagonal from them.
+    for seed in [1, 4] {
         let d = tempfile::tempdir().unwrap();
         let points = subfit::mesh::range_scan::range_scan(&mesh, 400, 2e-4, None, seed);
         let scan = d.path().join("scan.ply");

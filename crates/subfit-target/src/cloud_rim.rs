@@ -31,30 +31,73 @@ pub fn cloud_boundary_points(target: &Target, k: usize, max_gap: f64) -> Vec<boo
         .into_par_iter()
         .map(|i| {
             let p = points[i];
-            let n = normals[i];
-            let Some((u, v)) = tangent_basis(n) else {
-                return false;
-            };
-            let mut angles: Vec<f64> = index
+            let near = index
                 .k_nearest(&p, k + 1)
-                .iter()
+                .into_iter()
                 .filter(|nb| nb.index as usize != i)
-                .filter_map(|nb| {
-                    let q = points[nb.index as usize];
-                    let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                    let (x, y) = (dot(d, u), dot(d, v));
-                    (x * x + y * y > 0.0).then(|| y.atan2(x))
-                })
-                .collect();
-            if angles.len() < 3 {
-                return false;
-            }
-            angles.sort_by(f64::total_cmp);
-            let wrap = angles[0] + std::f64::consts::TAU - angles[angles.len() - 1];
-            let gap = angles.windows(2).map(|w| w[1] - w[0]).fold(wrap, f64::max);
-            gap > max_gap
+                .map(|nb| points[nb.index as usize]);
+            AngularGap::around(p, normals[i], near).is_some_and(|g| g.width > max_gap)
         })
         .collect()
+}
+
+/// The widest angular gap around a point between its neighbours, projected onto its tangent
+/// plane (the angle criterion above).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct AngularGap {
+    u: [f64; 3],
+    v: [f64; 3],
+    /// Angle (radians, in the tangent frame) where the gap starts, counter-clockwise.
+    start: f64,
+    /// Width of the gap (radians).
+    pub width: f64,
+}
+
+impl AngularGap {
+    /// The widest gap around `p` in the plane normal to `n` between `neighbours` (those
+    /// projecting onto `p` ignored). `None` for a zero normal or fewer than 3 neighbours.
+    pub(crate) fn around(
+        p: [f64; 3],
+        n: [f64; 3],
+        neighbours: impl IntoIterator<Item = [f64; 3]>,
+    ) -> Option<Self> {
+        let (u, v) = tangent_basis(n)?;
+        let angle = |q: [f64; 3]| {
+            let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+            let (x, y) = (dot(d, u), dot(d, v));
+            (x * x + y * y > 0.0).then(|| y.atan2(x))
+        };
+        let mut angles: Vec<f64> = neighbours.into_iter().filter_map(angle).collect();
+        if angles.len() < 3 {
+            return None;
+        }
+        angles.sort_by(f64::total_cmp);
+        let last = angles[angles.len() - 1];
+        let mut gap = (last, angles[0] + std::f64::consts::TAU - last);
+        for w in angles.windows(2) {
+            if w[1] - w[0] > gap.1 {
+                gap = (w[0], w[1] - w[0]);
+            }
+        }
+        Some(Self {
+            u,
+            v,
+            start: gap.0,
+            width: gap.1,
+        })
+    }
+
+    /// Whether the direction from `p` (the point the gap is around) to `q`, projected onto the
+    /// tangent plane, lies inside the gap (false when `q` projects onto `p`).
+    pub(crate) fn contains(&self, p: [f64; 3], q: [f64; 3]) -> bool {
+        let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let (x, y) = (dot(d, self.u), dot(d, self.v));
+        if x * x + y * y == 0.0 {
+            return false;
+        }
+        let rel = (y.atan2(x) - self.start).rem_euclid(std::f64::consts::TAU);
+        rel < self.width
+    }
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
