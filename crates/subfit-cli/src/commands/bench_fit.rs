@@ -61,6 +61,27 @@ impl Model {
     }
 }
 
+/// An open model of issue 14, fitted with `subfit fit`'s defaults ([`Model::defaults`]).
+const fn open_model(
+    name: &'static str,
+    file: &'static str,
+    as_points: bool,
+    paper: &'static str,
+) -> Model {
+    Model {
+        name,
+        file,
+        as_points,
+        tolerance: 0.0,
+        max_error: None,
+        max_control_points: None,
+        fixed: false,
+        method: Method::Sdm,
+        defaults: true,
+        paper,
+    }
+}
+
 const MODELS: &[Model] = &[
     Model {
         name: "igea",
@@ -180,54 +201,10 @@ const MODELS: &[Model] = &[
     // Issue 14's open models with `subfit fit`'s defaults: boundary loops and genus kept,
     // two-sided RMS ≤ 1e-3 and Hausdorff ≤ 1 % of the diagonal (the fit's own default
     // tolerances are 0.075 % and 0.7 %, boundary vertices 0.4 %).
-    Model {
-        name: "face",
-        file: "face.obj",
-        as_points: false,
-        tolerance: 0.0,
-        max_error: None,
-        max_control_points: None,
-        fixed: false,
-        method: Method::Sdm,
-        defaults: true,
-        paper: "issue 14 (open, 1 loop): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal",
-    },
-    Model {
-        name: "camelhead",
-        file: "camelhead.off",
-        as_points: false,
-        tolerance: 0.0,
-        max_error: None,
-        max_control_points: None,
-        fixed: false,
-        method: Method::Sdm,
-        defaults: true,
-        paper: "issue 14 (open, 1 loop): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal",
-    },
-    Model {
-        name: "beetle",
-        file: "beetle.off",
-        as_points: false,
-        tolerance: 0.0,
-        max_error: None,
-        max_control_points: None,
-        fixed: false,
-        method: Method::Sdm,
-        defaults: true,
-        paper: "issue 14 (open, 11 loops): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal",
-    },
-    Model {
-        name: "bun000",
-        file: "bun000_points.ply",
-        as_points: true,
-        tolerance: 0.0,
-        max_error: None,
-        max_control_points: None,
-        fixed: false,
-        method: Method::Sdm,
-        defaults: true,
-        paper: "issue 14 (single-view scan): an open surface, two-sided RMS ≤ 1e-3 of the diagonal",
-    },
+    open_model("face", "face.obj", false, "issue 14 (open, 1 loop): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
+    open_model("camelhead", "camelhead.off", false, "issue 14 (open, 1 loop): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
+    open_model("beetle", "beetle.off", false, "issue 14 (open, 11 loops): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
+    open_model("bun000", "bun000_points.ply", true, "issue 14 (single-view scan): an open surface, two-sided RMS ≤ 1e-3 of the diagonal"),
 ];
 
 pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
