@@ -5,12 +5,13 @@
 //! model's does (4.97e-4, 2.18e-3). Measured by `subfit compare` (exact closest points on the
 //! limit surface, both ways), `subfit fit --max-control-points 201` with both quad schemes
 //! beats the artist's RMS with a cage of ≥ 70 % quads. The issue asks for the Hausdorff
-//! distance too, and that is **not met** here: the fits' is 2.20e-3 (Catmull-Clark) and
-//! 1.80e-3 (quad/tri), 1.27× and 1.04× the artist's (the hidden artist's is 2.18e-3, but the
-//! hidden model is not this one). Started at the budget, as before `subfit::QUAD_BUDGET_START`,
-//! Catmull-Clark was at 3.11e-3, the largest errors at the legs' junctions with the body. The
-//! test holds the Hausdorff distance within 1.5× of the artist's, so that it cannot get worse
-//! unseen.
+//! distance too: fitted from three starts under the budget (`subfit::BUDGET_STARTS`), the
+//! better kept, the fits' is 1.77e-3 (Catmull-Clark) and 1.52e-3 (quad/tri) of the diagonal,
+//! below the hidden artist's 2.18e-3 (quad/tri also below this artist's 1.74e-3,
+//! Catmull-Clark 2 % above it). From one start at 0.6 of the budget they were 2.20e-3 and
+//! 1.80e-3; started at the budget, Catmull-Clark was at 3.11e-3, the largest errors at the
+//! legs' junctions with the body. The test holds the Hausdorff distance below the issue's
+//! 2.18e-3 and within 1.1× of this artist's.
 
 #![allow(clippy::print_stdout)]
 
@@ -150,8 +151,8 @@ fn at_201_control_points_both_quad_schemes_beat_the_artists_rms() {
             "{scheme}: RMS {rms} vs the artist's {artist_rms}"
         );
         assert!(
-            max < 1.5 * artist_max,
-            "{scheme}: Hausdorff {max} vs the artist's {artist_max}"
+            max < 2.18e-3 && max < 1.1 * artist_max,
+            "{scheme}: Hausdorff {max} vs the artist's {artist_max} (and the issue's 2.18e-3)"
         );
     }
 }

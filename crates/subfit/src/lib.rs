@@ -26,6 +26,7 @@
 //! - [`init`]: initial control meshes with the target's topology (QEM simplification, contouring);
 //! - [`report`]: two-sided distances, error colours, the limit tessellation, plots.
 
+mod budget_starts;
 mod error;
 mod html_report;
 mod outputs;
@@ -35,13 +36,13 @@ mod sequence;
 mod sequence_tracking;
 pub mod tolerance;
 
+pub use budget_starts::BUDGET_STARTS;
 pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use outputs::{log_csv, OUTPUTS};
 pub use pipeline_report::Report;
 pub use scan::{
     fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
-    QUAD_BUDGET_START,
 };
 pub use sequence::{
     fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence,

@@ -138,8 +138,22 @@ impl Fitted {
             Some(false) => " (the last a max-error polish, not kept)",
             None => "",
         };
+        let starts = if r.budget_starts.len() > 1 {
+            let all: Vec<String> = r
+                .budget_starts
+                .iter()
+                .map(|s| format!("{}", s.initial_control_points))
+                .collect();
+            format!(
+                " (the best of {} starts under the budget: {})",
+                all.len(),
+                all.join(", ")
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "{} → {} control points, {} stages{polish}, {} iterations ({}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (surface → data); two-sided E_rms {:.3e}, E_max {:.3e} ({:.2e} / {:.2e} of the diagonal; unit cube)",
+            "{} → {} control points{starts}, {} stages{polish}, {} iterations ({}): E_rms {:.3e} → {:.3e}, E_max {:.3e} → {:.3e} (surface → data); two-sided E_rms {:.3e}, E_max {:.3e} ({:.2e} / {:.2e} of the diagonal; unit cube)",
             r.init.control_points,
             r.control_points,
             r.stages.len(),

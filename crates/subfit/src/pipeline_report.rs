@@ -104,6 +104,11 @@ pub struct InitSummary {
     pub file: Option<String>,
     /// Control points asked of the automatic initial mesh.
     pub requested_control_points: Option<usize>,
+    /// The fraction of `--max-control-points` the automatic start took: a quad scheme whose
+    /// default start exceeds the budget starts below it ([`crate::BUDGET_STARTS`]). `None`
+    /// otherwise.
+    #[serde(default)]
+    pub budget_start: Option<f64>,
     /// Control points.
     pub control_points: usize,
     /// Faces.
@@ -544,8 +549,33 @@ pub struct Report {
     pub limit_tessellation: TessellationSummary,
     /// The error that maps to red in `error.ply` (normalized units).
     pub error_color_scale_unit_cube: f64,
-    /// Seconds per phase.
+    /// Fits from several starts under a budget ([`crate::BUDGET_STARTS`]), the one written
+    /// among them; empty when there was one fit.
+    #[serde(default)]
+    pub budget_starts: Vec<BudgetStart>,
+    /// Seconds per phase of the fit written; `total` also counts the other starts' fits.
     pub timings_s: Timings,
+}
+
+/// One of the fits from several starts under a budget ([`Report::budget_starts`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BudgetStart {
+    /// The start's fraction of the budget.
+    pub fraction: f64,
+    /// Control points of its initial cage.
+    pub initial_control_points: usize,
+    /// Control points of its cage.
+    pub control_points: usize,
+    /// Two-sided RMS error, fraction of the diagonal.
+    pub rms_fraction_of_diagonal: f64,
+    /// Two-sided maximum error (Hausdorff distance), fraction of the diagonal.
+    pub max_fraction_of_diagonal: f64,
+    /// Whether its cage met the tolerances.
+    pub tolerance_reached: bool,
+    /// Seconds of its whole fit.
+    pub seconds: f64,
+    /// Whether its cage is the one written.
+    pub kept: bool,
 }
 
 /// Tag counts.

@@ -242,12 +242,26 @@ impl Fitted {
 /// ([`Error::Io`], [`Error::Input`] naming the element), a budget that cannot be honoured
 /// ([`Error::Budget`]), a failed initial mesh or fit. On error nothing is returned; nothing
 /// is written in any case (see [`Fitted::write_into`]).
+///
+/// A quad scheme whose default start exceeds the budget (`--max-control-points` below the
+/// target's default size) is fitted from each of [`BUDGET_STARTS`] and the better cage kept
+/// ([`crate::budget_starts`]).
 pub fn fit_scan(
     input: Input,
     options: &FitScanOptions,
-    mut progress: Option<&mut dyn FnMut(Progress<'_>)>,
+    progress: Option<&mut dyn FnMut(Progress<'_>)>,
 ) -> Result<Fitted, Error> {
     validate(options)?;
+    crate::budget_starts::fit_best_start(input, options, progress)
+}
+
+/// [`fit_scan`] once: a quad scheme capped by the budget starts at `start` of it.
+pub(crate) fn fit_scan_from(
+    input: Input,
+    options: &FitScanOptions,
+    mut progress: Option<&mut dyn FnMut(Progress<'_>)>,
+    start: f64,
+) -> Result<Fitted, Error> {
     let mut warnings: Vec<String> = Vec::new();
     let mut warn = |msg: String, progress: &mut Option<&mut dyn FnMut(Progress<'_>)>| {
         if let Some(p) = progress.as_mut() {
@@ -361,6 +375,7 @@ pub fn fit_scan(
                 source: "File".into(),
                 file: Some(cname.clone()),
                 requested_control_points: None,
+                budget_start: None,
                 control_points: c.num_vertices(),
                 faces: normalized.faces.len(),
                 quads,
@@ -386,6 +401,7 @@ pub fn fit_scan(
             (normalized, tags.clone(), summary)
         }
         InitialCage::Auto => {
+            let mut budget_start = None;
             let n = match options.control_points {
                 Some(n) if n > budget => {
                     return Err(Error::Budget(format!(
@@ -393,7 +409,11 @@ pub fn fit_scan(
                     )))
                 }
                 Some(n) => n,
-                None => start_control_points(default_control_points(target.len()), budget, options.scheme),
+                None => {
+                    let (n, f) = crate::budget_starts::start_control_points(default_control_points(target.len()), budget, options.scheme, start);
+                    budget_start = f;
+                    n
+                }
             };
             let dense = (!mesh.faces.is_empty()).then_some(&mesh);
             // Concave corners may add points within the budget, not to a count asked for.
@@ -457,7 +477,10 @@ pub fn fit_scan(
                     &mut progress,
                 );
             }
-            let summary = init_summary(&r, n, &m, init_options.features.as_ref());
+            let summary = InitSummary {
+                budget_start,
+                ..init_summary(&r, n, &m, init_options.features.as_ref())
+            };
             if !r.feature_segments.is_empty() {
                 feature_segments = Some(Arc::new(r.feature_segments));
             }
@@ -712,6 +735,7 @@ pub fn fit_scan(
             }
         },
         error_color_scale_unit_cube: options.error_scale.unwrap_or(0.0),
+        budget_starts: Vec::new(),
         timings_s: Timings {
             read,
             preprocess,
@@ -900,6 +924,7 @@ fn init_summary(
         source: format!("{:?}", r.source),
         file: None,
         requested_control_points: Some(requested),
+        budget_start: None,
         control_points: m.num_vertices(),
         faces: m.faces.len(),
         quads,
@@ -947,33 +972,4 @@ pub fn read_cage(path: &Path) -> Result<InitialCage, Error> {
         tags: Tags::new(),
         name: path.display().to_string(),
     })
-}
-
-/// Where a quad cage (Catmull-Clark, quad/triangle) starts when the control-point budget caps
-/// the default initial size: at this fraction of the budget, so that refinement spends the
-/// rest where the error is, instead of a simplification spending all of it by quadric error.
-/// Measured with `--max-control-points 201` on dense meshes made as the Catmull-Clark limit of
-/// an artist-like 201-point cage plus sculpted detail (`tests/artist_cage.rs` of the CLI, and
-/// four more of the same kind): the largest Hausdorff distance over the five went from 6.2e-3
-/// to 1.9e-3 of the diagonal with quad/tri, and from 6.3e-3 to 2.1e-3 with Catmull-Clark (the
-/// artist's own cages: 1.6e-3–1.9e-3), at RMS 3.8e-4–4.1e-4 (from 3.6e-4–4.4e-4; the
-/// artist's: 4.9e-4–5.0e-4). On organic scans it is a trade: Igea at 201 points, Catmull-Clark,
-/// Hausdorff 8.1e-3 → 7.0e-3 for RMS
-/// 1.33e-3 → 1.39e-3; the bunny 9.1e-3 → 9.5e-3 and 1.34e-3 → 1.50e-3. Loop cages start at the
-/// budget: a CAD part's feature cage needs its points (fandisk at 75 points: two-sided RMS
-/// 5.8e-4 from 75, 7.1e-4 from 45). The largest error at a fixed small budget is sensitive to
-/// the start: over the same five models the worst Hausdorff distance was 3.4e-3 from 0.5 of
-/// the budget (101 points; 2.1e-3 from 100), 2.6e-3 from 0.7 and 2.3e-3–3.0e-3 from 0.4 — every
-/// start below the budget avoids the misses of starting at it, none is best on every model.
-pub const QUAD_BUDGET_START: f64 = 0.6;
-
-/// The automatic initial size: `default` (from the target's size), capped by `budget`; a quad
-/// scheme capped by the budget starts at [`QUAD_BUDGET_START`] of it.
-fn start_control_points(default: usize, budget: usize, scheme: Option<Scheme>) -> usize {
-    let quads = matches!(scheme, Some(Scheme::CatmullClark | Scheme::QuadTriangle));
-    if quads && default >= budget {
-        ((QUAD_BUDGET_START * budget as f64).round() as usize).clamp(4, budget)
-    } else {
-        default.min(budget)
-    }
 }
