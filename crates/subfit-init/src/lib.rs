@@ -28,6 +28,7 @@
 pub mod carve;
 pub mod contour;
 mod heap;
+pub mod hexagons;
 pub mod init;
 pub mod islands;
 mod march;

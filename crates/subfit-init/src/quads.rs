@@ -22,7 +22,9 @@
 //! that pair left-over triangles. Boundary edges and tagged crease edges are never removed,
 //! and no interior vertex is left with fewer than three edges, so the genus, the boundary
 //! loops, manifoldness and the faces' winding are kept; leftover triangles stay triangles
-//! (Catmull-Clark and the quad/triangle scheme accept mixed cages). Around a small hole no
+//! (Catmull-Clark and the quad/triangle scheme accept mixed cages), except that two left
+//! over on either side of a quad are merged with it into two quads ([`crate::hexagons`], up
+//! to four rounds; fandisk's cage 59 % → 72 % quads). Around a small hole no
 //! quad gets a corner wider than 150° ([`MAX_HOLE_CORNER_DEG`]).
 //!
 //! Cost: `O(E log E)` for scoring and the greedy pass (plus `O(E · s · log P)` target
@@ -87,6 +89,9 @@ pub struct PairReport {
     pub greedy_pairs: usize,
     /// Augmenting paths applied (each adds one pair).
     pub augmentations: usize,
+    /// Hexagons of a quad and two left-over triangles split into two quads
+    /// ([`crate::hexagons`]).
+    pub hexagons: usize,
     /// Mean Lavoué coherency score `SC` (degrees, `[0, 45]`) of the new quads' edges; 45 without
     /// a target or on isotropic regions.
     pub mean_coherency_deg: f64,
@@ -137,6 +142,16 @@ pub fn pair_triangles(
     report.greedy_pairs = m.greedy();
     report.augmentations = m.augment(options.search_limit);
     let faces = merged_faces(&mesh.faces, &cands, &m.mate_edge);
+    // A merge makes quads that may border other left-over triangles: a few rounds.
+    let mut faces = faces;
+    for _ in 0..HEXAGON_ROUNDS {
+        let (f, n) = crate::hexagons::merge_hexagons(&faces, &mesh.positions, tags, options);
+        faces = f;
+        report.hexagons += n;
+        if n == 0 {
+            break;
+        }
+    }
     let mut coherency = (0.0, 0usize);
     for (e, c) in cands.iter().enumerate() {
         if m.mate_edge[c.faces[0] as usize] == e as u32 {
@@ -161,6 +176,9 @@ pub fn pair_triangles(
     Ok((out, report))
 }
 
+/// Rounds of [`crate::hexagons::merge_hexagons`] at most.
+const HEXAGON_ROUNDS: usize = 4;
+
 /// A diagonal that may be removed: the two triangles, the quad it leaves and its score.
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
@@ -175,7 +193,7 @@ struct Candidate {
 }
 
 /// Why a candidate is not a quad.
-enum Reject {
+pub(crate) enum Reject {
     Fold,
     Shape,
 }
@@ -303,7 +321,7 @@ pub const MAX_HOLE_CORNER_DEG: f64 = 150.0;
 /// Shape score in `[0, 1]` of the quad `p` (corners in order, diagonal `p0`–`p2`), or why it
 /// is rejected (a fold, a non-convex or degenerate quad): `(1 − (mean + max corner deviation from
 /// 90°) / 180°) · (1 − ½ dihedral / max dihedral)`.
-fn shape_score(p: [[f64; 3]; 4], o: &PairOptions) -> Result<f64, Reject> {
+pub(crate) fn shape_score(p: [[f64; 3]; 4], o: &PairOptions) -> Result<f64, Reject> {
     let n1 = cross(sub(p[1], p[0]), sub(p[2], p[0]));
     let n2 = cross(sub(p[2], p[0]), sub(p[3], p[0]));
     let (l1, l2) = (norm(n1), norm(n2));
