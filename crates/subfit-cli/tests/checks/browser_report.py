@@ -26,6 +26,9 @@ CHROMIUM_ARGS = [
     "--use-gl=swiftshader",
     "--enable-unsafe-swiftshader",
     "--ignore-gpu-blocklist",
+    # SwiftShader renders on the CPU: under load a frame can outlast the GPU watchdog, which
+    # then kills the GPU process and the page's WebGL context with it (a blank canvas).
+    "--disable-gpu-watchdog",
     "--disable-quic",
     "--no-first-run",
     "--disable-background-networking",
@@ -90,6 +93,11 @@ def main():
             lambda m: console_errors.append(m.text) if m.type == "error" else None,
         )
         page.on("pageerror", lambda e: console_errors.append(f"uncaught: {e}"))
+        context_events = []
+        page.on(
+            "console",
+            lambda m: context_events.append(m.text) if "context" in m.text.lower() else None,
+        )
         page.on(
             "request",
             lambda r: requests.append(r.url)
@@ -105,6 +113,16 @@ def main():
         except Exception as e:  # noqa: BLE001 - reported as a failed check
             failures.append(f"the viewer did not become ready: {e}")
         result["open_s"] = round(time.perf_counter() - start, 3)
+        # The first frame is drawn before the viewer says it is ready; a software renderer
+        # under load may still be compositing it (or restoring a lost context): give it time.
+        drawn = (
+            "() => { const s = (%s)(); return s && s.colors >= 16 && s.foreground >= 0.05; }"
+            % CANVAS_STATS.strip()
+        )
+        try:
+            page.wait_for_function(drawn, timeout=60_000, polling=250)
+        except Exception:  # noqa: BLE001 - judged below
+            pass
         stats = page.evaluate(CANVAS_STATS)
         result["canvas"] = stats
         if not stats:
@@ -149,6 +167,8 @@ def main():
             page.screenshot(path=args.screenshot, full_page=False)
             result["screenshot"] = args.screenshot
         browser.close()
+    if context_events:
+        result["webgl_context"] = context_events[:5]
     if console_errors:
         failures.append(f"console errors: {console_errors[:5]}")
     if requests:

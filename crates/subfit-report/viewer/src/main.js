@@ -160,6 +160,9 @@ function start() {
     }
   };
   controls.addEventListener('change', redraw);
+  // A lost WebGL context (a GPU process restarted; three.js asks for it back) comes back
+  // empty: draw again once it is restored.
+  renderer.domElement.addEventListener('webglcontextrestored', redraw);
   window.addEventListener('resize', () => {
     camera.aspect = width() / height();
     camera.updateProjectionMatrix();
