@@ -322,7 +322,7 @@ pub struct FitArgs {
     #[arg(long)]
     pub no_flips: bool,
     /// Split a face of the initial cage at most this many times (levels of local refinement).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=12))]
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u8).range(1..=12))]
     pub max_depth: u8,
     /// The last stage's polish of the best cage towards a lower maximum error: the surface →
     /// data error raised to this power (iteratively reweighted least squares), kept only when

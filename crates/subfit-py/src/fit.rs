@@ -182,7 +182,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     as_points=false, init=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
-    max_depth=4, local=false, local_rings=None, error_scale=None, name=None, progress=None
+    max_depth=5, local=false, local_rings=None, error_scale=None, name=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit(

@@ -46,7 +46,7 @@ def fit(
     coverage: float = 1.0,
     refine: bool = True,
     edge_flips: bool = True,
-    max_depth: int = 4,
+    max_depth: int = 5,
     local: bool = False,
     local_rings: Optional[int] = None,
     error_scale: Optional[float] = None,
