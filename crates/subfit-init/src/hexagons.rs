@@ -187,9 +187,9 @@ fn merge(f: &[u32], g: &[u32]) -> Option<Vec<u32>> {
     let j = (0..ng).find(|&j| g[j] == x)?;
     // f from y round to x, then g from x round to y (its end points left out).
     let mut out: Vec<u32> = (1..=nf).map(|k| f[(i + k) % nf]).collect();
+    debug_assert_eq!((out[0], out[nf - 1]), (y, x));
     out.extend((1..ng - 1).map(|k| g[(j + k) % ng]));
-    debug_assert_eq!(out[0], y);
-    debug_assert_eq!(*out.last().expect("nf ≥ 3"), x);
+    debug_assert_eq!(g[(j + ng - 1) % ng], y, "g runs y → x");
     Some(out)
 }
 
