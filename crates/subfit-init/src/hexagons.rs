@@ -77,7 +77,8 @@ pub(crate) fn merge_hexagons(
                 if key(c, d) == key(a, b) || !interior_edge(c, d) {
                     continue;
                 }
-                let Some(t2) = across(q, c, d).filter(|&t| t != t1 && list[t].len() == 3) else {
+                // Each hexagon once: from its lower-numbered triangle.
+                let Some(t2) = across(q, c, d).filter(|&t| t > t1 && list[t].len() == 3) else {
                     continue;
                 };
                 let Some(hex) = hexagon(&list[t1], quad, &list[t2]) else {

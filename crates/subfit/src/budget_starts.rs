@@ -42,7 +42,8 @@ use std::time::Instant;
 
 use crate::pipeline_report::{BudgetStart, Report};
 use crate::scan::fit_scan_from;
-use crate::{Error, FitScanOptions, Fitted, Input, Progress};
+use crate::{Error, FitScanOptions, Fitted, InitialCage, Input, Progress};
+use subfit_init::default_control_points;
 use subfit_subdiv::Scheme;
 
 /// The fractions of the budget a capped quad-scheme fit starts from (see the module docs);
@@ -56,12 +57,21 @@ pub(crate) fn fit_best_start(
     options: &FitScanOptions,
     mut progress: Option<&mut dyn FnMut(Progress<'_>)>,
 ) -> Result<Fitted, Error> {
-    let again = input.clone();
+    // Only a fit that can be capped keeps a copy of its input (a large mesh is not copied for
+    // nothing): a quad scheme, the automatic start, a budget at most the largest default.
+    let may_cap = matches!(options.init, InitialCage::Auto)
+        && options.control_points.is_none()
+        && matches!(
+            options.scheme,
+            Some(Scheme::CatmullClark | Scheme::QuadTriangle)
+        )
+        && options.stages.max_control_points <= default_control_points(usize::MAX);
+    let again = may_cap.then(|| input.clone());
     let t = Instant::now();
     let first = fit_scan_from(input, options, reborrow(&mut progress), BUDGET_STARTS[0])?;
-    if first.report.init.budget_start.is_none() {
+    let Some(again) = again.filter(|_| first.report.init.budget_start.is_some()) else {
         return Ok(first);
-    }
+    };
     let mut runs = vec![(first, t.elapsed().as_secs_f64())];
     for &start in &BUDGET_STARTS[1..] {
         let t = Instant::now();
