@@ -27,6 +27,7 @@
 
 pub mod carve;
 pub mod contour;
+mod denoise;
 mod heap;
 pub mod hexagons;
 pub mod init;

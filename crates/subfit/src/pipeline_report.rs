@@ -142,6 +142,11 @@ pub struct InitSummary {
     /// or a given cage).
     #[serde(default)]
     pub contour_faces_trimmed: usize,
+    /// Mesh targets: whether the mesh was too noisy to simplify (the simplification stuck well
+    /// above the requested count) and the cage was simplified from a Taubin-smoothed copy
+    /// (`subfit_init::SimplifyReport::smoothed`).
+    #[serde(default)]
+    pub smoothed: bool,
     /// Mesh targets with feature detection on: the target's sharp features, which the cage
     /// keeps as crease and corner tags (`subfit_target::detect_features`). `None` otherwise.
     #[serde(default)]
@@ -523,7 +528,7 @@ pub struct Report {
     pub r#final: FinalErrors,
     /// The stage whose cage is written (the best measured).
     pub best_stage: usize,
-    /// Why the stages stopped: `Tolerance`, `Budget`, `Stalled` or `Limit`.
+    /// Why the stages stopped: `Tolerance`, `Budget`, `Stalled`, `Diminishing` or `Limit`.
     pub stop: String,
     /// Whether the tolerances hold for the cage written (both ways unless `options.two_sided`
     /// is false).

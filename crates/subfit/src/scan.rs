@@ -391,6 +391,7 @@ pub(crate) fn fit_scan_from(
                 },
                 cloud_open: false,
                 contour_faces_trimmed: 0,
+                smoothed: false,
                 features: None,
                 timings_s: InitTimings {
                     pair: t_pair.elapsed().as_secs_f64(),
@@ -467,6 +468,10 @@ pub(crate) fn fit_scan_from(
                     "{name}: the initial control mesh keeps {} control points (no legal simplification below it for this topology), more than the budget of {budget}",
                     m.num_vertices()
                 )));
+            }
+            if r.simplify.smoothed {
+                let msg = "the mesh is too noisy to simplify as it is (crumpled triangles): the initial cage comes from a smoothed copy";
+                warn(msg.into(), &mut progress);
             }
             if !r.genus_matches {
                 warn(
@@ -940,6 +945,7 @@ fn init_summary(
         },
         cloud_open: r.cloud_open(),
         contour_faces_trimmed: r.trim.as_ref().map_or(0, |t| t.faces_trimmed),
+        smoothed: r.simplify.smoothed,
         features: r.features.zip(features).map(|(f, o)| FeatureSummary {
             angle_deg: o.angle_deg,
             edges: f.edges,

@@ -179,6 +179,12 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         t0.elapsed().as_secs_f64()
     );
     out!("wrote {}", a.output.display());
+    if report.simplify.smoothed {
+        eprintln!(
+            "subfit: warning: the mesh is too noisy to simplify as it is (crumpled triangles); \
+             the cage was simplified from a smoothed copy"
+        );
+    }
     if !report.simplify.reached_target {
         eprintln!(
             "subfit: warning: no legal collapse left at {} vertices ({n} requested)",
