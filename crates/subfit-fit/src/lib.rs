@@ -94,7 +94,7 @@ pub use remesh::RefineStats;
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 pub use stages::{
     fit_stages, judged_with_boundary, StageEvent, StageOptions, StageReport, StageStop,
-    StagesReport, StagesResult, STALL_GAIN, STALL_STAGES,
+    StagesReport, StagesResult, REFINE_PAYOFF, STALL_GAIN, STALL_STAGES, UNPAID_REFINEMENTS,
 };
 pub use surface_term::{fan_triangles, SurfaceTerm, WeightedSurfaceTerm};
 pub use term::{DataTerm, Mat3};

@@ -5,7 +5,8 @@ mod common;
 
 use subfit_fit::internals::refine_red_green;
 use subfit_fit::{
-    fit_stages, FitOptions, Fitter, StageOptions, StageStop, STALL_GAIN, STALL_STAGES,
+    fit_stages, FitOptions, Fitter, StageOptions, StageStop, REFINE_PAYOFF, STALL_GAIN,
+    STALL_STAGES, UNPAID_REFINEMENTS,
 };
 use subfit_mesh::shapes::Shape;
 use subfit_target::{Target, TargetOptions};
@@ -125,6 +126,8 @@ fn stages_give_up_when_no_stage_improves_on_the_best() {
         max_stages: 40,
         // The stall rule is the stage loop's; the polish after it has its own test.
         polish_power: 2.0,
+        // So is the rule on refinements that do not pay (its own test below).
+        refine_payoff: 0.0,
         ..StageOptions::default()
     };
     let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
@@ -186,6 +189,43 @@ fn stages_give_up_when_the_gain_is_below_the_stall_gain() {
     assert!(rms.len() < last_better + 1 + STALL_STAGES, "{summary:?}");
 }
 
+/// The same noisy ellipsoid with the rule on refinements that do not pay
+/// ([`StageOptions::refine_payoff`] at its default, [`REFINE_PAYOFF`]): the fit ends
+/// ([`StageStop::Diminishing`]) at the second refinement in a row that lowers the RMS by less
+/// than `n^−0.15`, far below the budget, where the stall rule alone spent 15 stages and 1,586
+/// points. (A clean surface under an unreachable tolerance refines on: the local-stages test
+/// above stops by the stall rule with this rule on.)
+#[test]
+fn stages_end_when_refinement_stops_paying() {
+    let (out, rms, stages) = noisy_ellipsoid_stages_paying(6_000, 0.01, 3_000, REFINE_PAYOFF);
+    let r = &out.report;
+    let summary: Vec<_> = r
+        .stages
+        .iter()
+        .zip(&rms)
+        .map(|(s, e)| (s.num_control_points, *e))
+        .collect();
+    assert_eq!(r.stop, StageStop::Diminishing, "{summary:?}");
+    // Replay the rule: refinements (stages with more points than the one before) that do not
+    // pay, counted in a row; the fit ends at the first second one.
+    let mut unpaid = 0;
+    let mut end = None;
+    for (k, w) in summary.windows(2).enumerate() {
+        let ((n0, r0), (n1, r1)) = (w[0], w[1]);
+        if n1 > n0 {
+            let paid = r1 <= r0 * (n0 as f64 / n1 as f64).powf(REFINE_PAYOFF);
+            unpaid = if paid { 0 } else { unpaid + 1 };
+        }
+        if unpaid == UNPAID_REFINEMENTS {
+            end = Some(k + 1);
+            break;
+        }
+    }
+    assert_eq!(end, Some(summary.len() - 1), "{summary:?}");
+    let last = summary.last().unwrap().0;
+    assert!(last < stages.max_control_points / 4, "{summary:?}");
+}
+
 /// With the control-point budget spent and `λ` at its end, a stage only flips edges: the first
 /// such stage that does not gain more than [`STALL_GAIN`] over the last stage that did ends the
 /// fit ([`StageStop::Budget`]), where before it went on as long as any stage gained at all (the
@@ -229,6 +269,16 @@ fn noisy_ellipsoid_stages(
     noise: f64,
     budget: usize,
 ) -> (subfit_fit::StagesResult, Vec<f64>, StageOptions) {
+    noisy_ellipsoid_stages_paying(points, noise, budget, 0.0)
+}
+
+/// [`noisy_ellipsoid_stages`] with [`StageOptions::refine_payoff`] `payoff`.
+fn noisy_ellipsoid_stages_paying(
+    points: usize,
+    noise: f64,
+    budget: usize,
+    payoff: f64,
+) -> (subfit_fit::StagesResult, Vec<f64>, StageOptions) {
     let cloud = Shape::PAPER_ELLIPSOID.sample(points, noise, 5);
     let target = Target::from_points(
         &cloud.positions,
@@ -243,6 +293,7 @@ fn noisy_ellipsoid_stages(
         max_stages: 40,
         // The stall rules are the stage loop's; the polish after it has its own test.
         polish_power: 2.0,
+        refine_payoff: payoff,
         // The figures in the tests' docs were taken at this depth (at 5 the 150-point budget
         // is not quite spent: the fit stalls at 148).
         max_depth: 4,
