@@ -1,5 +1,6 @@
-//! A target mesh with a few faces the wrong way round (as real scans have) is repaired, with a
-//! warning, by `init`, `analyze` and `fit`, instead of being refused.
+//! A target mesh with a few faces the wrong way round (as real scans have), or with faces meeting
+//! only at a vertex, is repaired, with a warning, by `init`, `analyze` and `fit`, instead of
+//! being refused.
 
 mod common;
 
@@ -87,4 +88,92 @@ fn inconsistently_oriented_faces_are_repaired_with_a_warning() {
         .as_str()
         .unwrap()
         .contains("re-oriented 4 faces"));
+}
+
+/// A torus mesh (genus 1) with two faces at vertex 100 removed that share only that vertex:
+/// two triangular holes touching at it, a non-manifold vertex (a bowtie), as cutting holes
+/// into a scan can leave.
+fn bowtie_torus(dir: &Path) -> std::path::PathBuf {
+    let t = torus_mesh(1.0, 0.4, 48, 24, true);
+    let at: Vec<usize> = (0..t.faces.len())
+        .filter(|&f| t.faces.iter().nth(f).unwrap().contains(&100))
+        .collect();
+    let shares_edge = |a: usize, b: usize| {
+        let (fa, fb) = (
+            t.faces.iter().nth(a).unwrap(),
+            t.faces.iter().nth(b).unwrap(),
+        );
+        fa.iter().filter(|v| fb.contains(v)).count() > 1
+    };
+    let b = at[1..]
+        .iter()
+        .copied()
+        .find(|&b| !shares_edge(at[0], b))
+        .unwrap();
+    let mut faces = Polygons::new();
+    for (f, poly) in t.faces.iter().enumerate() {
+        if f != at[0] && f != b {
+            faces.push(poly);
+        }
+    }
+    let path = dir.join("bowtie.obj");
+    let opts = WriteOptions {
+        format: None,
+        encoding: Encoding::Ascii,
+        single_precision: false,
+    };
+    subfit::io::write_file(&path, &PolyMesh::new(t.positions, faces), &opts).unwrap();
+    path
+}
+
+#[test]
+fn a_non_manifold_vertex_is_split_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let bowtie = bowtie_torus(d.path());
+    let m = bowtie.to_str().unwrap();
+    let warning = format!(
+        "subfit: warning: split 1 non-manifold vertices of {m} (faces meeting only at a vertex, e.g. vertex 100) into one vertex per fan"
+    );
+    let info: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", m]).stdout).unwrap();
+    assert_eq!(info["topology"]["non_manifold_vertices"], 1, "{info}");
+
+    let cage = d.path().join("cage.obj");
+    let r = subfit(&[
+        "init",
+        m,
+        "--control-points",
+        "80",
+        "-o",
+        cage.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    assert!(err.contains(&warning), "{err}");
+
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        m,
+        "-o",
+        out.to_str().unwrap(),
+        "--control-points",
+        "80",
+        "--max-iterations",
+        "1",
+        "--sample-level",
+        "2",
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    assert!(err.contains(&warning), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    // Split, the two holes are one boundary loop through the two copies of the vertex.
+    assert_eq!(report["target_topology"]["boundary_loops"], 1, "{report}");
+    assert_eq!(report["target_topology"]["genus"], 1, "{report}");
+    assert!(report["warnings"][0]
+        .as_str()
+        .unwrap()
+        .contains("split 1 non-manifold vertices"));
 }

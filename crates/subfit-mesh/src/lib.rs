@@ -11,6 +11,7 @@
 //! the exact closest point on triangles; [`deforming`] generates deforming test sequences with
 //! known correspondence.
 
+pub mod bowtie;
 pub mod bvh;
 pub mod cancel;
 pub mod components;
@@ -27,6 +28,7 @@ pub mod shapes;
 pub mod tags;
 pub mod vec3;
 
+pub use bowtie::{split_bowties, BowtieReport};
 pub use cancel::{Cancel, Cancelled};
 pub use components::{euler_characteristic, face_components, genus, Components};
 pub use concave::{split_concave_corners, ConcaveSplits, CONCAVE_ANGLE};

@@ -15,8 +15,9 @@
 //!   dropped, as scanners drop them; the depth gets Gaussian noise of `NOISE` × the diagonal
 //!   (default 2e-4). Points only.
 //! * `holes`: `COUNT` (default 27) holes, each the faces within `RADIUS` × the diagonal (default
-//!   0.02) of a random vertex, grown through face adjacency so a hole is one disc; holes that
-//!   would touch another one are skipped.
+//!   0.02) of a random vertex, grown through faces that share a vertex, so a hole is one piece
+//!   (it can pinch at a vertex: seed 4 on the armadillo leaves one such bowtie, which `subfit
+//!   fit` splits with a warning); holes that would touch another one are skipped.
 //! * `noisy`: `N` points (default 150,000) sampled uniformly by area, moved by Gaussian noise of
 //!   `NOISE` × the diagonal (default 0.003) and joined by `OUTLIERS` × N points (default 0.03)
 //!   drawn uniformly in the bounding box grown by 10 % (issue 16's noisy scans). Points only.

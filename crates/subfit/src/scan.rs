@@ -767,8 +767,9 @@ pub(crate) fn fit_scan_from(
     })
 }
 
-/// Reads `input` (a file, or takes the mesh given) and turns faces that disagree with their
-/// neighbours (a messy scan), with a warning; only what cannot be repaired is refused
+/// Reads `input` (a file, or takes the mesh given), splits non-manifold vertices into one per
+/// fan of faces ([`subfit_mesh::split_bowties`]) and turns faces that disagree with their
+/// neighbours (a messy scan), each with a warning; only what cannot be repaired is refused
 /// (non-manifold edges, non-orientable parts), unless the faces are not used (`as_points`).
 /// Returns the mesh, its name for messages and what was re-oriented.
 pub(crate) fn read_input(
@@ -784,6 +785,16 @@ pub(crate) fn read_input(
         Input::Mesh { mesh, name } => (mesh, name),
     };
     let mut reoriented = None;
+    if !mesh.faces.is_empty() && !as_points {
+        let (split, r) = subfit_mesh::split_bowties(&mesh);
+        if r.vertices_split > 0 {
+            warn(format!(
+                "split {} non-manifold vertices of {name} (faces meeting only at a vertex, e.g. vertex {}) into one vertex per fan",
+                r.vertices_split, r.examples[0]
+            ));
+            mesh = split;
+        }
+    }
     if !mesh.faces.is_empty() {
         match reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions)) {
             Ok((faces, r)) if r.needed => {

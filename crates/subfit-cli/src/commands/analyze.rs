@@ -155,7 +155,7 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
 
     let t_read = std::time::Instant::now();
     let (mut mesh, _) = crate::progress::load(&a.target)?;
-    crate::commands::reorient_target(&mut mesh, &a.target);
+    crate::commands::repair_target(&mut mesh, &a.target);
     let read = t_read.elapsed().as_secs_f64();
     let feature_options = subfit::target::FeatureOptions {
         angle_deg: a.feature_angle,

@@ -38,7 +38,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
 
     let t0 = Instant::now();
     let (mut input, _) = crate::progress::load(&a.target)?;
-    crate::commands::reorient_target(&mut input, &a.target);
+    crate::commands::repair_target(&mut input, &a.target);
     let read_time = t0.elapsed();
     let use_mesh = !a.from_points && !input.faces.is_empty();
     // The target's own topology, when it has faces.

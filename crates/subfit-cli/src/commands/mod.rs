@@ -39,14 +39,26 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Re-orients the faces of a target mesh read from `file` consistently per component
-/// ([`reorient_faces`]; real scans often have a few faces the wrong way round), with a warning
-/// on stderr when any were flipped. A mesh that cannot be repaired (a non-manifold edge, a
-/// non-orientable component) is left as it is, for the command's own checks to accept (e.g.
-/// `analyze`, `init --from-points`) or refuse with their usual one-line error.
-pub fn reorient_target(mesh: &mut PolyMesh, file: &Path) {
+/// Repairs a target mesh read from `file` as `subfit fit` does: splits non-manifold vertices
+/// into one per fan of faces ([`subfit::mesh::split_bowties`]; holes that touch at a vertex)
+/// and re-orients the faces consistently per component ([`reorient_faces`]; real scans often
+/// have a few faces the wrong way round), with a warning on stderr for each repair. A mesh that
+/// cannot be repaired (a non-manifold edge, a non-orientable component) is left as it is, for
+/// the command's own checks to accept (e.g. `analyze`, `init --from-points`) or refuse with
+/// their usual one-line error.
+pub fn repair_target(mesh: &mut PolyMesh, file: &Path) {
     if mesh.faces.is_empty() {
         return;
+    }
+    let (split, r) = subfit::mesh::split_bowties(mesh);
+    if r.vertices_split > 0 {
+        eprintln!(
+            "subfit: warning: split {} non-manifold vertices of {} (faces meeting only at a vertex, e.g. vertex {}) into one vertex per fan",
+            r.vertices_split,
+            file.display(),
+            r.examples[0]
+        );
+        *mesh = split;
     }
     // Not repairable: the command's own checks accept or refuse the mesh as it is.
     let Ok((faces, r)) = reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions))

@@ -1,0 +1,185 @@
+//! Splitting non-manifold vertices ("bowties"): a vertex whose faces form several fans gets one
+//! copy per fan, so the mesh becomes a manifold surface with the same faces and positions.
+//!
+//! A bowtie is common in real meshes and in meshes with holes cut into them: two holes (or a
+//! hole and the rim) that touch at one vertex leave its faces in two fans joined only at that
+//! point (`diagnose` counts them as non-manifold vertices). The half-edge structure, the
+//! subdivision and the fit need a manifold; the usual repair (e.g. CGAL's
+//! `duplicate_non_manifold_vertices`, OpenMesh's import) duplicates the vertex per fan, which
+//! keeps every face and every position and only changes what touches what. The largest fan
+//! keeps the original vertex id; the others get new ids appended after the existing vertices.
+//!
+//! Fans are found as in [`crate::diagnose`]: a union-find over the corners at each vertex, two
+//! corners joined when their faces share an edge at the vertex. Non-manifold edges (three or
+//! more faces on one edge) are not touched. Cost `O(#H · α)`.
+
+use crate::edges::{corner_next, group_edges, UnionFind};
+use crate::polygons::PolyMesh;
+
+/// What [`split_bowties`] did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BowtieReport {
+    /// Vertices whose faces formed several fans.
+    pub vertices_split: usize,
+    /// Vertices added (one per fan beyond the first).
+    pub vertices_added: usize,
+    /// Up to [`crate::diagnose::MAX_EXAMPLES`] of the split vertices (input ids).
+    pub examples: Vec<u32>,
+}
+
+/// `mesh` with each non-manifold vertex split into one vertex per fan of its faces (see the
+/// module docs), and what was split. Faces with an out-of-range or repeated vertex id are left
+/// as they are and do not join fans. Returns the mesh unchanged (and an empty report) when there
+/// is no bowtie.
+pub fn split_bowties(mesh: &PolyMesh) -> (PolyMesh, BowtieReport) {
+    let faces = &mesh.faces;
+    let nv = mesh.num_vertices();
+    let idx = faces.indices();
+    let valid: Vec<bool> = faces
+        .iter()
+        .map(|f| {
+            f.len() >= 3
+                && f.iter().all(|&v| (v as usize) < nv)
+                && (0..f.len()).all(|i| !f[i + 1..].contains(&f[i]))
+        })
+        .collect();
+    let next = corner_next(faces);
+    let groups = group_edges(faces, &next, nv, |f| valid[f]);
+    let mut fans = UnionFind::new(idx.len());
+    for e in 0..groups.len() {
+        let g = groups.group(e);
+        let a = idx[g[0] as usize];
+        // The corner at the origin of half-edge h is h; at its destination, next[h].
+        let (mut at_a, mut at_b) = (u32::MAX, u32::MAX);
+        for &h in g {
+            let (ca, cb) = if idx[h as usize] == a {
+                (h, next[h as usize])
+            } else {
+                (next[h as usize], h)
+            };
+            for (c, first) in [(ca, &mut at_a), (cb, &mut at_b)] {
+                if *first == u32::MAX {
+                    *first = c;
+                } else {
+                    fans.union(*first, c);
+                }
+            }
+        }
+    }
+    // Corners of valid faces per fan root, and the fans of each vertex.
+    let mut fan_size = vec![0u32; idx.len()];
+    let mut corners_of_valid = Vec::with_capacity(idx.len());
+    for (f, w) in faces.offsets().windows(2).enumerate() {
+        if valid[f] {
+            for c in w[0]..w[1] {
+                let root = fans.find(c);
+                fan_size[root as usize] += 1;
+                corners_of_valid.push((c, root));
+            }
+        }
+    }
+    let mut roots_of: Vec<Vec<u32>> = vec![Vec::new(); nv];
+    for &(c, root) in &corners_of_valid {
+        if c == root {
+            roots_of[idx[c as usize] as usize].push(root);
+        }
+    }
+    let mut report = BowtieReport::default();
+    // New vertex id per fan root that is not its vertex's largest fan; the copies' source.
+    let mut new_id = vec![u32::MAX; idx.len()];
+    let mut source: Vec<usize> = Vec::new();
+    for (v, roots) in roots_of.iter_mut().enumerate() {
+        if roots.len() < 2 {
+            continue;
+        }
+        // The largest fan keeps the id (ties: the lowest corner), the rest in corner order.
+        roots.sort_unstable_by_key(|&r| (std::cmp::Reverse(fan_size[r as usize]), r));
+        for &r in &roots[1..] {
+            new_id[r as usize] = (nv + source.len()) as u32;
+            source.push(v);
+            report.vertices_added += 1;
+        }
+        report.vertices_split += 1;
+        if report.examples.len() < crate::diagnose::MAX_EXAMPLES {
+            report.examples.push(v as u32);
+        }
+    }
+    if report.vertices_split == 0 {
+        return (mesh.clone(), report);
+    }
+    let mut out = mesh.clone();
+    let indices = out.faces.indices_mut();
+    for &(c, root) in &corners_of_valid {
+        let id = new_id[root as usize];
+        if id != u32::MAX {
+            indices[c as usize] = id;
+        }
+    }
+    // The copies carry the vertex's attributes.
+    out.positions
+        .extend(source.iter().map(|&v| mesh.positions[v]));
+    if let Some(n) = out.normals.as_mut() {
+        n.extend(source.iter().map(|&v| n[v]).collect::<Vec<_>>());
+    }
+    if let Some(c) = out.colors.as_mut() {
+        c.extend(source.iter().map(|&v| c[v]).collect::<Vec<_>>());
+    }
+    (out, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::diagnose_mesh;
+    use crate::polygons::Polygons;
+
+    /// Two triangles meeting only at vertex 0, and a quad strip sharing an edge with one.
+    fn bowtie() -> PolyMesh {
+        let p = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [-1.0, -1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ];
+        let mut faces = Polygons::new();
+        for f in [&[0, 1, 2][..], &[0, 3, 4], &[1, 5, 6, 2]] {
+            faces.push(f);
+        }
+        PolyMesh::new(p, faces)
+    }
+
+    #[test]
+    fn a_bowtie_vertex_gets_one_copy_per_fan() {
+        let m = bowtie();
+        assert_eq!(diagnose_mesh(&m).non_manifold_vertices, 1);
+        let (out, r) = split_bowties(&m);
+        assert_eq!(
+            r,
+            BowtieReport {
+                vertices_split: 1,
+                vertices_added: 1,
+                examples: vec![0],
+            }
+        );
+        assert_eq!(out.num_vertices(), 8);
+        assert_eq!(out.positions[7], m.positions[0]);
+        let d = diagnose_mesh(&out);
+        assert_eq!(d.non_manifold_vertices, 0);
+        assert!(d.is_manifold, "{d:?}");
+        // Each fan has one corner at vertex 0: the tie goes to the lower corner, so the first
+        // triangle keeps id 0.
+        let f: Vec<Vec<u32>> = out.faces.iter().map(<[u32]>::to_vec).collect();
+        assert_eq!(f, vec![vec![0, 1, 2], vec![7, 3, 4], vec![1, 5, 6, 2]]);
+    }
+
+    #[test]
+    fn a_manifold_mesh_is_returned_unchanged() {
+        let m = crate::shapes::torus_mesh(1.0, 0.3, 12, 8, true);
+        let (out, r) = split_bowties(&m);
+        assert_eq!(r, BowtieReport::default());
+        assert_eq!(out, m);
+    }
+}
