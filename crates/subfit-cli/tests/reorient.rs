@@ -177,3 +177,75 @@ fn a_non_manifold_vertex_is_split_with_a_warning() {
         .unwrap()
         .contains("split 1 non-manifold vertices"));
 }
+
+/// A torus mesh exported with its vertices split along a seam (the faces with `x < 0` have
+/// their own copies of every vertex they share with the rest), as texture-mapped exports are:
+/// two open patches on file, one closed torus once welded.
+fn seamed_torus(dir: &Path) -> std::path::PathBuf {
+    let t = torus_mesh(1.0, 0.4, 48, 24, true);
+    let mut positions = t.positions.clone();
+    let mut copy = vec![u32::MAX; t.positions.len()];
+    let mut faces = Polygons::new();
+    for poly in t.faces.iter() {
+        let left = poly
+            .iter()
+            .map(|&v| t.positions[v as usize][0])
+            .sum::<f64>()
+            < 0.0;
+        let f: Vec<u32> = poly
+            .iter()
+            .map(|&v| {
+                if !left {
+                    return v;
+                }
+                if copy[v as usize] == u32::MAX {
+                    copy[v as usize] = positions.len() as u32;
+                    positions.push(t.positions[v as usize]);
+                }
+                copy[v as usize]
+            })
+            .collect();
+        faces.push(&f);
+    }
+    let path = dir.join("seamed.obj");
+    let opts = WriteOptions {
+        format: None,
+        encoding: Encoding::Ascii,
+        single_precision: false,
+    };
+    subfit::io::write_file(&path, &PolyMesh::new(positions, faces), &opts).unwrap();
+    path
+}
+
+#[test]
+fn a_mesh_split_along_seams_is_welded_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let seamed = seamed_torus(d.path());
+    let m = seamed.to_str().unwrap();
+    let info: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", m]).stdout).unwrap();
+    assert_eq!(info["topology"]["components"], 2, "{info}");
+
+    let out = d.path().join("fit");
+    let r = subfit(&[
+        "fit",
+        m,
+        "-o",
+        out.to_str().unwrap(),
+        "--control-points",
+        "80",
+        "--max-iterations",
+        "1",
+        "--sample-level",
+        "2",
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    let welded = format!("subfit: warning: welded 48 vertices of {m} at the same position");
+    assert!(err.contains(&welded), "{err}");
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["target_topology"]["genus"], 1, "{report}");
+    assert_eq!(report["target_topology"]["boundary_loops"], 0, "{report}");
+    assert_eq!(report["init"]["boundary_loops"]["cage"], 0, "{report}");
+}

@@ -27,11 +27,10 @@ pub struct BowtieReport {
     pub examples: Vec<u32>,
 }
 
-/// `mesh` with each non-manifold vertex split into one vertex per fan of its faces (see the
-/// module docs), and what was split. Faces with an out-of-range or repeated vertex id are left
-/// as they are and do not join fans. Returns the mesh unchanged (and an empty report) when there
-/// is no bowtie.
-pub fn split_bowties(mesh: &PolyMesh) -> (PolyMesh, BowtieReport) {
+/// Splits each non-manifold vertex of `mesh` into one vertex per fan of its faces (see the
+/// module docs); returns what was split. Faces with an out-of-range or repeated vertex id are
+/// left as they are and do not join fans. The mesh is unchanged when there is no bowtie.
+pub fn split_bowties(mesh: &mut PolyMesh) -> BowtieReport {
     let faces = &mesh.faces;
     let nv = mesh.num_vertices();
     let idx = faces.indices();
@@ -105,10 +104,9 @@ pub fn split_bowties(mesh: &PolyMesh) -> (PolyMesh, BowtieReport) {
         }
     }
     if report.vertices_split == 0 {
-        return (mesh.clone(), report);
+        return report;
     }
-    let mut out = mesh.clone();
-    let indices = out.faces.indices_mut();
+    let indices = mesh.faces.indices_mut();
     for &(c, root) in &corners_of_valid {
         let id = new_id[root as usize];
         if id != u32::MAX {
@@ -116,15 +114,17 @@ pub fn split_bowties(mesh: &PolyMesh) -> (PolyMesh, BowtieReport) {
         }
     }
     // The copies carry the vertex's attributes.
-    out.positions
-        .extend(source.iter().map(|&v| mesh.positions[v]));
-    if let Some(n) = out.normals.as_mut() {
-        n.extend(source.iter().map(|&v| n[v]).collect::<Vec<_>>());
+    let copies: Vec<[f64; 3]> = source.iter().map(|&v| mesh.positions[v]).collect();
+    mesh.positions.extend(copies);
+    if let Some(n) = mesh.normals.as_mut() {
+        let copies: Vec<[f64; 3]> = source.iter().map(|&v| n[v]).collect();
+        n.extend(copies);
     }
-    if let Some(c) = out.colors.as_mut() {
-        c.extend(source.iter().map(|&v| c[v]).collect::<Vec<_>>());
+    if let Some(c) = mesh.colors.as_mut() {
+        let copies: Vec<[u8; 3]> = source.iter().map(|&v| c[v]).collect();
+        c.extend(copies);
     }
-    (out, report)
+    report
 }
 
 #[cfg(test)]
@@ -155,7 +155,8 @@ mod tests {
     fn a_bowtie_vertex_gets_one_copy_per_fan() {
         let m = bowtie();
         assert_eq!(diagnose_mesh(&m).non_manifold_vertices, 1);
-        let (out, r) = split_bowties(&m);
+        let mut out = m.clone();
+        let r = split_bowties(&mut out);
         assert_eq!(
             r,
             BowtieReport {
@@ -178,7 +179,8 @@ mod tests {
     #[test]
     fn a_manifold_mesh_is_returned_unchanged() {
         let m = crate::shapes::torus_mesh(1.0, 0.3, 12, 8, true);
-        let (out, r) = split_bowties(&m);
+        let mut out = m.clone();
+        let r = split_bowties(&mut out);
         assert_eq!(r, BowtieReport::default());
         assert_eq!(out, m);
     }

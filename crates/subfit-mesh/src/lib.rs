@@ -27,6 +27,7 @@ pub mod reorient;
 pub mod shapes;
 pub mod tags;
 pub mod vec3;
+pub mod weld;
 
 pub use bowtie::{split_bowties, BowtieReport};
 pub use cancel::{Cancel, Cancelled};
@@ -38,3 +39,4 @@ pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
 pub use polygons::{bounding_box, PolyMesh, Polygons};
 pub use reorient::{reorient_faces, ReorientError, ReorientReport};
 pub use tags::{Tags, SHARPNESS_INFINITE};
+pub use weld::{weld_coincident, WeldReport};

@@ -31,6 +31,7 @@ mod error;
 mod html_report;
 mod outputs;
 pub mod pipeline_report;
+mod repair;
 mod scan;
 mod sequence;
 mod sequence_tracking;
@@ -41,6 +42,7 @@ pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use outputs::{log_csv, OUTPUTS};
 pub use pipeline_report::Report;
+pub use repair::repair_mesh;
 pub use scan::{
     fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
 };

@@ -20,7 +20,7 @@ use subfit_init::{
     default_control_points, initial_control_mesh, pair_triangles, InitOptions, InitReport,
     SimplifyOptions,
 };
-use subfit_mesh::{reorient_faces, Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
+use subfit_mesh::{Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::{FeatureOptions, Target, TargetOptions};
 
@@ -35,8 +35,8 @@ use subfit_report::{
 
 use crate::pipeline_report::{
     face_counts, BoundaryLoops, Errors, FeatureSummary, FinalErrors, InitSummary, InitTimings,
-    IterationSummary, OptionsSummary, Reorientation, Report, RmsMax, StageSummary, TagCounts,
-    TessellationSummary, Timings, Topology, TwoSidedErrors, UsdDifference,
+    IterationSummary, OptionsSummary, Report, RmsMax, StageSummary, TagCounts, TessellationSummary,
+    Timings, Topology, TwoSidedErrors, UsdDifference,
 };
 
 /// The scan to fit.
@@ -277,7 +277,7 @@ pub(crate) fn fit_scan_from(
     let t0 = Instant::now();
     step(Step::Read, &mut progress);
     let (mut mesh, name, reoriented) =
-        read_input(input, options.as_points, &mut |m| warn(m, &mut progress))?;
+        crate::repair::read_input(input, options.as_points, &mut |m| warn(m, &mut progress))?;
     let read = t0.elapsed().as_secs_f64();
     options.cancel.check().map_err(|_| Error::Interrupted)?;
 
@@ -765,55 +765,6 @@ pub(crate) fn fit_scan_from(
         data_error: to_surface,
         cancel: options.cancel.clone(),
     })
-}
-
-/// Reads `input` (a file, or takes the mesh given), splits non-manifold vertices into one per
-/// fan of faces ([`subfit_mesh::split_bowties`]) and turns faces that disagree with their
-/// neighbours (a messy scan), each with a warning; only what cannot be repaired is refused
-/// (non-manifold edges, non-orientable parts), unless the faces are not used (`as_points`).
-/// Returns the mesh, its name for messages and what was re-oriented.
-pub(crate) fn read_input(
-    input: Input,
-    as_points: bool,
-    warn: &mut dyn FnMut(String),
-) -> Result<(PolyMesh, String, Option<Reorientation>), Error> {
-    let (mut mesh, name) = match input {
-        Input::File(path) => {
-            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
-            (m, path.display().to_string())
-        }
-        Input::Mesh { mesh, name } => (mesh, name),
-    };
-    let mut reoriented = None;
-    if !mesh.faces.is_empty() && !as_points {
-        let (split, r) = subfit_mesh::split_bowties(&mesh);
-        if r.vertices_split > 0 {
-            warn(format!(
-                "split {} non-manifold vertices of {name} (faces meeting only at a vertex, e.g. vertex {}) into one vertex per fan",
-                r.vertices_split, r.examples[0]
-            ));
-            mesh = split;
-        }
-    }
-    if !mesh.faces.is_empty() {
-        match reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions)) {
-            Ok((faces, r)) if r.needed => {
-                warn(format!(
-                    "re-oriented {} faces in {} components of {name}",
-                    r.flipped_faces, r.repaired_components
-                ));
-                reoriented = Some(Reorientation {
-                    faces_flipped: r.flipped_faces,
-                    components_changed: r.repaired_components,
-                });
-                mesh.faces = faces;
-            }
-            Ok(_) => {}
-            Err(e) if !as_points => return Err(Error::input(&name, e)),
-            Err(_) => {}
-        }
-    }
-    Ok((mesh, name, reoriented))
 }
 
 /// Both-way distances between the quad/triangle limit of `cage` and the Catmull-Clark limit

@@ -52,7 +52,7 @@ use subfit_target::{Normalization, Target, TargetOptions};
 
 use crate::error::Error;
 use crate::pipeline_report::{Reorientation, TwoSidedErrors};
-use crate::scan::read_input;
+use crate::repair::read_input;
 use crate::sequence_tracking::Tracking;
 pub use crate::sequence_tracking::{TrackingOptions, TrackingReport};
 use crate::{fit_scan, FitScanOptions, InitialCage, Input};

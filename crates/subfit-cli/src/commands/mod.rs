@@ -18,7 +18,7 @@ mod subdivide;
 use std::path::Path;
 use std::process::ExitCode;
 
-use subfit::mesh::{reorient_faces, PolyMesh};
+use subfit::mesh::PolyMesh;
 
 use crate::cli::{Args, Command};
 
@@ -39,39 +39,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     }
 }
 
-/// Repairs a target mesh read from `file` as `subfit fit` does: splits non-manifold vertices
-/// into one per fan of faces ([`subfit::mesh::split_bowties`]; holes that touch at a vertex)
-/// and re-orients the faces consistently per component ([`reorient_faces`]; real scans often
-/// have a few faces the wrong way round), with a warning on stderr for each repair. A mesh that
-/// cannot be repaired (a non-manifold edge, a non-orientable component) is left as it is, for
-/// the command's own checks to accept (e.g. `analyze`, `init --from-points`) or refuse with
-/// their usual one-line error.
+/// Repairs a target mesh read from `file` as `subfit fit` does ([`subfit::repair_mesh`]: welds
+/// vertices split along seams, splits non-manifold vertices, re-orients faces), with a warning on
+/// stderr for each repair. A mesh that cannot be repaired (a non-manifold edge, a
+/// non-orientable component) is left as it is, for the command's own checks to accept (e.g.
+/// `analyze`, `init --from-points`) or refuse with their usual one-line error.
 pub fn repair_target(mesh: &mut PolyMesh, file: &Path) {
-    if mesh.faces.is_empty() {
-        return;
-    }
-    let (split, r) = subfit::mesh::split_bowties(mesh);
-    if r.vertices_split > 0 {
-        eprintln!(
-            "subfit: warning: split {} non-manifold vertices of {} (faces meeting only at a vertex, e.g. vertex {}) into one vertex per fan",
-            r.vertices_split,
-            file.display(),
-            r.examples[0]
-        );
-        *mesh = split;
-    }
+    let name = file.display().to_string();
+    let mut copy = mesh.clone();
+    let mut warnings = Vec::new();
     // Not repairable: the command's own checks accept or refuse the mesh as it is.
-    let Ok((faces, r)) = reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions))
-    else {
-        return;
-    };
-    if r.needed {
-        eprintln!(
-            "subfit: warning: re-oriented {} faces in {} components of {}",
-            r.flipped_faces,
-            r.repaired_components,
-            file.display()
-        );
-        mesh.faces = faces;
+    if subfit::repair_mesh(&mut copy, &name, &mut |w| warnings.push(w)).is_ok() {
+        for w in warnings {
+            eprintln!("subfit: warning: {w}");
+        }
+        *mesh = copy;
     }
 }

@@ -1,0 +1,91 @@
+//! Reading a target and repairing what a user expects repaired, each repair with a warning:
+//!
+//! 1. vertices at exactly the same position are welded ([`subfit_mesh::weld_coincident`]): a
+//!    mesh exported with its vertices split along texture seams is one surface, not one patch
+//!    per chart with a boundary along every seam;
+//! 2. non-manifold vertices are split into one per fan of faces
+//!    ([`subfit_mesh::split_bowties`]): holes that touch at a vertex;
+//! 3. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
+//!    a messy scan.
+//!
+//! Only what cannot be repaired is refused: a non-manifold edge, a non-orientable part.
+
+use subfit_mesh::{reorient_faces, split_bowties, weld_coincident, PolyMesh, ReorientError};
+
+use crate::error::Error;
+use crate::pipeline_report::Reorientation;
+use crate::scan::Input;
+
+/// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
+/// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
+/// an error (a non-manifold edge, a non-orientable component) the welds and splits are kept
+/// and the faces are as they were read.
+pub fn repair_mesh(
+    mesh: &mut PolyMesh,
+    name: &str,
+    warn: &mut dyn FnMut(String),
+) -> Result<Option<Reorientation>, ReorientError> {
+    if mesh.faces.is_empty() {
+        return Ok(None);
+    }
+    let w = weld_coincident(mesh);
+    if w.refused {
+        warn(format!(
+            "{name} has {} vertices at the same position as another (seams?), left apart: welding them would join three or more faces along an edge",
+            w.vertices_merged
+        ));
+    } else if w.vertices_merged > 0 {
+        warn(format!(
+            "welded {} vertices of {name} at the same position as another (a mesh split along seams){}",
+            w.vertices_merged,
+            if w.faces_dropped > 0 {
+                format!("; {} faces that collapsed were dropped", w.faces_dropped)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    let b = split_bowties(mesh);
+    if b.vertices_split > 0 {
+        warn(format!(
+            "split {} non-manifold vertices of {name} (faces meeting only at a vertex, e.g. vertex {}) into one vertex per fan",
+            b.vertices_split, b.examples[0]
+        ));
+    }
+    let (faces, r) = reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions))?;
+    if !r.needed {
+        return Ok(None);
+    }
+    warn(format!(
+        "re-oriented {} faces in {} components of {name}",
+        r.flipped_faces, r.repaired_components
+    ));
+    mesh.faces = faces;
+    Ok(Some(Reorientation {
+        faces_flipped: r.flipped_faces,
+        components_changed: r.repaired_components,
+    }))
+}
+
+/// Reads `input` (a file, or takes the mesh given) and repairs it ([`repair_mesh`]) unless its
+/// faces are not used (`as_points`). Returns the mesh, its name for messages and what was
+/// re-oriented.
+pub(crate) fn read_input(
+    input: Input,
+    as_points: bool,
+    warn: &mut dyn FnMut(String),
+) -> Result<(PolyMesh, String, Option<Reorientation>), Error> {
+    let (mut mesh, name) = match input {
+        Input::File(path) => {
+            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            (m, path.display().to_string())
+        }
+        Input::Mesh { mesh, name } => (mesh, name),
+    };
+    let reoriented = if as_points {
+        None
+    } else {
+        repair_mesh(&mut mesh, &name, warn).map_err(|e| Error::input(&name, e))?
+    };
+    Ok((mesh, name, reoriented))
+}
