@@ -444,3 +444,41 @@ fn a_known_open_cloud_is_not_wrapped_closed() {
         "cage vertex {far} vs spacing {spacing}"
     );
 }
+
+/// The cut of an open cloud moves toward the data's edge: on the hemisphere `z ≥ 0` the
+/// trimmed contour's boundary vertices lie on average 0.63 median spacings from the data with
+/// the tighter edge (`TrimOptions::edge_spacings` 0.75), 0.79 with the support rule alone
+/// (`edge_spacings` at `support_spacings`, 1.5); the front sheet and its one loop are kept
+/// either way. (The largest stays: a vertex nearest to a data point keeps its faces.)
+#[test]
+fn the_cut_moves_toward_the_datas_edge() {
+    let t = target(&hemisphere(6000, 1));
+    let (closed, c) = subfit_init::contour(&t, &subfit_init::ContourOptions::default()).unwrap();
+    let band = c.band_cells as f64 * c.cell_size * (1u64 << c.band_level) as f64;
+    let overhang = |edge_spacings: f64| {
+        let options = subfit_init::TrimOptions {
+            edge_spacings,
+            boundary_smoothing: 0,
+            ..subfit_init::TrimOptions::default()
+        };
+        let (open, rep) = subfit_init::trim_unsupported(&t, &closed, band, &options).unwrap();
+        assert_eq!(rep.boundary_loops, 1, "{rep:?}");
+        let he = subfit_mesh::HalfEdgeMesh::from_mesh(&open).unwrap();
+        let rim = &he.boundary_loops()[0];
+        let index = t.index();
+        let mean = rim
+            .iter()
+            .map(|v| index.nearest(&open.positions[v.idx()]).distance)
+            .sum::<f64>()
+            / rim.len() as f64;
+        (mean, rep)
+    };
+    let spacing = t.stats().point_spacing;
+    let (tight, rep) = overhang(0.75);
+    let (loose, _) = overhang(1.5);
+    assert!(rep.edge_faces_removed > 0, "{rep:?}");
+    assert!(
+        tight < 0.85 * loose,
+        "mean rim distance {tight} vs {loose} (spacing {spacing})"
+    );
+}
