@@ -225,6 +225,7 @@ fn a_mesh_split_along_seams_is_welded_with_a_warning() {
     let info: serde_json::Value =
         serde_json::from_slice(&subfit(&["info", "--json", m]).stdout).unwrap();
     assert_eq!(info["topology"]["components"], 2, "{info}");
+    assert_eq!(info["topology"]["coincident_vertices"], 48, "{info}");
 
     let out = d.path().join("fit");
     let r = subfit(&[

@@ -39,4 +39,4 @@ pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
 pub use polygons::{bounding_box, PolyMesh, Polygons};
 pub use reorient::{reorient_faces, ReorientError, ReorientReport};
 pub use tags::{Tags, SHARPNESS_INFINITE};
-pub use weld::{weld_coincident, WeldReport};
+pub use weld::{coincident_vertices, weld_coincident, WeldReport};

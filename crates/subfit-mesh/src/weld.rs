@@ -28,6 +28,28 @@ pub struct WeldReport {
     pub refused: bool,
 }
 
+/// How many referenced vertices of `mesh` sit at exactly the same position as an earlier
+/// referenced one: what [`weld_coincident`] would merge. Cost `O(#V + #H)`.
+pub fn coincident_vertices(mesh: &PolyMesh) -> usize {
+    let mut referenced = vec![false; mesh.positions.len()];
+    for &v in mesh.faces.indices() {
+        if let Some(r) = referenced.get_mut(v as usize) {
+            *r = true;
+        }
+    }
+    let mut seen = std::collections::HashSet::with_capacity(mesh.positions.len());
+    mesh.positions
+        .iter()
+        .zip(&referenced)
+        .filter(|(p, &r)| r && !seen.insert(key(p)))
+        .count()
+}
+
+/// A position's hash key: its bits, with `-0.0` read as `0.0`.
+fn key(p: &[f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0u64 } else { c.to_bits() })
+}
+
 /// Merges the vertices of `mesh` at the same position (see the module docs): each merged-away
 /// vertex is removed (with its normal and colour), the others keep their order, the faces are
 /// re-indexed. A point cloud (no faces) is left alone. The mesh is unchanged when nothing is merged or the weld is refused.
@@ -36,7 +58,6 @@ pub fn weld_coincident(mesh: &mut PolyMesh) -> WeldReport {
     if mesh.faces.is_empty() {
         return report;
     }
-    let key = |p: &[f64; 3]| p.map(|c| if c == 0.0 { 0u64 } else { c.to_bits() });
     let mut first: HashMap<[u64; 3], u32> = HashMap::with_capacity(mesh.positions.len());
     let mut referenced = vec![false; mesh.positions.len()];
     for &v in mesh.faces.indices() {
@@ -133,8 +154,10 @@ mod tests {
     fn a_seam_is_welded_into_one_sheet() {
         let m = split_squares();
         assert_eq!(diagnose_mesh(&m).num_components, 2);
+        assert_eq!(coincident_vertices(&m), 2);
         let mut w = m.clone();
         let r = weld_coincident(&mut w);
+        assert_eq!(coincident_vertices(&w), 0);
         assert_eq!(
             r,
             WeldReport {

@@ -54,6 +54,9 @@ struct Topology {
     consistently_oriented: bool,
     non_manifold_edges: usize,
     non_manifold_vertices: usize,
+    /// Referenced vertices at exactly the position of another (a mesh split along seams;
+    /// `fit` welds them).
+    coincident_vertices: usize,
     inconsistent_edges: usize,
     degenerate_faces: usize,
     zero_area_faces: Option<usize>,
@@ -80,6 +83,7 @@ impl Topology {
             consistently_oriented: r.is_consistently_oriented,
             non_manifold_edges: r.non_manifold_edges,
             non_manifold_vertices: r.non_manifold_vertices,
+            coincident_vertices: 0,
             inconsistent_edges: r.inconsistent_edges,
             degenerate_faces: r.degenerate_faces + r.repeated_vertex_faces,
             zero_area_faces: r.zero_area_faces,
@@ -118,6 +122,10 @@ impl Topology {
         let defects = [
             ("non-manifold edges", self.non_manifold_edges),
             ("non-manifold vertices", self.non_manifold_vertices),
+            (
+                "coincident vertices (split seams?)",
+                self.coincident_vertices,
+            ),
             ("inconsistently oriented edges", self.inconsistent_edges),
             ("degenerate faces", self.degenerate_faces),
             ("zero-area faces", self.zero_area_faces.unwrap_or(0)),
@@ -173,8 +181,10 @@ fn describe(path: &Path, mesh: &PolyMesh, fi: &subfit::io::FileInfo) -> Info {
             diagonal: (size[0] * size[0] + size[1] * size[1] + size[2] * size[2]).sqrt(),
         }
     });
-    let topology =
-        (!mesh.faces.is_empty()).then(|| Topology::new(subfit::mesh::diagnose_mesh(mesh)));
+    let topology = (!mesh.faces.is_empty()).then(|| Topology {
+        coincident_vertices: subfit::mesh::coincident_vertices(mesh),
+        ..Topology::new(subfit::mesh::diagnose_mesh(mesh))
+    });
     Info {
         file: path.display().to_string(),
         format: fi.format.name(),
