@@ -339,8 +339,8 @@ pub enum StageStop {
     /// [`STALL_GAIN`].
     Stalled,
     /// Refinement stopped paying: [`UNPAID_REFINEMENTS`] refinements in a row each lowered the
-    /// judged RMS by less than [`REFINE_PAYOFF`] asks while it still missed its tolerance (the
-    /// floor of a noisy target).
+    /// judged RMS by less than [`StageOptions::refine_payoff`] asks while it still missed its
+    /// tolerance (the floor of a noisy target).
     Diminishing,
     /// `max_stages` or `max_iterations` reached.
     Limit,
@@ -361,8 +361,8 @@ pub const STALL_STAGES: usize = 4;
 pub const STALL_GAIN: f64 = 0.01;
 
 /// The default [`StageOptions::refine_payoff`]: a refinement pays when the judged RMS falls at
-/// least as `n^−REFINE_PAYOFF` in the control
-/// points `n` (1.5 times the points for 6 % less). A smooth surface's error falls as `n^−1`
+/// least as `n^−REFINE_PAYOFF` in the control points `n` (1.5 times the points for 6 % less).
+/// A smooth surface's error falls as `n^−1`
 /// and local refinement does better: over 22 fits of the shared models with defaults no two
 /// refinements in a row were slower than `n^−0.2` while their RMS missed (the camel head's
 /// slowest, 0.32 then 0.20). Fitting noise is slower: the Igea cut with Gaussian vertex noise of
@@ -370,8 +370,8 @@ pub const STALL_GAIN: f64 = 0.01;
 /// for an RMS of 8.9e-4 → 7.6e-4 of the diagonal (tolerance 7.5e-4).
 pub const REFINE_PAYOFF: f64 = 0.15;
 
-/// Refinements in a row that do not pay ([`StageOptions::refine_payoff`]) while the RMS misses its tolerance
-/// after which [`fit_stages`] stops ([`StageStop::Diminishing`]).
+/// Refinements in a row that do not pay ([`StageOptions::refine_payoff`]) while the RMS misses
+/// its tolerance after which [`fit_stages`] stops ([`StageStop::Diminishing`]).
 pub const UNPAID_REFINEMENTS: usize = 2;
 
 /// The log of [`fit_stages`].

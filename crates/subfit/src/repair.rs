@@ -19,7 +19,7 @@ use crate::scan::Input;
 /// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
 /// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
 /// an error (a non-manifold edge, a non-orientable component) the welds and splits are kept
-/// and the faces are as they were read.
+/// and no face is turned.
 pub fn repair_mesh(
     mesh: &mut PolyMesh,
     name: &str,
