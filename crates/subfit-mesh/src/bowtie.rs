@@ -14,7 +14,7 @@
 //! more faces on one edge) are not touched. Cost `O(#H · α)`.
 
 use crate::edges::{corner_next, group_edges, UnionFind};
-use crate::polygons::PolyMesh;
+use crate::polygons::{PolyMesh, Polygons};
 
 /// What [`split_bowties`] did.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -31,8 +31,77 @@ pub struct BowtieReport {
 /// module docs); returns what was split. Faces with an out-of-range or repeated vertex id are
 /// left as they are and do not join fans. The mesh is unchanged when there is no bowtie.
 pub fn split_bowties(mesh: &mut PolyMesh) -> BowtieReport {
-    let faces = &mesh.faces;
     let nv = mesh.num_vertices();
+    let Fans {
+        corners_of_valid,
+        fan_size,
+        mut roots_of,
+    } = fans(&mesh.faces, nv);
+    let mut report = BowtieReport::default();
+    // New vertex id per fan root that is not its vertex's largest fan; the copies' source.
+    let mut new_id = vec![u32::MAX; mesh.faces.indices().len()];
+    let mut source: Vec<usize> = Vec::new();
+    for (v, roots) in roots_of.iter_mut().enumerate() {
+        if roots.len() < 2 {
+            continue;
+        }
+        // The largest fan keeps the id (ties: the lowest corner), the rest in corner order.
+        roots.sort_unstable_by_key(|&r| (std::cmp::Reverse(fan_size[r as usize]), r));
+        for &r in &roots[1..] {
+            new_id[r as usize] = (nv + source.len()) as u32;
+            source.push(v);
+            report.vertices_added += 1;
+        }
+        report.vertices_split += 1;
+        if report.examples.len() < crate::diagnose::MAX_EXAMPLES {
+            report.examples.push(v as u32);
+        }
+    }
+    if report.vertices_split == 0 {
+        return report;
+    }
+    let indices = mesh.faces.indices_mut();
+    for &(c, root) in &corners_of_valid {
+        let id = new_id[root as usize];
+        if id != u32::MAX {
+            indices[c as usize] = id;
+        }
+    }
+    // The copies carry the vertex's attributes.
+    let copies: Vec<[f64; 3]> = source.iter().map(|&v| mesh.positions[v]).collect();
+    mesh.positions.extend(copies);
+    if let Some(n) = mesh.normals.as_mut() {
+        let copies: Vec<[f64; 3]> = source.iter().map(|&v| n[v]).collect();
+        n.extend(copies);
+    }
+    if let Some(c) = mesh.colors.as_mut() {
+        let copies: Vec<[u8; 3]> = source.iter().map(|&v| c[v]).collect();
+        c.extend(copies);
+    }
+    report
+}
+
+/// The fans of faces at every vertex: per corner of a valid face its fan's root corner, per
+/// root the corners in its fan, per vertex the roots of its fans.
+struct Fans {
+    corners_of_valid: Vec<(u32, u32)>,
+    fan_size: Vec<u32>,
+    roots_of: Vec<Vec<u32>>,
+}
+
+/// Per vertex whether its faces form more than one fan (a bowtie), for `faces` over `nv`
+/// vertices. Cost `O(#H · α)`.
+pub(crate) fn bowtie_vertices(faces: &Polygons, nv: usize) -> Vec<bool> {
+    fans(faces, nv)
+        .roots_of
+        .iter()
+        .map(|r| r.len() > 1)
+        .collect()
+}
+
+/// The fans of `faces` (see [`Fans`]): a union-find over corners, two corners at a vertex
+/// joined when their faces share an edge at it.
+fn fans(faces: &Polygons, nv: usize) -> Fans {
     let idx = faces.indices();
     let valid: Vec<bool> = faces
         .iter()
@@ -83,55 +152,17 @@ pub fn split_bowties(mesh: &mut PolyMesh) -> BowtieReport {
             roots_of[idx[c as usize] as usize].push(root);
         }
     }
-    let mut report = BowtieReport::default();
-    // New vertex id per fan root that is not its vertex's largest fan; the copies' source.
-    let mut new_id = vec![u32::MAX; idx.len()];
-    let mut source: Vec<usize> = Vec::new();
-    for (v, roots) in roots_of.iter_mut().enumerate() {
-        if roots.len() < 2 {
-            continue;
-        }
-        // The largest fan keeps the id (ties: the lowest corner), the rest in corner order.
-        roots.sort_unstable_by_key(|&r| (std::cmp::Reverse(fan_size[r as usize]), r));
-        for &r in &roots[1..] {
-            new_id[r as usize] = (nv + source.len()) as u32;
-            source.push(v);
-            report.vertices_added += 1;
-        }
-        report.vertices_split += 1;
-        if report.examples.len() < crate::diagnose::MAX_EXAMPLES {
-            report.examples.push(v as u32);
-        }
+    Fans {
+        corners_of_valid,
+        fan_size,
+        roots_of,
     }
-    if report.vertices_split == 0 {
-        return report;
-    }
-    let indices = mesh.faces.indices_mut();
-    for &(c, root) in &corners_of_valid {
-        let id = new_id[root as usize];
-        if id != u32::MAX {
-            indices[c as usize] = id;
-        }
-    }
-    // The copies carry the vertex's attributes.
-    let copies: Vec<[f64; 3]> = source.iter().map(|&v| mesh.positions[v]).collect();
-    mesh.positions.extend(copies);
-    if let Some(n) = mesh.normals.as_mut() {
-        let copies: Vec<[f64; 3]> = source.iter().map(|&v| n[v]).collect();
-        n.extend(copies);
-    }
-    if let Some(c) = mesh.colors.as_mut() {
-        let copies: Vec<[u8; 3]> = source.iter().map(|&v| c[v]).collect();
-        c.extend(copies);
-    }
-    report
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::diagnose::diagnose_mesh;
-    use crate::polygons::Polygons;
 
     /// Two triangles meeting only at vertex 0, and a quad strip sharing an edge with one.
     fn bowtie() -> PolyMesh {

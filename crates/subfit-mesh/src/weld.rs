@@ -52,7 +52,9 @@ fn key(p: &[f64; 3]) -> [u64; 3] {
 
 /// Merges the vertices of `mesh` at the same position (see the module docs): each merged-away
 /// vertex is removed (with its normal and colour), the others keep their order, the faces are
-/// re-indexed. A point cloud (no faces) is left alone. The mesh is unchanged when nothing is merged or the weld is refused.
+/// re-indexed. A merge that would make its vertex a bowtie (faces meeting only there) is not
+/// done. A point cloud (no faces) is left alone. The mesh is unchanged when nothing is merged
+/// or the weld is refused.
 pub fn weld_coincident(mesh: &mut PolyMesh) -> WeldReport {
     let mut report = WeldReport::default();
     if mesh.faces.is_empty() {
@@ -79,6 +81,25 @@ pub fn weld_coincident(mesh: &mut PolyMesh) -> WeldReport {
     if report.vertices_merged == 0 {
         return report;
     }
+    // A merge whose vertex would become a bowtie is undone: two sheets touching at a point (a
+    // model's parts, or a split of our own) are not one surface there, and the bowtie split
+    // would only take the merge back.
+    let nv = mesh.positions.len();
+    let (mapped, _) = remapped(&mesh.faces, |v| map.get(v as usize).copied().unwrap_or(v));
+    let (was, now) = (
+        crate::bowtie::bowtie_vertices(&mesh.faces, nv),
+        crate::bowtie::bowtie_vertices(&mapped, nv),
+    );
+    for (v, m) in map.iter_mut().enumerate() {
+        let r = *m as usize;
+        if r != v && now[r] && !was[r] {
+            *m = v as u32;
+            report.vertices_merged -= 1;
+        }
+    }
+    if report.vertices_merged == 0 {
+        return report;
+    }
     // Merged-away vertices are removed; the others keep their order.
     let mut new_id = vec![u32::MAX; map.len()];
     let mut kept = 0u32;
@@ -92,18 +113,8 @@ pub fn weld_coincident(mesh: &mut PolyMesh) -> WeldReport {
         Some(&m) => new_id[m as usize],
         None => v,
     };
-    let mut faces = Polygons::with_capacity(mesh.faces.len(), mesh.faces.indices().len());
-    let mut face = Vec::new();
-    for f in mesh.faces.iter() {
-        face.clear();
-        face.extend(f.iter().map(|&v| renumber(v)));
-        let repeated = (0..face.len()).any(|i| face[i + 1..].contains(&face[i]));
-        if repeated {
-            report.faces_dropped += 1;
-        } else {
-            faces.push(&face);
-        }
-    }
+    let (faces, dropped) = remapped(&mesh.faces, renumber);
+    report.faces_dropped = dropped;
     let (before, after) = (
         diagnose(&mesh.faces, mesh.num_vertices(), None),
         diagnose(&faces, kept as usize, None),
@@ -125,6 +136,24 @@ pub fn weld_coincident(mesh: &mut PolyMesh) -> WeldReport {
         *c = (0..map.len()).filter(keep).map(|v| c[v]).collect();
     }
     report
+}
+
+/// `faces` with every vertex id `v` replaced by `id(v)`, without the faces that then repeat a
+/// vertex; and how many those were.
+fn remapped(faces: &Polygons, id: impl Fn(u32) -> u32) -> (Polygons, usize) {
+    let mut out = Polygons::with_capacity(faces.len(), faces.indices().len());
+    let mut face = Vec::new();
+    let mut dropped = 0;
+    for f in faces.iter() {
+        face.clear();
+        face.extend(f.iter().map(|&v| id(v)));
+        if (0..face.len()).any(|i| face[i + 1..].contains(&face[i])) {
+            dropped += 1;
+        } else {
+            out.push(&face);
+        }
+    }
+    (out, dropped)
 }
 
 #[cfg(test)]
@@ -189,6 +218,27 @@ mod tests {
         let mut w = m.clone();
         let r = weld_coincident(&mut w);
         assert!(r.refused, "{r:?}");
+        assert_eq!(w, m);
+    }
+
+    #[test]
+    fn two_sheets_touching_at_a_point_stay_apart() {
+        // Two triangles whose corners 0 and 3 coincide: welded, they would meet only there.
+        let p = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+        ];
+        let mut faces = Polygons::new();
+        faces.push(&[0, 1, 2]);
+        faces.push(&[3, 4, 5]);
+        let m = PolyMesh::new(p, faces);
+        assert_eq!(coincident_vertices(&m), 1);
+        let mut w = m.clone();
+        assert_eq!(weld_coincident(&mut w), WeldReport::default());
         assert_eq!(w, m);
     }
 
