@@ -11,6 +11,38 @@ use subfit::io::{Encoding, WriteOptions};
 use subfit::mesh::shapes::torus_mesh;
 use subfit::mesh::{PolyMesh, Polygons};
 
+/// Writes `mesh` to `path` as full-precision ASCII OBJ.
+fn write_obj(path: &Path, mesh: &PolyMesh) {
+    let opts = WriteOptions {
+        format: None,
+        encoding: Encoding::Ascii,
+        single_precision: false,
+    };
+    subfit::io::write_file(path, mesh, &opts).unwrap();
+}
+
+/// `subfit fit MESH -o OUT --control-points N`, one iteration at sample level 2 (exit 0 or 1):
+/// its stderr and report.json.
+fn quick_fit(mesh: &str, out: &Path, n: &str) -> (String, serde_json::Value) {
+    let o = out.to_str().unwrap();
+    let r = subfit(&[
+        "fit",
+        mesh,
+        "-o",
+        o,
+        "--control-points",
+        n,
+        "--max-iterations",
+        "1",
+        "--sample-level",
+        "2",
+    ]);
+    let err = String::from_utf8_lossy(&r.stderr).into_owned();
+    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    let report = serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+    (err, report)
+}
+
 /// A torus mesh (genus 1) with faces 10, 11, 500 and 900 reversed, as OBJ.
 fn messy_torus(dir: &Path) -> std::path::PathBuf {
     let t = torus_mesh(1.0, 0.4, 48, 24, true);
@@ -24,12 +56,7 @@ fn messy_torus(dir: &Path) -> std::path::PathBuf {
         }
     }
     let path = dir.join("messy.obj");
-    let opts = WriteOptions {
-        format: None,
-        encoding: Encoding::Ascii,
-        single_precision: false,
-    };
-    subfit::io::write_file(&path, &PolyMesh::new(t.positions, faces), &opts).unwrap();
+    write_obj(&path, &PolyMesh::new(t.positions, faces));
     path
 }
 
@@ -62,24 +89,8 @@ fn inconsistently_oriented_faces_are_repaired_with_a_warning() {
     assert!(r.status.success(), "{err}");
     assert!(err.contains(&warning), "{err}");
 
-    let out = d.path().join("fit");
-    let r = subfit(&[
-        "fit",
-        m,
-        "-o",
-        out.to_str().unwrap(),
-        "--control-points",
-        "60",
-        "--max-iterations",
-        "1",
-        "--sample-level",
-        "2",
-    ]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    let (err, report) = quick_fit(m, &d.path().join("fit"), "60");
     assert!(err.contains(&warning), "{err}");
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["target_topology"]["genus"], 1, "{report}");
     // The repair is in the report too, beside the warning.
     assert_eq!(report["reoriented"]["faces_flipped"], 4, "{report}");
@@ -117,12 +128,7 @@ fn bowtie_torus(dir: &Path) -> std::path::PathBuf {
         }
     }
     let path = dir.join("bowtie.obj");
-    let opts = WriteOptions {
-        format: None,
-        encoding: Encoding::Ascii,
-        single_precision: false,
-    };
-    subfit::io::write_file(&path, &PolyMesh::new(t.positions, faces), &opts).unwrap();
+    write_obj(&path, &PolyMesh::new(t.positions, faces));
     path
 }
 
@@ -151,24 +157,8 @@ fn a_non_manifold_vertex_is_split_with_a_warning() {
     assert!(r.status.success(), "{err}");
     assert!(err.contains(&warning), "{err}");
 
-    let out = d.path().join("fit");
-    let r = subfit(&[
-        "fit",
-        m,
-        "-o",
-        out.to_str().unwrap(),
-        "--control-points",
-        "80",
-        "--max-iterations",
-        "1",
-        "--sample-level",
-        "2",
-    ]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    let (err, report) = quick_fit(m, &d.path().join("fit"), "80");
     assert!(err.contains(&warning), "{err}");
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     // Split, the two holes are one boundary loop through the two copies of the vertex.
     assert_eq!(report["target_topology"]["boundary_loops"], 1, "{report}");
     assert_eq!(report["target_topology"]["genus"], 1, "{report}");
@@ -208,12 +198,7 @@ fn seamed_torus(dir: &Path) -> std::path::PathBuf {
         faces.push(&f);
     }
     let path = dir.join("seamed.obj");
-    let opts = WriteOptions {
-        format: None,
-        encoding: Encoding::Ascii,
-        single_precision: false,
-    };
-    subfit::io::write_file(&path, &PolyMesh::new(positions, faces), &opts).unwrap();
+    write_obj(&path, &PolyMesh::new(positions, faces));
     path
 }
 
@@ -227,25 +212,9 @@ fn a_mesh_split_along_seams_is_welded_with_a_warning() {
     assert_eq!(info["topology"]["components"], 2, "{info}");
     assert_eq!(info["topology"]["coincident_vertices"], 48, "{info}");
 
-    let out = d.path().join("fit");
-    let r = subfit(&[
-        "fit",
-        m,
-        "-o",
-        out.to_str().unwrap(),
-        "--control-points",
-        "80",
-        "--max-iterations",
-        "1",
-        "--sample-level",
-        "2",
-    ]);
-    let err = String::from_utf8_lossy(&r.stderr);
-    assert!(matches!(r.status.code(), Some(0 | 1)), "{err}");
+    let (err, report) = quick_fit(m, &d.path().join("fit"), "80");
     let welded = format!("subfit: warning: welded 48 vertices of {m} at the same position");
     assert!(err.contains(&welded), "{err}");
-    let report: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
     assert_eq!(report["target_topology"]["genus"], 1, "{report}");
     assert_eq!(report["target_topology"]["boundary_loops"], 0, "{report}");
     assert_eq!(report["init"]["boundary_loops"]["cage"], 0, "{report}");

@@ -162,24 +162,9 @@ mod tests {
     #[test]
     fn a_sphere_keeps_its_size() {
         // Octahedron refined by midpoint subdivision and projected onto the unit sphere.
-        let mut p: Vec<[f64; 3]> = vec![
-            [1.0, 0.0, 0.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, -1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 0.0, -1.0],
-        ];
-        let mut t: Vec<[u32; 3]> = vec![
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ];
+        let o = subfit_mesh::shapes::octahedron_mesh(1.0, 1.0, 1.0);
+        let mut p = o.positions;
+        let mut t = o.faces.triangulate_fan();
         for _ in 0..4 {
             let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
             let mut nt = Vec::new();

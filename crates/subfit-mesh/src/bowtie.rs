@@ -9,11 +9,11 @@
 //! keeps every face and every position and only changes what touches what. The largest fan
 //! keeps the original vertex id; the others get new ids appended after the existing vertices.
 //!
-//! Fans are found as in [`crate::diagnose`]: a union-find over the corners at each vertex, two
-//! corners joined when their faces share an edge at the vertex. Non-manifold edges (three or
+//! Fans are found as in [`crate::diagnose`], by the same union-find over the corners at each
+//! vertex, two corners joined when their faces share an edge at the vertex. Non-manifold edges (three or
 //! more faces on one edge) are not touched. Cost `O(#H · α)`.
 
-use crate::edges::{corner_next, group_edges, UnionFind};
+use crate::edges::{corner_fans, corner_next, group_edges};
 use crate::polygons::{PolyMesh, Polygons};
 
 /// What [`split_bowties`] did.
@@ -113,27 +113,7 @@ fn fans(faces: &Polygons, nv: usize) -> Fans {
         .collect();
     let next = corner_next(faces);
     let groups = group_edges(faces, &next, nv, |f| valid[f]);
-    let mut fans = UnionFind::new(idx.len());
-    for e in 0..groups.len() {
-        let g = groups.group(e);
-        let a = idx[g[0] as usize];
-        // The corner at the origin of half-edge h is h; at its destination, next[h].
-        let (mut at_a, mut at_b) = (u32::MAX, u32::MAX);
-        for &h in g {
-            let (ca, cb) = if idx[h as usize] == a {
-                (h, next[h as usize])
-            } else {
-                (next[h as usize], h)
-            };
-            for (c, first) in [(ca, &mut at_a), (cb, &mut at_b)] {
-                if *first == u32::MAX {
-                    *first = c;
-                } else {
-                    fans.union(*first, c);
-                }
-            }
-        }
-    }
+    let mut fans = corner_fans(faces, &groups, &next);
     // Corners of valid faces per fan root, and the fans of each vertex.
     let mut fan_size = vec![0u32; idx.len()];
     let mut corners_of_valid = Vec::with_capacity(idx.len());

@@ -349,27 +349,7 @@ fn fans_by_union_find(
     num_vertices: usize,
 ) -> Vec<u32> {
     let idx = faces.indices();
-    let mut fans = UnionFind::new(idx.len());
-    for e in 0..groups.len() {
-        let g = groups.group(e);
-        let a = idx[g[0] as usize];
-        // Corner at the origin of h is h; at its destination, next[h].
-        let (mut at_a, mut at_b) = (u32::MAX, u32::MAX);
-        for &h in g {
-            let (ca, cb) = if idx[h as usize] == a {
-                (h, next[h as usize])
-            } else {
-                (next[h as usize], h)
-            };
-            for (c, first) in [(ca, &mut at_a), (cb, &mut at_b)] {
-                if *first == u32::MAX {
-                    *first = c;
-                } else {
-                    fans.union(*first, c);
-                }
-            }
-        }
-    }
+    let mut fans = crate::edges::corner_fans(faces, groups, next);
     let mut fan_count = vec![0u32; num_vertices];
     for (f, w) in faces.offsets().windows(2).enumerate() {
         if analysed[f] {

@@ -116,6 +116,36 @@ pub(crate) fn group_edges(
     EdgeGroups { order, starts }
 }
 
+/// The fans of corners: a union-find over the corners (half-edge ids) of `faces` in which two
+/// corners at a vertex are joined when their faces share an edge at it (through any number of
+/// sides), for the edges `groups` of [`group_edges`] with `next` of [`corner_next`]. A vertex
+/// whose corners have several roots is a bowtie. Cost `O(#H · α)`.
+pub(crate) fn corner_fans(faces: &Polygons, groups: &EdgeGroups, next: &[u32]) -> UnionFind {
+    let idx = faces.indices();
+    let mut fans = UnionFind::new(idx.len());
+    for e in 0..groups.len() {
+        let g = groups.group(e);
+        let a = idx[g[0] as usize];
+        // Corner at the origin of h is h; at its destination, next[h].
+        let (mut at_a, mut at_b) = (u32::MAX, u32::MAX);
+        for &h in g {
+            let (ca, cb) = if idx[h as usize] == a {
+                (h, next[h as usize])
+            } else {
+                (next[h as usize], h)
+            };
+            for (c, first) in [(ca, &mut at_a), (cb, &mut at_b)] {
+                if *first == u32::MAX {
+                    *first = c;
+                } else {
+                    fans.union(*first, c);
+                }
+            }
+        }
+    }
+    fans
+}
+
 /// Union-find over `0..n` with path halving and union by size. Each operation costs amortized
 /// `O(α(n))`.
 pub(crate) struct UnionFind {
