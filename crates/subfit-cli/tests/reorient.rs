@@ -1,6 +1,6 @@
-//! A target mesh with a few faces the wrong way round (as real scans have), or with faces meeting
-//! only at a vertex, is repaired, with a warning, by `init`, `analyze` and `fit`, instead of
-//! being refused.
+//! A target mesh with a few faces the wrong way round (as real scans have), with faces meeting
+//! only at a vertex, split along seams, with stray, repeated or collapsed faces, is repaired,
+//! with a warning, by `init`, `analyze` and `fit`, instead of being refused.
 
 mod common;
 
@@ -215,6 +215,66 @@ fn a_mesh_split_along_seams_is_welded_with_a_warning() {
     let (err, report) = quick_fit(m, &d.path().join("fit"), "80");
     let welded = format!("subfit: warning: welded 48 vertices of {m} at the same position");
     assert!(err.contains(&welded), "{err}");
+    assert_eq!(report["target_topology"]["genus"], 1, "{report}");
+    assert_eq!(report["target_topology"]["boundary_loops"], 0, "{report}");
+    assert_eq!(report["init"]["boundary_loops"]["cage"], 0, "{report}");
+}
+
+/// A torus mesh with what exports and scanners leave behind: three stray triangles (fins)
+/// standing on edges of the surface (edges with three faces), two faces written twice (once
+/// turned), and two collapsed faces (a vertex repeated).
+fn littered_torus(dir: &Path) -> std::path::PathBuf {
+    let t = torus_mesh(1.0, 0.4, 48, 24, true);
+    let mut positions = t.positions.clone();
+    let mut faces = Polygons::new();
+    for poly in t.faces.iter() {
+        faces.push(poly);
+    }
+    let polys: Vec<Vec<u32>> = t.faces.iter().map(<[u32]>::to_vec).collect();
+    for f in [7, 300, 811] {
+        let (a, b) = (polys[f][0], polys[f][1]);
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        positions.push([
+            (pa[0] + pb[0]) / 2.0,
+            (pa[1] + pb[1]) / 2.0,
+            (pa[2] + pb[2]) / 2.0 + 0.2,
+        ]);
+        faces.push(&[b, a, (positions.len() - 1) as u32]);
+    }
+    faces.push(&polys[40]);
+    let turned: Vec<u32> = polys[41].iter().rev().copied().collect();
+    faces.push(&turned);
+    faces.push(&[polys[50][0], polys[50][1], polys[50][1]]);
+    faces.push(&[polys[60][0], polys[60][0], polys[60][0]]);
+    let path = dir.join("littered.obj");
+    write_obj(&path, &PolyMesh::new(positions, faces));
+    path
+}
+
+#[test]
+fn stray_repeated_and_collapsed_faces_are_repaired_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let littered = littered_torus(d.path());
+    let m = littered.to_str().unwrap();
+    let info: serde_json::Value =
+        serde_json::from_slice(&subfit(&["info", "--json", m]).stdout).unwrap();
+    assert!(
+        info["topology"]["non_manifold_edges"].as_u64().unwrap() >= 3,
+        "{info}"
+    );
+
+    let (err, report) = quick_fit(m, &d.path().join("fit"), "80");
+    let faces = format!(
+        "subfit: warning: repaired faces of {m}: 2 dropped with fewer than three distinct vertices, 2 dropped as duplicates of an earlier face"
+    );
+    let cut = format!("subfit: warning: cut 3 edges of {m} shared by more than two faces");
+    assert!(err.contains(&faces), "{err}");
+    assert!(err.contains(&cut), "{err}");
+    assert!(
+        err.contains("3 faces of flaps that came off dropped"),
+        "{err}"
+    );
+    // What is left is the closed torus.
     assert_eq!(report["target_topology"]["genus"], 1, "{report}");
     assert_eq!(report["target_topology"]["boundary_loops"], 0, "{report}");
     assert_eq!(report["init"]["boundary_loops"]["cage"], 0, "{report}");

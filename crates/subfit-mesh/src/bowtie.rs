@@ -13,7 +13,7 @@
 //! vertex, two corners joined when their faces share an edge at the vertex. Non-manifold edges (three or
 //! more faces on one edge) are not touched. Cost `O(#H · α)`.
 
-use crate::edges::{corner_fans, corner_next, group_edges};
+use crate::edges::{corner_fans, corner_next, group_edges, EdgeGroups};
 use crate::polygons::{PolyMesh, Polygons};
 
 /// What [`split_bowties`] did.
@@ -31,12 +31,23 @@ pub struct BowtieReport {
 /// module docs); returns what was split. Faces with an out-of-range or repeated vertex id are
 /// left as they are and do not join fans. The mesh is unchanged when there is no bowtie.
 pub fn split_bowties(mesh: &mut PolyMesh) -> BowtieReport {
+    split_fans(mesh, |_, _, groups| groups)
+}
+
+/// [`split_bowties`] with the edge grouping changed by `regroup(faces, next, groups)` before
+/// the fans are found: half-edges that `regroup` puts in separate groups do not join their
+/// faces, so their vertices split as bowties (how [`crate::cut_nonmanifold_edges`] detaches
+/// faces from an edge).
+pub(crate) fn split_fans(
+    mesh: &mut PolyMesh,
+    regroup: impl FnOnce(&Polygons, &[u32], EdgeGroups) -> EdgeGroups,
+) -> BowtieReport {
     let nv = mesh.num_vertices();
     let Fans {
         corners_of_valid,
         fan_size,
         mut roots_of,
-    } = fans(&mesh.faces, nv);
+    } = fans(&mesh.faces, nv, regroup);
     let mut report = BowtieReport::default();
     // New vertex id per fan root that is not its vertex's largest fan; the copies' source.
     let mut new_id = vec![u32::MAX; mesh.faces.indices().len()];
@@ -92,7 +103,7 @@ struct Fans {
 /// Per vertex whether its faces form more than one fan (a bowtie), for `faces` over `nv`
 /// vertices. Cost `O(#H · α)`.
 pub(crate) fn bowtie_vertices(faces: &Polygons, nv: usize) -> Vec<bool> {
-    fans(faces, nv)
+    fans(faces, nv, |_, _, groups| groups)
         .roots_of
         .iter()
         .map(|r| r.len() > 1)
@@ -100,8 +111,12 @@ pub(crate) fn bowtie_vertices(faces: &Polygons, nv: usize) -> Vec<bool> {
 }
 
 /// The fans of `faces` (see [`Fans`]): a union-find over corners, two corners at a vertex
-/// joined when their faces share an edge at it.
-fn fans(faces: &Polygons, nv: usize) -> Fans {
+/// joined when their faces share an edge at it (an edge as grouped by `regroup`).
+fn fans(
+    faces: &Polygons,
+    nv: usize,
+    regroup: impl FnOnce(&Polygons, &[u32], EdgeGroups) -> EdgeGroups,
+) -> Fans {
     let idx = faces.indices();
     let valid: Vec<bool> = faces
         .iter()
@@ -112,7 +127,7 @@ fn fans(faces: &Polygons, nv: usize) -> Fans {
         })
         .collect();
     let next = corner_next(faces);
-    let groups = group_edges(faces, &next, nv, |f| valid[f]);
+    let groups = regroup(faces, &next, group_edges(faces, &next, nv, |f| valid[f]));
     let mut fans = corner_fans(faces, &groups, &next);
     // Corners of valid faces per fan root, and the fans of each vertex.
     let mut fan_size = vec![0u32; idx.len()];

@@ -3,14 +3,22 @@
 //! 1. vertices at exactly the same position are welded ([`subfit_mesh::weld_coincident`]): a
 //!    mesh exported with its vertices split along texture seams is one surface, not one patch
 //!    per chart with a boundary along every seam;
-//! 2. non-manifold vertices are split into one per fan of faces
+//! 2. faces that collapse onto a repeated vertex are shortened or dropped, and faces written
+//!    twice are written once ([`subfit_mesh::clean_faces`]);
+//! 3. edges with more than two faces are cut into pairs of faces that continue each other
+//!    ([`subfit_mesh::cut_nonmanifold_edges`]): a stray triangle hanging from the surface comes
+//!    off as a piece of its own;
+//! 4. non-manifold vertices are split into one per fan of faces
 //!    ([`subfit_mesh::split_bowties`]): holes that touch at a vertex;
-//! 3. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
+//! 5. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
 //!    a messy scan.
 //!
-//! Only what cannot be repaired is refused: a non-manifold edge, a non-orientable part.
+//! Only what cannot be repaired is refused: a non-orientable part (a Möbius strip).
 
-use subfit_mesh::{reorient_faces, split_bowties, weld_coincident, PolyMesh, ReorientError};
+use subfit_mesh::{
+    clean_faces, cut_nonmanifold_edges, reorient_faces, split_bowties, weld_coincident, PolyMesh,
+    ReorientError,
+};
 
 use crate::error::Error;
 use crate::pipeline_report::Reorientation;
@@ -18,8 +26,7 @@ use crate::scan::Input;
 
 /// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
 /// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
-/// an error (a non-manifold edge, a non-orientable component) the welds and splits are kept
-/// and no face is turned.
+/// an error (a non-orientable component) the other repairs are kept and no face is turned.
 pub fn repair_mesh(
     mesh: &mut PolyMesh,
     name: &str,
@@ -40,6 +47,59 @@ pub fn repair_mesh(
             w.vertices_merged,
             if w.faces_dropped > 0 {
                 format!("; {} faces that collapsed were dropped", w.faces_dropped)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    let c = clean_faces(mesh);
+    if c.changed() {
+        let mut what = Vec::new();
+        for (n, kind) in [
+            (
+                c.degenerate_dropped,
+                "dropped with fewer than three distinct vertices",
+            ),
+            (
+                c.faces_shortened,
+                "listing a vertex twice in a row, listed once",
+            ),
+            (
+                c.duplicates_dropped,
+                "dropped as duplicates of an earlier face",
+            ),
+        ] {
+            if n > 0 {
+                what.push(format!("{n} {kind}"));
+            }
+        }
+        warn(format!(
+            "repaired faces of {name}: {} (e.g. face {})",
+            what.join(", "),
+            c.examples[0]
+        ));
+    }
+    let e = cut_nonmanifold_edges(mesh);
+    if e.edges_cut > 0 {
+        let [a, b] = e.examples[0];
+        warn(format!(
+            "cut {} edges of {name} shared by more than two faces (e.g. {a}-{b}) into pairs of faces that continue each other{}{}{}",
+            e.edges_cut,
+            if e.vertices_added > 0 {
+                format!(", {} vertices copied", e.vertices_added)
+            } else {
+                String::new()
+            },
+            if e.flap_faces_dropped > 0 {
+                format!(
+                    ", {} faces of flaps that came off dropped",
+                    e.flap_faces_dropped
+                )
+            } else {
+                String::new()
+            },
+            if e.faces_dropped > 0 {
+                format!(", {} faces the cut could not separate dropped", e.faces_dropped)
             } else {
                 String::new()
             }

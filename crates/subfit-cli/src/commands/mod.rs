@@ -40,9 +40,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
 }
 
 /// Repairs a target mesh read from `file` as `subfit fit` does ([`subfit::repair_mesh`]: welds
-/// vertices split along seams, splits non-manifold vertices, re-orients faces), with a warning on
-/// stderr for each repair. A mesh that cannot be repaired (a non-manifold edge, a
-/// non-orientable component) is left as it is, for the command's own checks to accept (e.g.
+/// vertices split along seams, drops collapsed and repeated faces, cuts edges with more than two
+/// faces, splits non-manifold vertices, re-orients faces), with a warning on stderr for each
+/// repair. A mesh that cannot be repaired (a non-orientable component) is left as it is, for the command's own checks to accept (e.g.
 /// `analyze`, `init --from-points`) or refuse with their usual one-line error.
 pub fn repair_target(mesh: &mut PolyMesh, file: &Path) {
     let name = file.display().to_string();
