@@ -176,17 +176,29 @@ fn bad_inputs_exit_with_2_and_leave_no_file() {
     let five = s(&write(p, "five.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n"));
     expect_bad(p, &[&five], &["five.xyz", "5 points"]);
 
-    // Three triangles on the edge 0-1 (a fin) among enough points for a target.
-    let mut fin = String::from("v 0 0 0\nv 1 0 0\nv 0.5 1 0\nv 0.5 -1 0\nv 0.5 0 1\n");
-    for i in 0..10 {
-        let _ = writeln!(fin, "v {} 0.3 {}", 0.1 * i as f64, 0.05 * i as f64);
+    // A Möbius strip of 8 quads (no orientation agrees across every edge; not repairable).
+    let mut mobius = String::new();
+    for i in 0..8 {
+        let t = std::f64::consts::TAU * i as f64 / 8.0;
+        let (h, r) = (0.3 * (t / 2.0).cos(), 0.3 * (t / 2.0).sin());
+        for side in [1.0, -1.0] {
+            let rr = 1.0 + side * r;
+            let _ = writeln!(mobius, "v {} {} {}", rr * t.cos(), rr * t.sin(), side * h);
+        }
     }
-    fin.push_str("f 1 2 3\nf 2 1 4\nf 1 2 5\n");
-    let fin = s(&write(p, "fin.obj", &fin));
+    for i in 0..8 {
+        let (c, e) = if i < 7 {
+            (2 * i + 4, 2 * i + 3)
+        } else {
+            (1, 2)
+        };
+        let _ = writeln!(mobius, "f {} {} {c} {e}", 2 * i + 1, 2 * i + 2);
+    }
+    let mobius = s(&write(p, "mobius.obj", &mobius));
     expect_bad(
         p,
-        &[&fin, "--control-points", "4"],
-        &["fin.obj", "edge 0-1", "--from-points"],
+        &[&mobius, "--control-points", "4"],
+        &["mobius.obj", "inconsistent orientation", "--from-points"],
     );
 
     // A torus (genus 1) needs at least 7 vertices.
