@@ -154,6 +154,15 @@ fn a_single_view_range_scan_is_an_open_surface_on_the_scan_and_the_mesh() {
             "seed {seed}: {}",
             String::from_utf8_lossy(&r.stderr)
         );
+        // The default start of an open cloud is doubled (subfit_init::OPEN_CLOUD_SCALE).
+        let report: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(out.join("report.json")).unwrap()).unwrap();
+        let init = &report["init"];
+        assert_eq!(
+            init["open_cloud_control_points"].as_u64(),
+            init["requested_control_points"].as_u64().map(|n| 2 * n),
+            "seed {seed}: {init}"
+        );
         let c = out.join("control.obj");
         let c = c.to_str().unwrap();
         let cage = json(&["info", "--json", c]);

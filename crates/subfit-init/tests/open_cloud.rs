@@ -482,3 +482,41 @@ fn the_cut_moves_toward_the_datas_edge() {
         "mean rim distance {tight} vs {loose} (spacing {spacing})"
     );
 }
+
+/// `open_cloud_scale`: a cloud found open is contoured and simplified again for the larger
+/// count (the report says for how many); a closed one is left at the count asked for.
+#[test]
+fn an_open_cloud_starts_from_more_points_when_asked() {
+    let scaled = InitOptions {
+        open_cloud_scale: 2.0,
+        ..InitOptions::default()
+    };
+    let t = target(&hemisphere(6000, 1));
+    let (plain, r1) = initial_control_mesh(&t, None, N, &InitOptions::default()).unwrap();
+    let (more, r2) = initial_control_mesh(&t, None, N, &scaled).unwrap();
+    assert_eq!(r1.open_cloud_control_points, None);
+    assert_eq!(r2.open_cloud_control_points, Some(2 * N));
+    assert!(r2.cloud_open() && topology(&more) == (0, 1, 1), "{r2:?}");
+    let (a, b) = (plain.num_vertices(), more.num_vertices());
+    assert!(
+        a <= N + N / 10 && (2 * N - N / 10..=2 * N + N / 5).contains(&b),
+        "{a} {b}"
+    );
+    // The budget caps it.
+    let capped = InitOptions {
+        max_control_points: 300,
+        ..scaled.clone()
+    };
+    let (_, r3) = initial_control_mesh(&t, None, N, &capped).unwrap();
+    assert_eq!(r3.open_cloud_control_points, Some(300));
+
+    let sphere = Shape::Ellipsoid {
+        a: 1.0,
+        b: 1.0,
+        c: 1.0,
+    };
+    let closed = target(&sphere.sample(8000, 0.0, 5).positions);
+    let (c, r) = initial_control_mesh(&closed, None, N, &scaled).unwrap();
+    assert_eq!(r.open_cloud_control_points, None);
+    assert!(c.num_vertices() <= N + N / 10, "{}", c.num_vertices());
+}

@@ -104,6 +104,10 @@ pub struct InitSummary {
     pub file: Option<String>,
     /// Control points asked of the automatic initial mesh.
     pub requested_control_points: Option<usize>,
+    /// A point cloud found open (a single-view scan): the default start was scaled by
+    /// `subfit_init::OPEN_CLOUD_SCALE` to this many control points. `None` otherwise.
+    #[serde(default)]
+    pub open_cloud_control_points: Option<usize>,
     /// The fraction of `--max-control-points` the automatic start took: a quad scheme whose
     /// default start exceeds the budget starts below it ([`crate::BUDGET_STARTS`]). `None`
     /// otherwise.

@@ -375,6 +375,7 @@ pub(crate) fn fit_scan_from(
                 source: "File".into(),
                 file: Some(cname.clone()),
                 requested_control_points: None,
+                open_cloud_control_points: None,
                 budget_start: None,
                 control_points: c.num_vertices(),
                 faces: normalized.faces.len(),
@@ -417,6 +418,11 @@ pub(crate) fn fit_scan_from(
                 }
             };
             let dense = (!mesh.faces.is_empty()).then_some(&mesh);
+            // The default start of a cloud found open is larger (subfit_init::OPEN_CLOUD_SCALE);
+            // a count asked for, or a start the budget set, is kept.
+            if options.control_points.is_none() && budget_start.is_none() {
+                init_options.open_cloud_scale = subfit_init::OPEN_CLOUD_SCALE;
+            }
             // Concave corners may add points within the budget, not to a count asked for.
             init_options.max_control_points = if options.control_points.is_some() {
                 n
@@ -891,6 +897,7 @@ fn init_summary(
         source: format!("{:?}", r.source),
         file: None,
         requested_control_points: Some(requested),
+        open_cloud_control_points: r.open_cloud_control_points,
         budget_start: None,
         control_points: m.num_vertices(),
         faces: m.faces.len(),
