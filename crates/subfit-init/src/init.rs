@@ -137,7 +137,8 @@ impl Default for InitOptions {
 /// six views of the bunny (by 16–33 %), on the fertility view (4.0e-4 → 2.1e-4) and on four of
 /// five views of the armadillo (1.45e-3 → 9.4e-4, 1.05e-3 → 7.8e-4, 8.6e-4 → 7.9e-4,
 /// 2.13e-3 → 1.40e-3; the fifth 1.04e-3 → 1.16e-3). 3 was better still on the bunny but
-/// not on the armadillo's views.
+/// not on the armadillo's views. `fit_scan` does not scale a cloud whose noise is half the
+/// scan's RMS tolerance or more (the extra points would fit the noise).
 pub const OPEN_CLOUD_SCALE: f64 = 2.0;
 
 /// The default control-vertex count for a target of `target_points` points:
