@@ -520,3 +520,43 @@ fn an_open_cloud_starts_from_more_points_when_asked() {
     assert_eq!(r.open_cloud_control_points, None);
     assert!(c.num_vertices() <= N + N / 10, "{}", c.num_vertices());
 }
+
+/// A piece of a few points apart from the rest (a claw seen through a gap) is an island of the
+/// cage when it has at least `MIN_ISLAND_POINTS` (4) points: its points are far from every
+/// other part of the surface. (With the rule at 8 points this piece of 5 was dropped.)
+/// The piece's points lie on a square of this many point spacings, at this height above the
+/// dome's base (the pole is at 1).
+const PIECE_SCALE: f64 = 1.0;
+const PIECE_Z: f64 = 1.3;
+
+#[test]
+fn a_small_separate_piece_of_a_scan_is_kept() {
+    let mut points = hemisphere(6000, 1);
+    let spacing = target(&points).stats().point_spacing;
+    // Five points on a small flat patch 0.3 above the pole (many spacings from the dome).
+    let piece: Vec<[f64; 3]> = [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0), (0.5, 0.5)]
+        .iter()
+        .map(|&(u, v)| {
+            [
+                PIECE_SCALE * spacing * u,
+                PIECE_SCALE * spacing * v,
+                PIECE_Z,
+            ]
+        })
+        .collect();
+    points.extend(&piece);
+    let t = target(&points);
+    let (cage, rep) = initial_control_mesh(&t, None, N, &InitOptions::default()).unwrap();
+    assert!(rep.cloud_open(), "{rep:?}");
+    let (_, _, components) = topology(&cage);
+    assert_eq!(components, 2, "{rep:?}");
+    let near = cage
+        .positions
+        .iter()
+        .map(|&p| {
+            let q = t.to_normalized([0.0, 0.0, PIECE_Z]);
+            subfit_mesh::vec3::dist2(p, q).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(near < 0.05, "nearest cage vertex to the piece: {near}");
+}
