@@ -198,7 +198,12 @@ fn bad_inputs_exit_with_2_and_leave_no_file() {
     expect_bad(
         p,
         &[&mobius, "--control-points", "4"],
-        &["mobius.obj", "inconsistent orientation", "--from-points"],
+        &[
+            "mobius.obj",
+            "faces 0 and 7",
+            "inconsistent orientation",
+            "--from-points",
+        ],
     );
 
     // A torus (genus 1) needs at least 7 vertices.

@@ -408,9 +408,21 @@ pub fn initial_control_mesh(
         }
     };
     let n_vertices = report.open_cloud_control_points.unwrap_or(n_vertices);
-    let before = HalfEdgeMesh::from_mesh(&dense).map_err(|e| match report.source {
-        InitSource::Mesh => InitError::InvalidMesh(e),
-        InitSource::Contour => InitError::Topology(e),
+    let before = HalfEdgeMesh::from_mesh(&dense).map_err(|e| match (report.source, mesh) {
+        // The error names faces of the fan-triangulated copy: name the input's polygons.
+        (InitSource::Mesh, Some(m)) => {
+            let polygon: Vec<u32> = m
+                .faces
+                .iter()
+                .enumerate()
+                .flat_map(|(f, p)| std::iter::repeat_n(f as u32, p.len().saturating_sub(2)))
+                .collect();
+            InitError::InvalidMesh(e.map_faces(|t| {
+                subfit_mesh::FaceId(polygon.get(t.0 as usize).copied().unwrap_or(t.0))
+            }))
+        }
+        (InitSource::Mesh, None) => InitError::InvalidMesh(e),
+        (InitSource::Contour, _) => InitError::Topology(e),
     })?;
     report.genus_before = before.genus();
     report.genus_target = match (report.source, options.expected_genus) {

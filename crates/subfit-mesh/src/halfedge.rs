@@ -101,6 +101,52 @@ pub enum TopologyError {
     },
 }
 
+impl TopologyError {
+    /// The error with every face id `f` it names replaced by `id(f)` (e.g. the polygon a
+    /// triangle of a triangulated copy came from).
+    pub fn map_faces(self, id: impl Fn(FaceId) -> FaceId) -> Self {
+        match self {
+            Self::TooFewVertices { face, len } => Self::TooFewVertices {
+                face: id(face),
+                len,
+            },
+            Self::RepeatedVertex { face, vertex } => Self::RepeatedVertex {
+                face: id(face),
+                vertex,
+            },
+            Self::VertexOutOfRange {
+                face,
+                vertex,
+                num_vertices,
+            } => Self::VertexOutOfRange {
+                face: id(face),
+                vertex,
+                num_vertices,
+            },
+            Self::NonManifoldEdge {
+                a,
+                b,
+                count,
+                f0,
+                f1,
+            } => Self::NonManifoldEdge {
+                a,
+                b,
+                count,
+                f0: id(f0),
+                f1: id(f1),
+            },
+            Self::InconsistentOrientation { a, b, f0, f1 } => Self::InconsistentOrientation {
+                a,
+                b,
+                f0: id(f0),
+                f1: id(f1),
+            },
+            e @ (Self::NonManifoldVertex { .. } | Self::TooLarge { .. }) => e,
+        }
+    }
+}
+
 /// Half-edge connectivity of a manifold, consistently oriented polygon mesh.
 ///
 /// All arrays are flat: `#H` half-edges (the total number of face corners), `#E` undirected edges,
