@@ -45,37 +45,32 @@ pub fn repair_mesh(
         warn(format!(
             "welded {} vertices of {name} at the same position as another (a mesh split along seams){}",
             w.vertices_merged,
-            if w.faces_dropped > 0 {
-                format!("; {} faces that collapsed were dropped", w.faces_dropped)
-            } else {
-                String::new()
-            }
+            clause("; ", w.faces_dropped, "faces that collapsed were dropped")
         ));
     }
     let c = clean_faces(mesh);
     if c.changed() {
-        let mut what = Vec::new();
-        for (n, kind) in [
-            (
+        let what = [
+            clause(
+                "",
                 c.degenerate_dropped,
                 "dropped with fewer than three distinct vertices",
             ),
-            (
+            clause(
+                ", ",
                 c.faces_shortened,
                 "listing a vertex twice in a row, listed once",
             ),
-            (
+            clause(
+                ", ",
                 c.duplicates_dropped,
                 "dropped as duplicates of an earlier face",
             ),
-        ] {
-            if n > 0 {
-                what.push(format!("{n} {kind}"));
-            }
-        }
+        ]
+        .concat();
         warn(format!(
             "repaired faces of {name}: {} (e.g. face {})",
-            what.join(", "),
+            what.trim_start_matches(", "),
             c.examples[0]
         ));
     }
@@ -85,24 +80,9 @@ pub fn repair_mesh(
         warn(format!(
             "cut {} edges of {name} shared by more than two faces (e.g. {a}-{b}) into pairs of faces that continue each other{}{}{}",
             e.edges_cut,
-            if e.vertices_added > 0 {
-                format!(", {} vertices copied", e.vertices_added)
-            } else {
-                String::new()
-            },
-            if e.flap_faces_dropped > 0 {
-                format!(
-                    ", {} faces of flaps that came off dropped",
-                    e.flap_faces_dropped
-                )
-            } else {
-                String::new()
-            },
-            if e.faces_dropped > 0 {
-                format!(", {} faces the cut could not separate dropped", e.faces_dropped)
-            } else {
-                String::new()
-            }
+            clause(", ", e.vertices_added, "vertices copied"),
+            clause(", ", e.flap_faces_dropped, "faces of flaps that came off dropped"),
+            clause(", ", e.faces_dropped, "faces the cut could not separate dropped")
         ));
     }
     let b = split_bowties(mesh);
@@ -125,6 +105,15 @@ pub fn repair_mesh(
         faces_flipped: r.flipped_faces,
         components_changed: r.repaired_components,
     }))
+}
+
+/// `"{sep}{n} {what}"` when `n > 0`, else nothing: an optional part of a warning.
+fn clause(sep: &str, n: usize, what: &str) -> String {
+    if n > 0 {
+        format!("{sep}{n} {what}")
+    } else {
+        String::new()
+    }
 }
 
 /// Reads `input` (a file, or takes the mesh given) and repairs it ([`repair_mesh`]) unless its
