@@ -262,29 +262,16 @@ fn pair_up(
     EdgeGroups { order, starts }
 }
 
-/// Unit normal of every face by Newell's method (zero for a face without area or out of range).
+/// Unit normal of every face by Newell's method (zero for a face without area or with an id
+/// out of range).
 fn face_normals(faces: &Polygons, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
     faces
         .iter()
         .map(|f| {
-            let mut n = [0.0; 3];
-            for i in 0..f.len() {
-                let (Some(p), Some(q)) = (
-                    positions.get(f[i] as usize),
-                    positions.get(f[(i + 1) % f.len()] as usize),
-                ) else {
-                    return [0.0; 3];
-                };
-                n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-                n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-                n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+            if f.iter().any(|&v| v as usize >= positions.len()) {
+                return [0.0; 3];
             }
-            let l = crate::vec3::norm(n);
-            if l > 0.0 {
-                [n[0] / l, n[1] / l, n[2] / l]
-            } else {
-                [0.0; 3]
-            }
+            crate::vec3::normalize(crate::vec3::polygon_normal(positions, f)).unwrap_or([0.0; 3])
         })
         .collect()
 }

@@ -60,6 +60,25 @@ pub fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
     norm2(sub(a, b))
 }
 
+/// The Newell normal of the polygon `face` over `positions`: twice its vector area, not
+/// normalized (Newell's method, exact for planar polygons and the best-fit direction for
+/// others); zero when it is not finite. Every id must be in range.
+pub fn polygon_normal(positions: &[[f64; 3]], face: &[u32]) -> [f64; 3] {
+    let mut n = [0.0; 3];
+    for (i, &a) in face.iter().enumerate() {
+        let p = positions[a as usize];
+        let q = positions[face[(i + 1) % face.len()] as usize];
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    if n.iter().all(|x| x.is_finite()) {
+        n
+    } else {
+        [0.0; 3]
+    }
+}
+
 /// The unit vector `a · (1 / |a|)`, or `None` when `|a|` is zero or not finite (a zero, huge or
 /// NaN vector).
 #[inline]

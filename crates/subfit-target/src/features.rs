@@ -287,23 +287,6 @@ fn cos_between(a: [f64; 3], b: [f64; 3]) -> Option<f64> {
     (l > 0.0 && l.is_finite()).then(|| (dot(a, b) / l).clamp(-1.0, 1.0))
 }
 
-/// Newell normal of a polygon (not normalized); zero for degenerate or non-finite faces.
-fn face_normal(positions: &[[f64; 3]], face: &[u32]) -> [f64; 3] {
-    let mut n = [0.0; 3];
-    for (i, &a) in face.iter().enumerate() {
-        let p = positions[a as usize];
-        let q = positions[face[(i + 1) % face.len()] as usize];
-        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-    }
-    if n.iter().all(|x| x.is_finite()) {
-        n
-    } else {
-        [0.0; 3]
-    }
-}
-
 /// The interior manifold edges (exactly two faces) with their dihedral angles, sorted by
 /// endpoints. An edge both faces traverse the same way (inconsistent orientation) compares
 /// one normal with the other's opposite.
@@ -313,7 +296,7 @@ fn interior_edges(positions: &[[f64; 3]], faces: &Polygons) -> Vec<EdgeInfo> {
         .iter()
         .map(|f| {
             if f.len() >= 3 && f.iter().all(|&v| v < nv) {
-                face_normal(positions, f)
+                subfit_mesh::vec3::polygon_normal(positions, f)
             } else {
                 [0.0; 3]
             }

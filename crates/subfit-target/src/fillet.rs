@@ -189,17 +189,7 @@ impl Context<'_> {
 
 /// The unit Newell normal of a polygon (zero for a degenerate one).
 fn newell(positions: &[[f64; 3]], face: &[u32]) -> [f64; 3] {
-    let mut n = [0.0; 3];
-    for i in 0..face.len() {
-        let c = cross(
-            positions[face[i] as usize],
-            positions[face[(i + 1) % face.len()] as usize],
-        );
-        for k in 0..3 {
-            n[k] += c[k];
-        }
-    }
-    normalize(n).unwrap_or([0.0; 3])
+    normalize(subfit_mesh::vec3::polygon_normal(positions, face)).unwrap_or([0.0; 3])
 }
 
 /// The angle between unit vectors (radians).
