@@ -30,6 +30,7 @@ use crate::quads::{pair_triangles, PairOptions, PairReport};
 use crate::simplify::{
     simplify_with_features, FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport,
 };
+use crate::specks::Speck;
 use crate::trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};
 
 /// Options of [`initial_control_mesh`].
@@ -252,6 +253,9 @@ pub struct InitReport {
     /// vertices contoured and simplified for instead of the requested count. `None`
     /// otherwise.
     pub open_cloud_control_points: Option<usize>,
+    /// Specks added to an open clean cloud's cage for lone returns no piece of its trimmed
+    /// surface reaches ([`crate::specks`]), within [`InitOptions::max_control_points`].
+    pub specks: usize,
 }
 
 /// How many sharp features of each kind a mesh target has ([`InitReport::features`]).
@@ -394,6 +398,7 @@ pub fn initial_control_mesh(
         return Err(InitError::TooFewVertices(n_vertices));
     }
     let mut report = InitReport::default();
+    let mut specks = Vec::new();
     let mut dense = match mesh {
         Some(m) if !m.faces.is_empty() => {
             report.source = InitSource::Mesh;
@@ -402,7 +407,8 @@ pub fn initial_control_mesh(
         _ => {
             report.source = InitSource::Contour;
             let t = Instant::now();
-            let m = cloud_surface(target, n_vertices, options, &mut report)?;
+            let (m, found) = cloud_surface(target, n_vertices, options, &mut report)?;
+            specks = found;
             report.timings.contour = t.elapsed();
             m
         }
@@ -486,6 +492,14 @@ pub fn initial_control_mesh(
             .saturating_sub(out.num_vertices());
         report.concave = split_concave_corners(&mut out, &mut tags, room);
     }
+    // Specks within the budget only.
+    let room = options
+        .max_control_points
+        .saturating_sub(out.num_vertices())
+        / crate::specks::SPECK_VERTICES;
+    specks.truncate(room);
+    crate::specks::push_specks(&mut out, &specks);
+    report.specks = specks.len();
     report.timings.simplify = t.elapsed();
     report.simplify = srep;
     report.tags = tags;
@@ -501,7 +515,7 @@ pub fn initial_control_mesh(
     let after = HalfEdgeMesh::from_mesh(&out)?;
     report.genus_after = after.genus();
     let loops_after = after.boundary_loops().len();
-    report.boundary_loops = (loops_before, loops_after);
+    report.boundary_loops = (loops_before + report.specks, loops_after);
     report.closed = loops_after == 0;
     report.components = after.components().count;
     report.genus_matches = report.genus_after == report.genus_target;
@@ -549,7 +563,7 @@ fn cloud_surface(
     n_vertices: usize,
     options: &InitOptions,
     report: &mut InitReport,
-) -> Result<PolyMesh, InitError> {
+) -> Result<(PolyMesh, Vec<Speck>), InitError> {
     let (m, mut c) = contour_for(target, n_vertices, options)?;
     options.cancel.check()?;
     let band =
@@ -576,15 +590,20 @@ fn cloud_surface(
         if let Some((cm, cc, r)) = carve_for(target, &c, g, &options.cancel)? {
             report.carve_radius = Some(r);
             report.contour = Some(cc);
-            return Ok(cm);
+            return Ok((cm, Vec::new()));
         }
     }
+    let mut specks = Vec::new();
     if tr.open {
+        if !target.stats().is_noisy() {
+            let gap = crate::islands::island_gap(target, band(&c));
+            specks = crate::specks::find_specks(target, &m, gap);
+        }
         report.boundary_curves = boundary_polylines(&m)?;
     }
     report.trim = Some(tr);
     report.contour = Some(c);
-    Ok(m)
+    Ok((m, specks))
 }
 
 /// The contour of the target's points, re-contoured once at a finer resolution when it has fewer

@@ -38,6 +38,7 @@ pub mod quads;
 pub mod semi_sharp;
 pub mod simplify;
 pub mod snap;
+pub mod specks;
 pub mod trim;
 
 pub use carve::carve;

@@ -367,7 +367,12 @@ fn real_single_view_scan_is_open_and_closed_model_is_closed() {
     let trim = rep.trim.clone().unwrap();
     let (_, loops, _) = topology(&cage);
     assert!(rep.cloud_open() && loops >= 1, "bun000: {trim:?}");
-    assert_eq!(rep.boundary_loops, (trim.boundary_loops, loops), "bun000");
+    // A speck (subfit_init::specks) adds a loop of its own.
+    assert_eq!(
+        rep.boundary_loops,
+        (trim.boundary_loops + rep.specks, loops),
+        "bun000"
+    );
     assert_eq!(rep.boundary_curves.len(), trim.boundary_loops);
     // The front sheet only: well under the closed contour's faces (front + back).
     assert!(
@@ -559,4 +564,37 @@ fn a_small_separate_piece_of_a_scan_is_kept() {
         })
         .fold(f64::INFINITY, f64::min);
     assert!(near < 0.05, "nearest cage vertex to the piece: {near}");
+}
+
+/// Two lone returns above the pole of a scanned dome (no other point within two spacings) get
+/// a speck: a seven-vertex component whose centre lies on them (`subfit_init::specks`).
+#[test]
+fn lone_returns_get_a_speck() {
+    let mut points = hemisphere(6000, 1);
+    let t = target(&points);
+    let d = t.stats().point_spacing;
+    // The spacing in the input's units.
+    let d = subfit_mesh::vec3::norm(subfit_mesh::vec3::sub(
+        t.to_original([d, 0.0, 0.0]),
+        t.to_original([0.0, 0.0, 0.0]),
+    ));
+    let lone = [[0.0, 0.0, 1.0 + 4.0 * d], [0.5 * d, 0.0, 1.0 + 4.0 * d]];
+    points.extend(lone);
+    let t = target(&points);
+    assert_eq!(
+        t.len(),
+        points.len(),
+        "the lone returns are data (outlier rule 5)"
+    );
+    let (cage, rep) = initial_control_mesh(&t, None, N, &InitOptions::default()).unwrap();
+    assert!(rep.cloud_open(), "{rep:?}");
+    assert_eq!(rep.specks, 1, "{rep:?}");
+    let (_, loops, components) = topology(&cage);
+    assert_eq!(components, 2, "{rep:?}");
+    assert_eq!(rep.boundary_loops, (loops, loops));
+    // The speck is the last seven vertices; its centre is the returns' centre.
+    let centre = t.to_original(cage.positions[cage.positions.len() - 7]);
+    let mid = [0.25 * d, 0.0, 1.0 + 4.0 * d];
+    let off = subfit_mesh::vec3::norm(subfit_mesh::vec3::sub(centre, mid));
+    assert!(off < 1e-9, "speck centre {centre:?}, returns at {mid:?}");
 }

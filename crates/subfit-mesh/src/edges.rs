@@ -148,7 +148,7 @@ pub(crate) fn corner_fans(faces: &Polygons, groups: &EdgeGroups, next: &[u32]) -
 
 /// Union-find over `0..n` with path halving and union by size. Each operation costs amortized
 /// `O(α(n))`.
-pub(crate) struct UnionFind {
+pub struct UnionFind {
     parent: Vec<u32>,
     size: Vec<u32>,
 }

@@ -35,6 +35,7 @@ pub use cancel::{Cancel, Cancelled};
 pub use components::{euler_characteristic, face_components, genus, Components};
 pub use concave::{split_concave_corners, ConcaveSplits, CONCAVE_ANGLE};
 pub use diagnose::{diagnose, diagnose_mesh, ComponentReport, IssueExamples, MeshReport};
+pub use edges::UnionFind;
 pub use halfedge::{HalfEdgeMesh, Outgoing, TopologyError};
 pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
 pub use nonmanifold::{clean_faces, cut_nonmanifold_edges, EdgeCutReport, FaceCleanReport};

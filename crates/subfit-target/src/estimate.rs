@@ -158,7 +158,7 @@ fn variation(lam: &[f64; 3]) -> f64 {
 }
 
 /// Centroid (relative), eigenvalues (ascending) and eigenvectors of the covariance of `rel`.
-pub(crate) fn pca(rel: &[[f64; 3]]) -> ([f64; 3], [f64; 3], [[f64; 3]; 3]) {
+pub fn pca(rel: &[[f64; 3]]) -> ([f64; 3], [f64; 3], [[f64; 3]; 3]) {
     let inv = 1.0 / rel.len() as f64;
     let mut c = [0.0; 3];
     for r in rel {

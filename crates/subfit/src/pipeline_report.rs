@@ -108,6 +108,11 @@ pub struct InitSummary {
     /// `subfit_init::OPEN_CLOUD_SCALE` to this many control points. `None` otherwise.
     #[serde(default)]
     pub open_cloud_control_points: Option<usize>,
+    /// Specks: small discs of seven control points added to an open clean cloud's cage for
+    /// clusters of lone returns that no piece of its trimmed surface reaches
+    /// (`subfit_init::specks`).
+    #[serde(default)]
+    pub specks: usize,
     /// The fraction of `--max-control-points` the automatic start took: a quad scheme whose
     /// default start exceeds the budget starts below it ([`crate::BUDGET_STARTS`]). `None`
     /// otherwise.

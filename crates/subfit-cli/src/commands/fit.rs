@@ -212,12 +212,16 @@ pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
         if i.paired { ", triangles paired" } else { "" },
         if i.cloud_open {
             format!(
-                "; open cloud: {} contour faces trimmed, {} boundary loop(s){}",
+                "; open cloud: {} contour faces trimmed, {} boundary loop(s){}{}",
                 i.contour_faces_trimmed,
                 i.boundary_loops.cage,
                 match (i.open_cloud_control_points, i.requested_control_points) {
                     (Some(o), Some(r)) => format!(", started from {o} control points, not {r}"),
                     _ => String::new(),
+                },
+                match i.specks {
+                    0 => String::new(),
+                    k => format!(", {k} speck(s) for lone returns no piece of the surface reaches"),
                 }
             )
         } else {

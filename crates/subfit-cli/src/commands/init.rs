@@ -255,6 +255,12 @@ fn print_summary(
             t.faces_trimmed, t.faces_before, t.support_distance, t.boundary_loops, t.genus
         );
     }
+    if r.specks > 0 {
+        out!(
+            "{} speck(s) (seven control points each) for lone returns no piece of the trimmed surface reaches",
+            r.specks
+        );
+    }
     let versus = if r.source == InitSource::Contour && input.is_none() && a.genus.is_none() {
         "target genus unknown (a point cloud: pass --genus G to check it)".to_owned()
     } else {
