@@ -28,6 +28,7 @@
 //! Cost: one nearest-vertex query per point, a triangle query and a radius query for the few
 //! beyond the gap.
 
+use rayon::prelude::*;
 use subfit_mesh::bvh::TriangleBvh;
 use subfit_mesh::vec3::{add, cross, norm, normalize, scale, sub};
 use subfit_mesh::{PolyMesh, UnionFind};
@@ -82,7 +83,7 @@ pub(crate) fn find_specks(target: &Target, surface: &PolyMesh, gap: f64) -> Vec<
     }
     let bvh = TriangleBvh::new(surface.positions.clone(), surface.faces.triangulate_fan());
     let uncovered: Vec<usize> = beyond
-        .into_iter()
+        .into_par_iter()
         .filter(|&i| bvh.closest(points[i]).is_some_and(|c| c.distance > gap))
         .collect();
     if uncovered.is_empty() {
