@@ -279,3 +279,38 @@ fn stray_repeated_and_collapsed_faces_are_repaired_with_a_warning() {
     assert_eq!(report["target_topology"]["boundary_loops"], 0, "{report}");
     assert_eq!(report["init"]["boundary_loops"]["cage"], 0, "{report}");
 }
+
+/// A torus with two vertices no face uses, one far outside it: they are dropped with a
+/// warning, so the diagonal the tolerances are relative to is the torus's own.
+#[test]
+fn vertices_no_face_uses_are_dropped_with_a_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let t = torus_mesh(1.0, 0.4, 48, 24, true);
+    let clean = d.path().join("clean.obj");
+    write_obj(&clean, &t);
+    let mut littered = t.clone();
+    littered.positions.insert(5, [0.5, 0.0, 0.0]);
+    littered.positions.push([30.0, 30.0, 30.0]);
+    for v in littered.faces.indices_mut() {
+        if *v >= 5 {
+            *v += 1;
+        }
+    }
+    let path = d.path().join("unreferenced.obj");
+    write_obj(&path, &littered);
+    let m = path.to_str().unwrap();
+    let (err, report) = quick_fit(m, &d.path().join("fit"), "80");
+    let warning =
+        format!("subfit: warning: dropped 2 vertices of {m} that no face uses (e.g. vertex 5)");
+    assert!(err.contains(&warning), "{err}");
+    let (_, clean_report) = quick_fit(clean.to_str().unwrap(), &d.path().join("fit0"), "80");
+    assert_eq!(report["target_points"], clean_report["target_points"]);
+    assert_eq!(
+        report["bbox_diagonal_unit_cube"], clean_report["bbox_diagonal_unit_cube"],
+        "{report}"
+    );
+    assert_eq!(
+        report["normalized_unit_in_original_units"],
+        clean_report["normalized_unit_in_original_units"]
+    );
+}

@@ -245,6 +245,48 @@ impl PolyMesh {
     pub fn bounding_box(&self) -> Option<([f64; 3], [f64; 3])> {
         bounding_box(&self.positions)
     }
+
+    /// Removes the vertices no face uses (with their normals and colours) and renumbers the
+    /// faces; returns the removed vertices' former indices, ascending. A point cloud (no faces)
+    /// is left alone. Cost: O(#V + #corners).
+    pub fn remove_unreferenced(&mut self) -> Vec<u32> {
+        if self.faces.is_empty() {
+            return Vec::new();
+        }
+        let mut used = vec![false; self.positions.len()];
+        for &v in self.faces.indices() {
+            used[v as usize] = true;
+        }
+        let removed: Vec<u32> = (0..used.len() as u32)
+            .filter(|&v| !used[v as usize])
+            .collect();
+        if removed.is_empty() {
+            return removed;
+        }
+        let mut map = vec![u32::MAX; used.len()];
+        let mut next = 0u32;
+        for (v, &u) in used.iter().enumerate() {
+            if u {
+                map[v] = next;
+                next += 1;
+            }
+        }
+        fn keep<T: Copy>(values: &[T], used: &[bool]) -> Vec<T> {
+            values
+                .iter()
+                .zip(used)
+                .filter(|(_, &u)| u)
+                .map(|(&x, _)| x)
+                .collect()
+        }
+        self.positions = keep(&self.positions, &used);
+        self.normals = self.normals.as_deref().map(|n| keep(n, &used));
+        self.colors = self.colors.as_deref().map(|c| keep(c, &used));
+        for v in self.faces.indices_mut() {
+            *v = map[*v as usize];
+        }
+        removed
+    }
 }
 
 /// Axis-aligned bounding box `(min, max)` of a point set, or `None` when it is empty.
@@ -280,5 +322,31 @@ mod tests {
         assert_eq!(p, q);
         assert!(Polygons::from_raw(vec![0, 3, 2], vec![0, 1, 2]).is_none());
         assert!(Polygons::from_raw(vec![1], vec![]).is_none());
+    }
+
+    #[test]
+    fn unreferenced_vertices_are_removed_with_their_attributes() {
+        let mut m = PolyMesh::new(
+            vec![
+                [0.0; 3],
+                [9.0; 3],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [7.0; 3],
+            ],
+            Polygons::from_triangles(&[[0, 2, 3]]),
+        );
+        m.colors = Some(vec![[0; 3], [1; 3], [2; 3], [3; 3], [4; 3]]);
+        assert_eq!(m.remove_unreferenced(), vec![1, 4]);
+        assert_eq!(
+            m.positions,
+            vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        );
+        assert_eq!(m.colors, Some(vec![[0; 3], [2; 3], [3; 3]]));
+        assert_eq!(m.faces.face(FaceId(0)), &[0, 1, 2]);
+        assert!(m.remove_unreferenced().is_empty());
+        let mut cloud = PolyMesh::point_cloud(vec![[0.0; 3]; 3], None);
+        assert!(cloud.remove_unreferenced().is_empty());
+        assert_eq!(cloud.num_vertices(), 3);
     }
 }

@@ -1,5 +1,7 @@
 //! Reading a target and repairing what a user expects repaired, each repair with a warning:
 //!
+//! 0. vertices that no face uses are dropped: left in, they would widen the bounding box that
+//!    the tolerances and the reported fractions of the diagonal are relative to;
 //! 1. vertices at exactly the same position are welded ([`subfit_mesh::weld_coincident`]): a
 //!    mesh exported with its vertices split along texture seams is one surface, not one patch
 //!    per chart with a boundary along every seam;
@@ -34,6 +36,13 @@ pub fn repair_mesh(
 ) -> Result<Option<Reorientation>, ReorientError> {
     if mesh.faces.is_empty() {
         return Ok(None);
+    }
+    let unused = mesh.remove_unreferenced();
+    if let Some(v) = unused.first() {
+        warn(format!(
+            "dropped {} vertices of {name} that no face uses (e.g. vertex {v}): they are not part of the surface and would widen its bounding box",
+            unused.len()
+        ));
     }
     let w = weld_coincident(mesh);
     if w.refused {
