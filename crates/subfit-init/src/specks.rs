@@ -101,8 +101,7 @@ pub(crate) fn find_specks(target: &Target, surface: &PolyMesh, gap: f64) -> Vec<
     };
     let specks: Vec<Speck> = clusters(points, &uncovered, link)
         .iter()
-        .filter(|c| alone(c))
-        .filter_map(|c| speck(target, c, spacing))
+        .filter_map(|c| speck(target, c, spacing).filter(|_| alone(c)))
         .collect();
     if specks.len() > MAX_SPECKS {
         return Vec::new();
