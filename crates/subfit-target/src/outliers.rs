@@ -41,15 +41,18 @@
 //!    closed surface is never past an edge; around an open one, those beside its rim are
 //!    (`subfit analyze --json`, 900 points uniform in the box around 30k points of a clean
 //!    unit sphere: 817 removed before, 806 with the rule; of a hemisphere: 832, 801).
-//! 5. **A handful** (clean scans). When what rules 1–4 leave flagged is at most one point in
-//!    [`FEW_PER`] (2,000), those within [`LONE_REACH`] (8) × `D` of a kept neighbour are kept:
-//!    a clean scan flags that few where it sees small parts alone (a claw through a gap, a
-//!    toe's tip behind another), not where it is contaminated, whose stray returns come at a
-//!    rate. On five simulated views of the armadillo (issue 14) rules 1–4 dropped 0–4 points
-//!    each, all within 5e-4 of the diagonal of the true surface and 1.3–2.6 % from the rest of
-//!    the scan; the init's specks then cover them (`subfit_init::specks`, in the crate that
-//!    builds cages). Scattered outliers are many (900 around a 30k-point sphere) and keep
-//!    rules 1–4; a noisy scan never gets this rule.
+//! 5. **A handful past the edge** (clean scans). When what rules 1–4 leave flagged is at most
+//!    one point in [`FEW_PER`] (2,000), rule 4 runs again with the reach [`LONE_REACH`] (8 `D`):
+//!    a clean scan flags that few where it sees small parts alone past an occluding edge (a
+//!    claw through a gap, a toe's tip behind another), not where it is contaminated, whose
+//!    stray returns come at a rate. On six simulated views of the armadillo (issue 14) rules 1–4
+//!    dropped 0–4 points each, all within 5e-4 of the diagonal of the true surface and 1.3–2.6 %
+//!    from the rest of the scan; the init's specks then cover them (`subfit_init::specks`, in
+//!    the crate that builds cages). A point above the middle of a surface is not past an edge:
+//!    three stray points 4 `D` off a clean closed scan of the armadillo stay outliers (kept,
+//!    they made the closed cloud's contour open and the fit's maximum 3.5 % of the diagonal).
+//!    Scattered outliers are many (900 around a 30k-point sphere) and keep rules 1–4; a noisy
+//!    scan never gets this rule.
 //!
 //! **Noise level.** `σ = 1.4826 · median_i r_i` over the kept points: about the standard
 //! deviation of Gaussian noise along the normal (measured within 10 % on the noisy analytic
@@ -346,26 +349,11 @@ fn keep_returns_past_the_rim(points: &[[f64; 3]], rows: &[u32], outlier: &mut [b
 }
 
 /// Rule 5 of the module docs: on a clean scan, when at most one point in [`FEW_PER`] is still
-/// flagged, unflags those within `reach` of a kept neighbour (one of their [`OUTLIER_K`]
-/// nearest). Cost: O(k) per flagged point.
+/// flagged, rule 4 again with the longer `reach`.
 fn keep_a_handful(points: &[[f64; 3]], rows: &[u32], outlier: &mut [bool], reach: f64) {
-    let flagged: Vec<usize> = (0..outlier.len()).filter(|&i| outlier[i]).collect();
-    if flagged.is_empty() || flagged.len() * FEW_PER > outlier.len() {
-        return;
-    }
-    let k = OUTLIER_K;
-    let near: Vec<usize> = flagged
-        .into_iter()
-        .filter(|&i| {
-            rows[i * k..(i + 1) * k].iter().any(|&j| {
-                j != u32::MAX
-                    && !outlier[j as usize]
-                    && norm(sub(points[j as usize], points[i])) <= reach
-            })
-        })
-        .collect();
-    for i in near {
-        outlier[i] = false;
+    let flagged = outlier.iter().filter(|&&o| o).count();
+    if flagged > 0 && flagged * FEW_PER <= outlier.len() {
+        keep_returns_past_the_rim(points, rows, outlier, reach);
     }
 }
 
@@ -373,7 +361,7 @@ fn keep_a_handful(points: &[[f64; 3]], rows: &[u32], outlier: &mut [bool], reach
 const RIM_TRIES: usize = 4;
 /// Rule 4: reach past the edge, in units of the median `k`-th neighbour distance.
 const RIM_REACH: f64 = 4.0;
-/// Rule 5: the reach from a kept neighbour, in units of the median `k`-th neighbour distance.
+/// Rule 5: the reach past the edge, in units of the median `k`-th neighbour distance.
 const LONE_REACH: f64 = 8.0;
 /// Rule 5: one flagged point in this many is a handful.
 const FEW_PER: usize = 2000;
@@ -456,24 +444,27 @@ mod tests {
     }
 
     #[test]
-    fn a_handful_of_flagged_points_near_the_data_is_kept() {
+    fn a_handful_of_returns_farther_past_the_edge_is_kept() {
         let mut p = grid(60);
         let idx = PointIndex::new(&p).unwrap();
         let d = detect(&p, &idx, true, &Cancel::default()).unwrap().spacing;
-        // One return 3 D above the middle of 3,601 points: the only one flagged, near the
-        // data (a small part seen alone in front of the surface).
-        p.push([0.5, 0.5, 0.1 * 0.5 + 3.0 * d]);
+        // 6 D past the last column (beyond rule 4's reach, within rule 5's), 2 D below the
+        // surface's continuation (a part behind the edge): the only point flagged in 3,601.
+        let x = 59.0 / 60.0 + 6.0 * d;
+        let past = [x, 0.5, 0.1 * (x * x + 0.25) - 2.0 * d];
+        p.push(past);
         let idx = PointIndex::new(&p).unwrap();
         let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
         assert_eq!(s.count, 0, "{s:?}");
-        // Far from the data (more than LONE_REACH) it is dropped.
-        *p.last_mut().unwrap() = [0.5, 0.5, 0.1 * 0.5 + 1.2 * LONE_REACH * d];
+        // 3 D above the middle instead: not past an edge, dropped though alone.
+        *p.last_mut().unwrap() = [0.5, 0.5, 0.1 * 0.5 + 3.0 * d];
         let idx = PointIndex::new(&p).unwrap();
         let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
         assert_eq!(s.count, 1);
-        // Two near the data in 3,602 points are not a handful: both dropped.
-        *p.last_mut().unwrap() = [0.5, 0.5, 0.1 * 0.5 + 3.0 * d];
-        p.push([0.3, 0.6, 0.1 * 0.45 + 3.0 * d]);
+        // Two past opposite edges in 3,602 points are not a handful: both dropped.
+        *p.last_mut().unwrap() = past;
+        let x = -6.0 * d;
+        p.push([x, 0.5, 0.1 * (x * x + 0.25) - 2.0 * d]);
         let idx = PointIndex::new(&p).unwrap();
         let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
         assert_eq!(s.count, 2);
