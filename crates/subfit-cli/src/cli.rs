@@ -355,9 +355,10 @@ pub struct FitArgs {
     pub features: FeatureArgs,
     /// Point clouds: levels of adaptive refinement of the implicit surface's octree below its
     /// band level (0–4). 1 keeps thin parts (plates, tubes thinner than about the IMLS radius)
-    /// in one piece with their genus; the default 0 is better on clouds with small holes.
-    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u8).range(0..=4))]
-    pub contour_refine: u8,
+    /// in one piece with their genus; 0 is better on clouds with small holes. Default: 0, and
+    /// 1 for a one-sided cloud (a single view: trimming removes 40 % of the contour or more).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(0..=4))]
+    pub contour_refine: Option<u8>,
     /// Output directory (control.obj, control.usda, control.tags.json, limit.ply, error.ply,
     /// log.csv, preview.png, report.html, report.json).
     #[arg(short, long, default_value = "subfit-fit")]

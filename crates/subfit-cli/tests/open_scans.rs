@@ -120,13 +120,15 @@ fn open_meshes_keep_their_loops_and_are_covered_both_ways() {
 /// A single-view range scan of the bunny (400 × 400 pixels, noise 2e-4 of the diagonal, views
 /// of seeds 1 and 4) and one of the armadillo, fitted with the defaults: the cage is open, the scan's points are covered
 /// (RMS ≤ 1e-3, max ≤ 1 % of the scan's diagonal) and the surface lies on the true mesh (RMS
-/// ≤ 1e-3 of the scan's diagonal). Measured (release build) 4.3e-4 / 0.28 % / 4.4e-4 and
-/// 6.8e-4 / 0.89 % / 6.4e-4. Before the clean-scan outlier exemptions, the island gap and the
+/// ≤ 1e-3 of the scan's diagonal). Measured (release build) 5.1e-4 / 0.44 % / 4.7e-4 and
+/// 5.8e-4 / 0.43 % / 5.5e-4 (before the one-sided contour refinement, subfit-init
+/// `ONE_SIDED_REFINE`: 4.3e-4 / 0.28 % / 4.4e-4 and 6.8e-4 / 0.89 % / 6.4e-4). Before the clean-scan outlier exemptions, the island gap and the
 /// badness change: 1.06e-3 / 4.0 % and 1.36e-3 / 5.4 % (sparse rim returns dropped, a stall at
 /// the initial cage); before the past-the-edge rule, view 4 still missed its lone returns
 /// (2.2 %). Views 2, 3, 5 and 6 of the same scans: 0.51 %, 0.76 %, 0.65 %, 0.47 %.
 /// And the armadillo seen along +z (`hard_cases range-scan armadillo.obj OUT 400 2e-4 0,0,1`):
-/// 6.9e-4 / 0.55 % / 7.1e-4 with four specks; before them 4.7e-4 / 3.61 % / 1.13e-3.
+/// 6.7e-4 / 0.43 % / 6.3e-4 with specks and the one-sided refinement; 6.9e-4 / 0.55 % /
+/// 7.1e-4 with the specks alone; before both 4.7e-4 / 3.61 % / 1.13e-3.
 ///
 /// The fit's own default tolerance is stricter (two-sided, surface → scan included, where the
 /// surface spans the scan's occlusion gaps), so its exit code is 0 or 1.

@@ -45,7 +45,8 @@ pub use carve::carve;
 pub use contour::{contour, ContourError, ContourOptions, ContourReport, MAX_RESOLUTION};
 pub use init::{
     default_control_points, initial_control_mesh, min_vertices_for_topology, FeatureCounts,
-    InitError, InitOptions, InitReport, InitSource, InitTimings, OPEN_CLOUD_SCALE,
+    InitError, InitOptions, InitReport, InitSource, InitTimings, ONE_SIDED_REFINE, ONE_SIDED_TRIM,
+    OPEN_CLOUD_SCALE,
 };
 pub use quads::{coherency_score, pair_triangles, PairOptions, PairReport};
 pub use simplify::{

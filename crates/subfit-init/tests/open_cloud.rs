@@ -599,3 +599,36 @@ fn lone_returns_get_a_speck() {
     let off = subfit_mesh::vec3::norm(subfit_mesh::vec3::sub(centre, mid));
     assert!(off < 1e-9, "speck centre {centre:?}, returns at {mid:?}");
 }
+
+/// With `one_sided_refine`, a one-sided cloud (a dome: trimming removes at least a quarter of
+/// its closed contour, `ONE_SIDED_TRIM`) is contoured again finer; a sphere with a hole (trimming removes little) and
+/// a closed sphere are not.
+#[test]
+fn a_one_sided_cloud_is_contoured_finer_when_asked() {
+    let finer = InitOptions {
+        one_sided_refine: 1,
+        ..InitOptions::default()
+    };
+    let dome = target(&hemisphere(6000, 1));
+    let (_, plain) = initial_control_mesh(&dome, None, N, &InitOptions::default()).unwrap();
+    let (cage, r) = initial_control_mesh(&dome, None, N, &finer).unwrap();
+    let trim = plain.trim.clone().unwrap();
+    let removed = trim.faces_trimmed as f64 / trim.faces_before as f64;
+    assert!(removed >= subfit_init::ONE_SIDED_TRIM, "{trim:?}");
+    assert!(r.one_sided_refined && !plain.one_sided_refined, "{r:?}");
+    let (coarse, fine) = (plain.contour.unwrap(), r.contour.clone().unwrap());
+    assert_eq!(fine.resolution, 2 * coarse.resolution, "{fine:?}");
+    assert_eq!(topology(&cage), (0, 1, 1), "{r:?}");
+
+    let sphere = Shape::Ellipsoid {
+        a: 1.0,
+        b: 1.0,
+        c: 1.0,
+    };
+    let points = sphere.sample(8000, 0.0, 5).positions;
+    let holed: Vec<[f64; 3]> = points.iter().copied().filter(|p| p[2] < 0.8).collect();
+    let (_, r) = initial_control_mesh(&target(&holed), None, N, &finer).unwrap();
+    assert!(r.cloud_open() && !r.one_sided_refined, "{r:?}");
+    let (_, r) = initial_control_mesh(&target(&points), None, N, &finer).unwrap();
+    assert!(!r.cloud_open() && !r.one_sided_refined, "{r:?}");
+}

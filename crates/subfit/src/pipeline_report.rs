@@ -113,6 +113,10 @@ pub struct InitSummary {
     /// (`subfit_init::specks`).
     #[serde(default)]
     pub specks: usize,
+    /// A one-sided cloud (a single view) contoured again one level finer
+    /// (`subfit_init::InitOptions::one_sided_refine`).
+    #[serde(default)]
+    pub one_sided_refined: bool,
     /// The fraction of `--max-control-points` the automatic start took: a quad scheme whose
     /// default start exceeds the budget starts below it ([`crate::BUDGET_STARTS`]). `None`
     /// otherwise.

@@ -151,6 +151,7 @@ impl Default for FitScanOptions {
                     exact_error: EXACT_ERROR,
                     ..SimplifyOptions::default()
                 },
+                one_sided_refine: subfit_init::ONE_SIDED_REFINE,
                 ..InitOptions::default()
             },
             error_scale: None,
@@ -377,6 +378,7 @@ pub(crate) fn fit_scan_from(
                 requested_control_points: None,
                 open_cloud_control_points: None,
                 specks: 0,
+                one_sided_refined: false,
                 budget_start: None,
                 control_points: c.num_vertices(),
                 faces: normalized.faces.len(),
@@ -907,6 +909,7 @@ fn init_summary(
         requested_control_points: Some(requested),
         open_cloud_control_points: r.open_cloud_control_points,
         specks: r.specks,
+        one_sided_refined: r.one_sided_refined,
         budget_start: None,
         control_points: m.num_vertices(),
         faces: m.faces.len(),

@@ -114,9 +114,14 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             semi_sharp: a.features.semi_sharp,
             cloud_features: a.features.cloud_features,
             contour: subfit::init::ContourOptions {
-                refine_levels: usize::from(a.contour_refine),
+                refine_levels: a.contour_refine.map_or(0, usize::from),
                 ..subfit::init::ContourOptions::default()
             },
+            // A level given is the level used, one-sided or not.
+            one_sided_refine: a.contour_refine.map_or(
+                FitScanOptions::default().init_options.one_sided_refine,
+                usize::from,
+            ),
             ..FitScanOptions::default().init_options
         },
         target_tolerances: a.tolerance.is_none()
@@ -212,8 +217,13 @@ pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
         if i.paired { ", triangles paired" } else { "" },
         if i.cloud_open {
             format!(
-                "; open cloud: {} contour faces trimmed, {} boundary loop(s){}{}",
+                "; open cloud: {} contour faces trimmed{}, {} boundary loop(s){}{}",
                 i.contour_faces_trimmed,
+                if i.one_sided_refined {
+                    " (one-sided: contoured finer)"
+                } else {
+                    ""
+                },
                 i.boundary_loops.cage,
                 match (i.open_cloud_control_points, i.requested_control_points) {
                     (Some(o), Some(r)) => format!(", started from {o} control points, not {r}"),
