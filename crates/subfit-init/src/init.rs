@@ -98,8 +98,9 @@ pub struct InitOptions {
     /// 7.7e-4). Default 1 (off); `subfit fit` uses [`OPEN_CLOUD_SCALE`] for its default start.
     pub open_cloud_scale: f64,
     /// Point clouds found one-sided (trimming removed at least [`ONE_SIDED_TRIM`] of the
-    /// contour's faces: a single view, whose contour closes behind the data): contour again with at least this
-    /// many levels of refinement ([`ContourOptions::refine_levels`]), kept when still open;
+    /// contour's faces: a single view, whose contour closes behind the data): contour again
+    /// with at least this many levels of refinement ([`ContourOptions::refine_levels`]), kept
+    /// when still open;
     /// [`InitReport::one_sided_refined`] says so. On simulated single-view scans the band level
     /// alone blends surfaces that meet at grazing angles (the side and the sole of the
     /// armadillo's foot seen along −z: the fitted surface stayed 2 % of the diagonal from 25

@@ -408,17 +408,21 @@ mod tests {
             .collect()
     }
 
+    /// [`detect`] with removal on `p`.
+    fn scan(p: &[[f64; 3]]) -> OutlierScan {
+        let idx = PointIndex::new(p).unwrap();
+        detect(p, &idx, true, &Cancel::default()).unwrap()
+    }
+
     #[test]
     fn clean_grid_keeps_everything_and_a_far_point_goes() {
         let mut p = grid(60);
-        let idx = PointIndex::new(&p).unwrap();
-        let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
+        let s = scan(&p);
         assert_eq!(s.count, 0);
         assert!(s.noise < 0.01 * s.spacing, "{s:?}");
         p.push([0.5, 0.5, 0.6]);
         p.push([0.3, 0.7, 0.12]);
-        let idx = PointIndex::new(&p).unwrap();
-        let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
+        let s = scan(&p);
         assert_eq!(s.count, 2);
         assert!(s.outlier[p.len() - 1] && s.outlier[p.len() - 2]);
     }
@@ -426,8 +430,7 @@ mod tests {
     #[test]
     fn a_lone_return_past_the_edge_is_kept_and_one_above_the_middle_is_not() {
         let mut p = grid(60);
-        let idx = PointIndex::new(&p).unwrap();
-        let d = detect(&p, &idx, true, &Cancel::default()).unwrap().spacing;
+        let d = scan(&p).spacing;
         // Past the last column (x = 59/60) by 3.5 D, a D below the surface's continuation:
         // the surface turning away, as near a range scan's silhouette.
         let x = 59.0 / 60.0 + 3.5 * d;
@@ -436,8 +439,7 @@ mod tests {
         // 3,602 points are more than a handful, rule 5).
         p.push([0.5, 0.5, 0.1 * 0.5 + d]);
         p.push([0.3, 0.6, 0.1 * 0.45 + d]);
-        let idx = PointIndex::new(&p).unwrap();
-        let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
+        let s = scan(&p);
         assert!(!s.outlier[p.len() - 3], "{s:?}");
         assert!(s.outlier[p.len() - 2] && s.outlier[p.len() - 1]);
         assert_eq!(s.count, 2);
@@ -446,27 +448,23 @@ mod tests {
     #[test]
     fn a_handful_of_returns_farther_past_the_edge_is_kept() {
         let mut p = grid(60);
-        let idx = PointIndex::new(&p).unwrap();
-        let d = detect(&p, &idx, true, &Cancel::default()).unwrap().spacing;
+        let d = scan(&p).spacing;
         // 6 D past the last column (beyond rule 4's reach, within rule 5's), 2 D below the
         // surface's continuation (a part behind the edge): the only point flagged in 3,601.
         let x = 59.0 / 60.0 + 6.0 * d;
         let past = [x, 0.5, 0.1 * (x * x + 0.25) - 2.0 * d];
         p.push(past);
-        let idx = PointIndex::new(&p).unwrap();
-        let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
+        let s = scan(&p);
         assert_eq!(s.count, 0, "{s:?}");
         // 3 D above the middle instead: not past an edge, dropped though alone.
         *p.last_mut().unwrap() = [0.5, 0.5, 0.1 * 0.5 + 3.0 * d];
-        let idx = PointIndex::new(&p).unwrap();
-        let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
+        let s = scan(&p);
         assert_eq!(s.count, 1);
         // Two past opposite edges in 3,602 points are not a handful: both dropped.
         *p.last_mut().unwrap() = past;
         let x = -6.0 * d;
         p.push([x, 0.5, 0.1 * (x * x + 0.25) - 2.0 * d]);
-        let idx = PointIndex::new(&p).unwrap();
-        let s = detect(&p, &idx, true, &Cancel::default()).unwrap();
+        let s = scan(&p);
         assert_eq!(s.count, 2);
     }
 
