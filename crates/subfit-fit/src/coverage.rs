@@ -377,6 +377,18 @@ impl Coverage {
         dot(sub(xs[k], c), sub(p, xs[k])) > 0.0
     }
 
+    /// The direction along the rim at the boundary sample `k` towards `p`: to the boundary
+    /// neighbour of `k` most nearly in line with `p − x_k` (at a corner sample, the edge `p`
+    /// lies along). `None` when `k` has no boundary neighbour.
+    fn rim_tangent(&self, xs: &[[f64; 3]], k: usize, p: [f64; 3]) -> Option<[f64; 3]> {
+        let d = sub(p, xs[k]);
+        self.rings[k]
+            .iter()
+            .filter(|&&w| self.sample_boundary[w as usize])
+            .filter_map(|&w| normalize(sub(xs[w as usize], xs[k])))
+            .max_by(|a, b| dot(*a, d).abs().total_cmp(&dot(*b, d).abs()))
+    }
+
     /// The data points' quadratics summed per sample for the samples `xs` (all rows of the
     /// prepared tessellation, in order). `None` where no data point is assigned; all `None`
     /// when `xs` does not match the tessellation. Weighted so that the objective's mean over
@@ -434,6 +446,13 @@ impl Coverage {
             if gate <= 0.0 {
                 continue;
             }
+            // A data boundary point not beyond the surface's rim pulls its rim sample across
+            // the rim only: along it the pull is one-sided where the rim ends (at a corner of
+            // a coarse cage the samples within half a sample spacing of it pulled the corner
+            // inward, uncovering the data's corner).
+            let along = (self.boundary[j] && self.sample_boundary[k as usize] && !past_rim)
+                .then(|| self.rim_tangent(xs, k as usize, self.points[j]))
+                .flatten();
             let sum =
                 out[k as usize].get_or_insert_with(|| Box::new(CoverSum::new(xs[k as usize])));
             let plane = if self.noisy {
@@ -441,7 +460,10 @@ impl Coverage {
             } else {
                 n
             };
-            sum.add(self.points[j], (!point_to_point).then_some(plane), w * gate);
+            match along {
+                Some(t) => sum.add_across(self.points[j], t, w * gate),
+                None => sum.add(self.points[j], (!point_to_point).then_some(plane), w * gate),
+            }
         }
         self.assign_features(xs, spacing, &mut out);
         out
