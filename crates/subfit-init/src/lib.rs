@@ -27,6 +27,7 @@
 
 pub mod carve;
 pub mod contour;
+pub mod curvature_lines;
 mod denoise;
 mod heap;
 pub mod hexagons;

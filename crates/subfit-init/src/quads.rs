@@ -417,7 +417,11 @@ pub fn coherency_score(target: &Target, p: [f64; 3], q: [f64; 3], samples: usize
 /// Angles (degrees, `[0, 90]`) between the segment direction `d` (length `len`) projected
 /// into the tangent plane and the lines of `t1`, `t2`; `(45, 45)` where the frame is isotropic
 /// at the scale `len` or the segment is along the normal.
-fn direction_angles(d: [f64; 3], len: f64, f: &subfit_target::SurfaceFrame) -> (f64, f64) {
+pub(crate) fn direction_angles(
+    d: [f64; 3],
+    len: f64,
+    f: &subfit_target::SurfaceFrame,
+) -> (f64, f64) {
     let spread = (f.k2 - f.k1).abs();
     if !(spread * len > FLAT_TURN && spread > UMBILIC_RATIO * (f.k1.abs() + f.k2.abs())) {
         return (45.0, 45.0);

@@ -1,0 +1,178 @@
+//! The curvature-line initial cage (Lavoué et al. 2007 §4) on open patches of our own making:
+//! the cage has the target's topology, its vertices are the boundary curves' control points,
+//! corners of the boundary are tagged, cuts follow the lines of curvature, and targets it
+//! cannot handle are refused with the reason.
+
+use subfit_init::curvature_lines::{curvature_line_cage, CurvatureLineError, CurvatureLineOptions};
+use subfit_mesh::vec3::{dot, norm, sub};
+use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons};
+use subfit_target::{Target, TargetOptions};
+
+/// A `nu × nv` grid of `at(u, v)` over `[0, 1]²`, triangulated.
+fn grid(nu: usize, nv: usize, at: impl Fn(f64, f64) -> [f64; 3]) -> PolyMesh {
+    let mut p = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            p.push(at(i as f64 / (nu - 1) as f64, j as f64 / (nv - 1) as f64));
+        }
+    }
+    let id = |i: usize, j: usize| (j * nu + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..nv - 1 {
+        for i in 0..nu - 1 {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    PolyMesh::new(p, Polygons::from_triangles(&tris))
+}
+
+/// The target and its mesh in normalized units.
+fn prepared(m: &PolyMesh) -> (Target, PolyMesh) {
+    let t = Target::from_mesh(m, &TargetOptions::default()).expect("a valid patch");
+    let dense = PolyMesh::new(
+        m.positions.iter().map(|&p| t.to_normalized(p)).collect(),
+        m.faces.clone(),
+    );
+    (t, dense)
+}
+
+fn half_cylinder() -> PolyMesh {
+    grid(40, 40, |u, v| {
+        let a = std::f64::consts::PI * u;
+        [0.5 * a.cos(), 0.5 * a.sin(), v]
+    })
+}
+
+#[test]
+fn a_half_cylinder_is_cut_along_its_rulings() {
+    let (t, dense) = prepared(&half_cylinder());
+    let (cage, tags, r) = curvature_line_cage(&t, &dense, &CurvatureLineOptions::default())
+        .expect("a half-cylinder is an open disc");
+    let he = HalfEdgeMesh::from_mesh(&cage).expect("a manifold cage");
+    assert_eq!((he.genus(), he.boundary_loops().len()), (0, 1));
+    assert_eq!(r.corners, 4, "the four corners of the rim: {r:?}");
+    assert_eq!(tags.corners().len(), 4);
+    // Every vertex is a boundary control point (the cage has no inner vertex).
+    assert!((0..cage.num_vertices())
+        .all(|v| he.is_boundary_vertex(subfit_mesh::VertexId::from_usize(v))));
+    assert!(r.cuts >= 1, "{r:?}");
+    assert!(
+        cage.num_vertices() <= 30,
+        "{} control points",
+        cage.num_vertices()
+    );
+    // The inner edges are rulings: along the axis (z in the input, the normalized z too).
+    let axis = sub(
+        t.to_normalized([0.0, 0.0, 1.0]),
+        t.to_normalized([0.0, 0.0, 0.0]),
+    );
+    let axis_len = norm(axis);
+    let mut inner = 0;
+    for e in 0..he.num_edges() {
+        let e = subfit_mesh::EdgeId::from_usize(e);
+        if he.is_boundary_edge(e) {
+            continue;
+        }
+        inner += 1;
+        let [a, b] = he.edge_vertices(e);
+        let d = sub(cage.positions[b.0 as usize], cage.positions[a.0 as usize]);
+        let cos = dot(d, axis).abs() / (norm(d) * axis_len);
+        assert!(
+            cos > 0.98,
+            "an inner edge {a:?}–{b:?} at {:.1}° to the axis",
+            cos.acos().to_degrees()
+        );
+    }
+    assert!(inner >= 1);
+    assert!(r.curve_max_error <= CurvatureLineOptions::default().curve_tolerance);
+}
+
+#[test]
+fn a_saddle_becomes_a_few_quads_with_its_four_corners() {
+    let (t, dense) = prepared(&grid(30, 30, |u, v| {
+        let (x, y) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+        [x, y, 0.3 * (x * x - y * y)]
+    }));
+    let (cage, _, r) = curvature_line_cage(&t, &dense, &CurvatureLineOptions::default())
+        .expect("a saddle is an open disc");
+    let he = HalfEdgeMesh::from_mesh(&cage).expect("a manifold cage");
+    assert_eq!((he.genus(), he.boundary_loops().len()), (0, 1));
+    assert_eq!(r.corners, 4, "{r:?}");
+    assert!(
+        cage.num_vertices() <= 24,
+        "{} control points",
+        cage.num_vertices()
+    );
+    assert!(cage.faces.iter().all(|f| f.len() == 3 || f.len() == 4));
+}
+
+#[test]
+fn a_plate_with_a_hole_is_linked_into_one_contour() {
+    // The square [-1, 1]² bent, with a round hole of radius 0.35: rings from the hole to the
+    // square's edge.
+    let (nr, na) = (16, 48);
+    let mut p = Vec::new();
+    for j in 0..nr {
+        for i in 0..na {
+            let a = std::f64::consts::TAU * i as f64 / na as f64;
+            let (c, s) = (a.cos(), a.sin());
+            let edge = 1.0 / c.abs().max(s.abs());
+            let r = 0.35 + (edge - 0.35) * j as f64 / (nr - 1) as f64;
+            let (x, y) = (r * c, r * s);
+            p.push([x, y, 0.25 * x * x - 0.1 * y * y + 0.1 * x * y]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * na + i % na) as u32;
+    let mut tris = Vec::new();
+    for j in 0..nr - 1 {
+        for i in 0..na {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let (t, dense) = prepared(&PolyMesh::new(p, Polygons::from_triangles(&tris)));
+    let (cage, _, r) = curvature_line_cage(&t, &dense, &CurvatureLineOptions::default())
+        .expect("a plate with a hole is a sphere with two holes");
+    let he = HalfEdgeMesh::from_mesh(&cage).expect("a manifold cage");
+    assert_eq!((he.genus(), he.boundary_loops().len()), (0, 2));
+    assert_eq!(r.links, 1);
+    assert_eq!(r.corners, 4, "the square's corners: {r:?}");
+}
+
+#[test]
+fn closed_and_handled_targets_are_refused_with_their_topology() {
+    // A closed cylinder tube with its ends open is an annulus (genus 0, 2 loops): accepted;
+    // a torus is closed and of genus 1: refused.
+    let (n, m) = (24, 12);
+    let mut p = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            let (a, b) = (
+                std::f64::consts::TAU * i as f64 / n as f64,
+                std::f64::consts::TAU * j as f64 / m as f64,
+            );
+            let r = 1.0 + 0.3 * b.cos();
+            p.push([r * a.cos(), r * a.sin(), 0.3 * b.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((j % m) * n + i % n) as u32;
+    let mut tris = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let (t, dense) = prepared(&PolyMesh::new(p, Polygons::from_triangles(&tris)));
+    let e = curvature_line_cage(&t, &dense, &CurvatureLineOptions::default()).unwrap_err();
+    assert_eq!(
+        e,
+        CurvatureLineError::Topology {
+            genus: 1,
+            loops: 0,
+            components: 1
+        }
+    );
+    assert!(e.to_string().contains("genus 1"), "{e}");
+}
