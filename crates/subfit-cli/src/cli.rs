@@ -235,9 +235,15 @@ pub struct ConvergenceArgs {
 pub struct FitArgs {
     /// The target: a point cloud or a mesh (any supported format).
     pub target: PathBuf,
-    /// Initial control mesh in the target's coordinates (any mesh format), or `auto` to build
-    /// one with the target's topology (QEM simplification of a mesh target, contouring of an
-    /// implicit surface for a point cloud).
+    /// Initial control mesh in the target's coordinates (any mesh format), or how to build one
+    /// with the target's topology: `qem` (QEM simplification of a mesh target, contouring of an
+    /// implicit surface for a point cloud), `curvature-lines` (open mesh targets of genus 0:
+    /// the boundary curves' control points joined along the lines of curvature, Lavoué et al.
+    /// 2007 §4; fitted with the quad/triangle scheme unless --scheme is given), or `auto`: QEM,
+    /// and for an open genus-0 mesh of at most 10,000 points (CAD-like patches) the
+    /// curvature-line start as well, keeping the fit within the tolerances with fewer control
+    /// points; report.json `init.source` and `init.curvature_lines` say which and what the
+    /// other gave.
     #[arg(long, default_value = "auto")]
     pub init: String,
     /// Use only the target's points (and normals): ignore its faces, as for a scan.

@@ -111,6 +111,22 @@ fn a_cage_of_the_wrong_topology_is_rejected_before_fitting() {
     let msg = String::from_utf8_lossy(&r.stderr);
     assert!(msg.contains("genus 0") && msg.contains("genus 1"), "{msg}");
     assert!(!out.join("control.obj").exists());
+    // A curvature-line cage needs an open surface of genus 0 (Lavoué et al. §4).
+    let r = subfit(&[
+        "fit",
+        torus.to_str().unwrap(),
+        "--init",
+        "curvature-lines",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(2));
+    let msg = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        msg.contains("curvature-lines") && msg.contains("genus 1"),
+        "{msg}"
+    );
+    assert!(!out.join("control.obj").exists());
     // --control-points belongs to the automatic initial mesh.
     let r = subfit(&[
         "fit",

@@ -59,7 +59,7 @@ pub(crate) fn fit_best_start(
 ) -> Result<Fitted, Error> {
     // Only a fit that can be capped keeps a copy of its input (a large mesh is not copied for
     // nothing): a quad scheme, the automatic start, a budget at most the largest default.
-    let may_cap = matches!(options.init, InitialCage::Auto)
+    let may_cap = matches!(options.init, InitialCage::Auto | InitialCage::Qem)
         && options.control_points.is_none()
         && matches!(
             options.scheme,
@@ -141,7 +141,7 @@ pub(crate) fn start_control_points(
 }
 
 /// A shorter-lived handle on the progress callback, for one of several fits.
-fn reborrow<'a>(
+pub(crate) fn reborrow<'a>(
     p: &'a mut Option<&mut dyn FnMut(Progress<'_>)>,
 ) -> Option<&'a mut dyn FnMut(Progress<'_>)> {
     match p {

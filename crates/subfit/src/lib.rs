@@ -29,6 +29,7 @@
 mod budget_starts;
 mod error;
 mod html_report;
+pub mod initial_cage;
 mod outputs;
 pub mod pipeline_report;
 mod repair;

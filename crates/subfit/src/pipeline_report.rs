@@ -166,6 +166,53 @@ pub struct InitSummary {
     pub features: Option<FeatureSummary>,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
+    /// The curvature-line cage (`subfit_init::curvature_lines`) when it was built or tried:
+    /// whether it is this cage, and why not. `None` when it was not tried.
+    #[serde(default)]
+    pub curvature_lines: Option<CurvatureLineSummary>,
+}
+
+/// The curvature-line initial cage of Lavoué et al. 2007 §4 ([`InitSummary::curvature_lines`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CurvatureLineSummary {
+    /// Whether it is the initial cage.
+    pub used: bool,
+    /// Why it is not (it cannot be built, or the QEM start gave the better fit, see
+    /// `crate::initial_cage`). `None` when used.
+    pub reason: Option<String>,
+    /// Its control points (0 when it could not be built).
+    pub control_points: usize,
+    /// Its faces.
+    pub faces: usize,
+    /// Control points tagged as corners (sharp turns of the boundary).
+    pub corners: usize,
+    /// Control points per boundary curve.
+    pub curve_control_points: Vec<usize>,
+    /// Largest distance of a target boundary vertex from its boundary curve, as a fraction of
+    /// the bounding-box diagonal.
+    pub curve_max_error: f64,
+    /// Edges linking the boundary loops into one contour.
+    pub links: usize,
+    /// Cuts along lines of curvature.
+    pub cuts: usize,
+    /// Under `--init auto`, what the other start gave (QEM when this one was kept, this one
+    /// when QEM was). `None` when only one start was fitted.
+    pub alternative: Option<InitAlternative>,
+}
+
+/// A start fitted and not kept ([`CurvatureLineSummary::alternative`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct InitAlternative {
+    /// Control points of its initial cage.
+    pub initial_control_points: usize,
+    /// Control points of its fitted cage.
+    pub control_points: usize,
+    /// Its two-sided RMS, as a fraction of the diagonal.
+    pub rms_fraction_of_diagonal: f64,
+    /// Its two-sided maximum (Hausdorff distance), as a fraction of the diagonal.
+    pub max_fraction_of_diagonal: f64,
+    /// Whether it met the tolerances.
+    pub tolerance_reached: bool,
 }
 
 /// A mesh target's sharp features ([`InitSummary::features`]).

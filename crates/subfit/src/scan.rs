@@ -16,10 +16,7 @@ use subfit_fit::{
     fit_stages, judged_with_boundary, DataTerm, FitOptions, FootPointTerm, IterationRow,
     StageEvent, StageOptions, StageReport, StagesResult,
 };
-use subfit_init::{
-    default_control_points, initial_control_mesh, pair_triangles, InitOptions, InitReport,
-    SimplifyOptions,
-};
+use subfit_init::{default_control_points, initial_control_mesh, InitOptions, SimplifyOptions};
 use subfit_mesh::{Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::{FeatureOptions, Target, TargetOptions};
@@ -34,9 +31,9 @@ use subfit_report::{
 };
 
 use crate::pipeline_report::{
-    face_counts, BoundaryLoops, Errors, FeatureSummary, FinalErrors, InitSummary, InitTimings,
-    IterationSummary, OptionsSummary, Report, RmsMax, StageSummary, TagCounts, TessellationSummary,
-    Timings, Topology, TwoSidedErrors, UsdDifference,
+    face_counts, Errors, FinalErrors, InitSummary, IterationSummary, OptionsSummary, Report,
+    RmsMax, StageSummary, TagCounts, TessellationSummary, Timings, Topology, TwoSidedErrors,
+    UsdDifference,
 };
 
 /// The scan to fit.
@@ -58,10 +55,18 @@ pub enum Input {
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, Default)]
 pub enum InitialCage {
-    /// Built with the target's topology (QEM simplification of a mesh target, IMLS contour of
-    /// a point cloud), with [`FitScanOptions::control_points`] points.
+    /// Built with the target's topology: QEM simplification of a mesh target or IMLS contour
+    /// of a point cloud, with [`FitScanOptions::control_points`] points; a small open mesh
+    /// target of genus 0 is also fitted from the curvature-line cage and the better fit kept
+    /// (see [`crate::initial_cage`](mod@crate::initial_cage)).
     #[default]
     Auto,
+    /// QEM only: [`subfit_init::initial_control_mesh`] (the simplification of a mesh target,
+    /// the trimmed IMLS contour of a point cloud), never the curvature-line cage.
+    Qem,
+    /// The curvature-line cage of Lavoué et al. 2007 §4 ([`subfit_init::curvature_lines`]):
+    /// open mesh targets of genus 0 only; an error otherwise.
+    CurvatureLines,
     /// Given, in the target's coordinates; its genus and boundary loops must match a mesh
     /// target's.
     Given {
@@ -253,7 +258,7 @@ pub fn fit_scan(
     progress: Option<&mut dyn FnMut(Progress<'_>)>,
 ) -> Result<Fitted, Error> {
     validate(options)?;
-    crate::budget_starts::fit_best_start(input, options, progress)
+    crate::initial_cage::fit_best_init(input, options, progress)
 }
 
 /// [`fit_scan`] once: a quad scheme capped by the budget starts at `start` of it.
@@ -337,75 +342,21 @@ pub(crate) fn fit_scan_from(
             mesh: c,
             tags,
             name: cname,
-        } => {
-            let topo = topology(c).map_err(|e| Error::input(cname, e))?;
-            if let Some(t) = target_topology {
-                if t != topo {
-                    return Err(Error::input(
-                        cname,
-                        format!(
-                            "the control mesh has genus {} and {} boundary loop(s), the target {name} has genus {} and {} — their topologies must match",
-                            topo.genus, topo.boundary_loops, t.genus, t.boundary_loops
-                        ),
-                    ));
-                }
-            }
-            if c.num_vertices() > budget {
-                return Err(Error::Budget(format!(
-                    "{cname}: the initial control mesh has {} control points, more than the budget of {budget}",
-                    c.num_vertices()
-                )));
-            }
-            let mut normalized = PolyMesh::new(
-                c.positions
-                    .iter()
-                    .map(|&p| target.to_normalized(p))
-                    .collect(),
-                c.faces.clone(),
-            );
-            let t_pair = Instant::now();
-            let paired = options.quad_dominant == Some(true);
-            if paired {
-                let (m, _) =
-                    pair_triangles(&normalized, tags, Some(&target), &init_options.pairing)
-                        .map_err(|e| Error::input(cname, e))?;
-                normalized = m;
-            }
-            let (quads, triangles, quad_fraction) = face_counts(&normalized.faces);
-            let summary = InitSummary {
-                source: "File".into(),
-                file: Some(cname.clone()),
-                requested_control_points: None,
-                open_cloud_control_points: None,
-                specks: 0,
-                one_sided_refined: false,
-                budget_start: None,
-                control_points: c.num_vertices(),
-                faces: normalized.faces.len(),
-                quads,
-                triangles,
-                quad_fraction,
-                paired,
-                genus_target: target_topology.map_or(topo.genus, |t| t.genus),
-                genus: topo.genus,
-                genus_matches: target_topology.is_none_or(|t| t.genus == topo.genus),
-                boundary_loops: BoundaryLoops {
-                    target: target_topology.map_or(topo.boundary_loops, |t| t.boundary_loops),
-                    cage: topo.boundary_loops,
-                },
-                cloud_open: false,
-                contour_faces_trimmed: 0,
-                smoothed: false,
-                features: None,
-                timings_s: InitTimings {
-                    pair: t_pair.elapsed().as_secs_f64(),
-                    total: t_pair.elapsed().as_secs_f64(),
-                    ..InitTimings::default()
-                },
-            };
-            (normalized, tags.clone(), summary)
+        } => crate::initial_cage::given_cage(
+            &target,
+            target_topology,
+            &name,
+            c,
+            tags,
+            cname,
+            budget,
+            options,
+            &init_options,
+        )?,
+        InitialCage::CurvatureLines => {
+            crate::initial_cage::curvature_line_start(&target, &mesh, &name, options)?
         }
-        InitialCage::Auto => {
+        InitialCage::Auto | InitialCage::Qem => {
             let mut budget_start = None;
             let n = match options.control_points {
                 Some(n) if n > budget => {
@@ -500,7 +451,7 @@ pub(crate) fn fit_scan_from(
             }
             let summary = InitSummary {
                 budget_start,
-                ..init_summary(&r, n, &m, init_options.features.as_ref())
+                ..crate::initial_cage::init_summary(&r, n, &m, init_options.features.as_ref())
             };
             if !r.feature_segments.is_empty() {
                 feature_segments = Some(Arc::new(r.feature_segments));
@@ -510,16 +461,26 @@ pub(crate) fn fit_scan_from(
     };
     let init_time = t_init.elapsed().as_secs_f64();
 
-    let scheme = options.scheme.unwrap_or(if control.faces.is_triangles() {
-        Scheme::Loop
-    } else {
-        Scheme::CatmullClark
-    });
+    let scheme = options
+        .scheme
+        .unwrap_or(if init.source == "CurvatureLines" {
+            // Lavoué's cages are quad/triangle.
+            Scheme::QuadTriangle
+        } else if control.faces.is_triangles() {
+            Scheme::Loop
+        } else {
+            Scheme::CatmullClark
+        });
     let fit = FitOptions {
         scheme,
         tags,
         feature_segments: feature_segments.or_else(|| options.fit.feature_segments.clone()),
         cancel: options.cancel.clone(),
+        sample_level: if init.source == "CurvatureLines" {
+            crate::initial_cage::coarse_sample_level(control.faces.len(), options.fit.sample_level)
+        } else {
+            options.fit.sample_level
+        },
         ..options.fit.clone()
     };
 
@@ -888,61 +849,12 @@ fn validate(o: &FitScanOptions) -> Result<(), Error> {
 
 /// Genus and boundary loops of a mesh with faces; the error names the element that makes it
 /// unusable.
-fn topology(m: &PolyMesh) -> Result<Topology, subfit_mesh::TopologyError> {
+pub(crate) fn topology(m: &PolyMesh) -> Result<Topology, subfit_mesh::TopologyError> {
     let h = HalfEdgeMesh::from_mesh(m)?;
     Ok(Topology {
         genus: h.genus(),
         boundary_loops: h.boundary_loops().len(),
     })
-}
-
-fn init_summary(
-    r: &InitReport,
-    requested: usize,
-    m: &PolyMesh,
-    features: Option<&FeatureOptions>,
-) -> InitSummary {
-    let (quads, triangles, quad_fraction) = face_counts(&m.faces);
-    InitSummary {
-        source: format!("{:?}", r.source),
-        file: None,
-        requested_control_points: Some(requested),
-        open_cloud_control_points: r.open_cloud_control_points,
-        specks: r.specks,
-        one_sided_refined: r.one_sided_refined,
-        budget_start: None,
-        control_points: m.num_vertices(),
-        faces: m.faces.len(),
-        quads,
-        triangles,
-        quad_fraction,
-        paired: r.pairing.is_some(),
-        genus_target: r.genus_target,
-        genus: r.genus_after,
-        genus_matches: r.genus_matches,
-        boundary_loops: BoundaryLoops {
-            target: r.boundary_loops.0,
-            cage: r.boundary_loops.1,
-        },
-        cloud_open: r.cloud_open(),
-        contour_faces_trimmed: r.trim.as_ref().map_or(0, |t| t.faces_trimmed),
-        smoothed: r.simplify.smoothed,
-        features: r.features.zip(features).map(|(f, o)| FeatureSummary {
-            angle_deg: o.angle_deg,
-            edges: f.edges,
-            curves: f.curves,
-            corners: f.corners,
-            darts: f.darts,
-            concave_sectors: r.concave.creases,
-            concave_points: r.concave.inserted,
-        }),
-        timings_s: InitTimings {
-            contour: r.timings.contour.as_secs_f64(),
-            simplify: r.timings.simplify.as_secs_f64(),
-            pair: r.timings.pair.as_secs_f64(),
-            total: r.timings.total.as_secs_f64(),
-        },
-    }
 }
 
 /// Reads `path` as a cage for [`InitialCage::Given`].

@@ -95,7 +95,7 @@ pub struct SequenceOptions {
     /// frame's coordinates, fitted to it like every other frame.
     pub template: InitialCage,
     /// Options of the template's fit ([`fit_scan`]; its `init` is replaced by
-    /// [`InitialCage::Auto`], its `cancel` by [`Self::cancel`]). Default: `fit_scan`'s.
+    /// [`Self::template`], its `cancel` by [`Self::cancel`]). Default: `fit_scan`'s.
     pub template_fit: FitScanOptions,
     /// Per-frame fit options: method (SDM or IMLS), sample level, coverage, step control. The
     /// scheme and tags are the template's, `λ`, `α` and the iteration cap those below.
@@ -352,7 +352,7 @@ where
         options.cancel.check().map_err(|_| Error::Interrupted)?;
         let t0 = Instant::now();
         let (report, cage) = match carry.as_mut() {
-            None if matches!(options.template, InitialCage::Auto) => {
+            None if !matches!(options.template, InitialCage::Given { .. }) => {
                 let (c, report, fitted_report) = template_frame(input, options, &mut warn_all)?;
                 template_report = Some(Box::new(fitted_report));
                 let cage = original_cage(&c);
@@ -564,7 +564,7 @@ fn template_frame(
 ) -> Result<(Carry, FrameReport, crate::Report), Error> {
     let t0 = Instant::now();
     let mut o = options.template_fit.clone();
-    o.init = InitialCage::Auto;
+    o.init = options.template.clone();
     o.fit.boundary = options.fit.boundary;
     o.cancel = options.cancel.clone();
     let mut forward = |p: crate::Progress<'_>| {

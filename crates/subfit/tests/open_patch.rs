@@ -140,3 +140,45 @@ fn one_sided_the_rim_stays_short() {
     let (_, gap) = fit_and_gap("cap", &spherical_cap(48), &options);
     assert!(gap > 0.01, "rim gap {gap:.2e}");
 }
+
+/// Half of a cylinder of radius 0.5 and length 1 as an `n × n` grid: one boundary loop with
+/// four corners.
+fn half_cylinder(n: usize) -> PolyMesh {
+    let mut m = height_field(n, |_, _| 0.0);
+    for p in &mut m.positions {
+        let a = std::f64::consts::FRAC_PI_2 * (p[0] + 1.0);
+        *p = [0.5 * a.cos(), 0.5 * a.sin(), 0.5 * (p[1] + 1.0)];
+    }
+    m
+}
+
+#[test]
+fn a_half_cylinder_keeps_the_curvature_line_start_and_its_corners() {
+    // `--init auto` on a small open patch: both starts are fitted and the one within the
+    // tolerances with fewer control points kept — here the curvature-line cage (Lavoué §4),
+    // whose four corners are tagged so the rim keeps them.
+    let options = FitScanOptions {
+        target_tolerances: true,
+        ..FitScanOptions::default()
+    };
+    let (fitted, gap) = fit_and_gap("half-cylinder", &half_cylinder(24), &options);
+    let r = &fitted.report;
+    let cl = r
+        .init
+        .curvature_lines
+        .as_ref()
+        .expect("both starts were fitted");
+    let other = cl.alternative.expect("the QEM start's figures");
+    println!(
+        "half-cylinder: {} → {} control points from curvature lines, QEM {} → {}; rim gap {gap:.2e}",
+        r.init.control_points, r.control_points, other.initial_control_points, other.control_points
+    );
+    assert_eq!(r.init.source, "CurvatureLines");
+    assert!(cl.used && r.tolerance_reached);
+    assert!(!other.tolerance_reached || other.control_points > r.control_points);
+    assert_eq!(cl.corners, 4);
+    assert_eq!(fitted.tags.corners().len(), 4);
+    assert_eq!(fitted.scheme, subfit::subdiv::Scheme::QuadTriangle);
+    assert_eq!((r.init.genus, r.init.boundary_loops.cage), (0, 1));
+    assert!(gap < 0.004, "the rim misses the data's edge by {gap:.2e}");
+}

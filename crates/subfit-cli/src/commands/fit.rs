@@ -44,6 +44,10 @@ pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
 pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
     let init = if a.init == "auto" {
         InitialCage::Auto
+    } else if a.init == "qem" {
+        InitialCage::Qem
+    } else if a.init == "curvature-lines" {
+        InitialCage::CurvatureLines
     } else {
         let path = PathBuf::from(&a.init);
         let (mesh, _) = crate::progress::load(&path)?;
