@@ -54,6 +54,11 @@ pub struct InitArgs {
     /// the rule of `subfit fit`].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000_000))]
     pub control_points: Option<u32>,
+    /// The cage of Lavoué et al. 2007 §4 instead of QEM (open mesh targets of genus 0): the
+    /// control points of the boundary loops' subdivision curves, joined along the lines of
+    /// curvature; corners tagged (`subfit fit --init curvature-lines` starts from it).
+    #[arg(long, conflicts_with_all = ["control_points", "from_points"])]
+    pub curvature_lines: bool,
     /// Ignore the target's faces: contour an implicit surface of its points instead of
     /// simplifying the mesh.
     #[arg(long)]

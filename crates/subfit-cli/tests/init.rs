@@ -214,6 +214,13 @@ fn bad_inputs_exit_with_2_and_leave_no_file() {
         &["torus.obj", "genus 1", "at least 7"],
     );
 
+    // Lavoué's curvature-line cage needs an open surface of genus 0.
+    expect_bad(
+        p,
+        &[&torus, "--curvature-lines"],
+        &["torus.obj", "curvature-line", "genus 1"],
+    );
+
     // A point format cannot hold a cage (checked before reading).
     let r = subfit(&["init", &torus, "-o", &s(&p.join("cage.xyz"))]);
     assert_eq!(r.status.code(), Some(2));
@@ -413,4 +420,74 @@ fn init_150(cloud: &Path, out: &Path, extra: &[&str]) -> Output {
     ];
     args.extend(extra);
     subfit(&args)
+}
+
+/// `--curvature-lines` on an open patch (a half-cylinder, one boundary loop with four corners):
+/// a cage of the boundary curve's control points only, with the four corners as OpenSubdiv
+/// `t corner` lines, in the target's coordinates.
+#[test]
+fn curvature_lines_build_a_boundary_cage_with_tagged_corners() {
+    let d = tempfile::tempdir().unwrap();
+    let (nu, nv) = (30, 20);
+    let mut obj = String::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            let a = std::f64::consts::PI * i as f64 / (nu - 1) as f64;
+            let _ = writeln!(
+                obj,
+                "v {} {} {}",
+                5.0 * a.cos(),
+                5.0 * a.sin(),
+                10.0 * j as f64 / (nv - 1) as f64
+            );
+        }
+    }
+    for j in 0..nv - 1 {
+        for i in 0..nu - 1 {
+            let v = |i: usize, j: usize| j * nu + i + 1;
+            let _ = writeln!(obj, "f {} {} {}", v(i, j), v(i + 1, j), v(i + 1, j + 1));
+            let _ = writeln!(obj, "f {} {} {}", v(i, j), v(i + 1, j + 1), v(i, j + 1));
+        }
+    }
+    let patch = write(d.path(), "half_cylinder.obj", &obj);
+    let out = d.path().join("cage.obj");
+    let r = subfit(&[
+        "init",
+        patch.to_str().unwrap(),
+        "--curvature-lines",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("t corner")).count(),
+        4,
+        "{text}"
+    );
+    // Quads and triangles: read the positions only.
+    let v: Vec<Vec<f64>> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| l.split_whitespace().map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(v.len() >= 4 && v.len() <= 30, "{} control points", v.len());
+    // In the target's coordinates: the corners are the patch's corners (radius 5, length 10).
+    for c in [
+        [5.0, 0.0, 0.0],
+        [-5.0, 0.0, 0.0],
+        [5.0, 0.0, 10.0],
+        [-5.0, 0.0, 10.0],
+    ] {
+        let d = v
+            .iter()
+            .map(|p| (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f64>().sqrt())
+            .fold(f64::MAX, f64::min);
+        assert!(d < 1e-6, "no control point at the corner {c:?} ({d})");
+    }
+    let said = String::from_utf8_lossy(&r.stdout);
+    assert!(
+        said.contains("4 corner(s)") && said.contains("cut(s) along curvature lines"),
+        "{said}"
+    );
 }

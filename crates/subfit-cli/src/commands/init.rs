@@ -5,6 +5,7 @@
 //! `--from-points`, are contoured (IMLS on an adaptive octree + marching tetrahedra) and then simplified. The default
 //! size is [`subfit::init::default_control_points`]: `clamp(round(1.5·√points), 200, 2000)`.
 //! `--quad-dominant` pairs the triangles into quads ([`subfit::init::pair_triangles`]).
+//! `--curvature-lines` builds Lavoué et al.'s cage instead ([`subfit::init::curvature_lines`]).
 
 use std::process::ExitCode;
 use std::time::Instant;
@@ -66,6 +67,9 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
         built.with_context(|| format!("{}: cannot use as a target", a.target.display()))?;
     let target_time = t.elapsed();
 
+    if a.curvature_lines {
+        return curvature_lines(&a, &input, &target, t0);
+    }
     let n = a
         .control_points
         .map_or_else(|| default_control_points(target.len()), |n| n as usize);
@@ -197,6 +201,87 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
             report.genus_after, report.genus_target
         );
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `--curvature-lines`: the cage of [`subfit::init::curvature_lines`], written with its
+/// corner tags.
+fn curvature_lines(
+    a: &InitArgs,
+    input: &PolyMesh,
+    target: &Target,
+    t0: Instant,
+) -> anyhow::Result<ExitCode> {
+    use subfit::init::curvature_lines::{curvature_line_cage, CurvatureLineOptions};
+    if input.faces.is_empty() {
+        bail!(
+            "{}: --curvature-lines needs a mesh (faces): a point cloud has no boundary loops to start from",
+            a.target.display()
+        );
+    }
+    let dense = PolyMesh::new(
+        input
+            .positions
+            .iter()
+            .map(|&p| target.to_normalized(p))
+            .collect(),
+        subfit::mesh::Polygons::from_triangles(&input.faces.triangulate_fan()),
+    );
+    let options = CurvatureLineOptions {
+        cancel: crate::interrupt::token(),
+        ..CurvatureLineOptions::default()
+    };
+    let sp = crate::progress::spinner("fitting boundary curves and cutting along curvature lines");
+    let result = curvature_line_cage(target, &dense, &options);
+    sp.finish_and_clear();
+    let (cage, tags, r) = result.map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot build the curvature-line cage: {e}",
+            a.target.display()
+        )
+    })?;
+    let out = PolyMesh::new(
+        cage.positions
+            .iter()
+            .map(|&p| target.to_original(p))
+            .collect(),
+        cage.faces.clone(),
+    );
+    crate::interrupt::watch_dir(&a.output);
+    if Format::from_path(&a.output) == Some(Format::Obj) {
+        subfit::io::write_obj_with_tags_file(&a.output, &out, &tags)?;
+    } else {
+        eprintln!(
+            "subfit: warning: {} has no place for the cage's {} corner tags (write .obj to keep them)",
+            a.output.display(),
+            tags.corners().len()
+        );
+        let wopts = WriteOptions {
+            format: None,
+            encoding: Encoding::Ascii,
+            single_precision: false,
+        };
+        subfit::io::write_file(&a.output, &out, &wopts)?;
+    }
+    let quads = out.faces.iter().filter(|f| f.len() == 4).count();
+    out!(
+        "boundary curves: {} loop(s), control points {:?}, {} corner(s), largest distance of a boundary vertex {:.2e} unit cube",
+        r.boundary_loops,
+        r.curve_control_points,
+        r.corners,
+        r.curve_max_error
+    );
+    out!(
+        "cage: {} vertices, {} faces ({quads} quads, {} triangles, {} larger), {} link(s) between loops, {} cut(s) along curvature lines",
+        out.num_vertices(),
+        out.num_faces(),
+        out.faces.iter().filter(|f| f.len() == 3).count(),
+        out.faces.iter().filter(|f| f.len() > 4).count(),
+        r.links,
+        r.cuts
+    );
+    out!("time: total {:.3} s", t0.elapsed().as_secs_f64());
+    out!("wrote {}", a.output.display());
     Ok(ExitCode::SUCCESS)
 }
 
