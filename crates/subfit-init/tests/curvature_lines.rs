@@ -90,11 +90,26 @@ fn a_half_cylinder_is_cut_along_its_rulings() {
 
 #[test]
 fn a_saddle_becomes_a_few_quads_with_its_four_corners() {
-    let (t, dense) = prepared(&grid(30, 30, |u, v| {
+    // 13 × 13 vertices with alternating diagonals (as `examples/open_patches.rs` writes it).
+    let mut m = grid(13, 13, |u, v| {
         let (x, y) = (2.0 * u - 1.0, 2.0 * v - 1.0);
         [x, y, 0.3 * (x * x - y * y)]
-    }));
-    let (cage, _, r) = curvature_line_cage(&t, &dense, &CurvatureLineOptions::default())
+    });
+    let id = |i: usize, j: usize| (j * 13 + i) as u32;
+    let mut tris = Vec::new();
+    for j in 0..12 {
+        for i in 0..12 {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                tris.extend([[a, b, c], [a, c, d]]);
+            } else {
+                tris.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    m.faces = Polygons::from_triangles(&tris);
+    let (t, dense) = prepared(&m);
+    let (cage, tags, r) = curvature_line_cage(&t, &dense, &CurvatureLineOptions::default())
         .expect("a saddle is an open disc");
     let he = HalfEdgeMesh::from_mesh(&cage).expect("a manifold cage");
     assert_eq!((he.genus(), he.boundary_loops().len()), (0, 1));
@@ -105,6 +120,26 @@ fn a_saddle_becomes_a_few_quads_with_its_four_corners() {
         cage.num_vertices()
     );
     assert!(cage.faces.iter().all(|f| f.len() == 3 || f.len() == 4));
+    // No sliver facets: two control points of one side of the square joined by a cut just
+    // inside it (which follows a principal direction and scores well) closed a facet of points
+    // of that side alone. The cage's vertices are the boundary curve's control points in loop
+    // order, the corners tagged: a side is a run from one corner to the next.
+    let corners: Vec<u32> = {
+        let mut c: Vec<u32> = tags.corners().into_iter().map(|(v, _)| v).collect();
+        c.sort_unstable();
+        c
+    };
+    let n = cage.num_vertices() as u32;
+    for f in cage.faces.iter() {
+        for (k, &c) in corners.iter().enumerate() {
+            let next = corners[(k + 1) % corners.len()];
+            let on_side = |v: u32| (v + n - c) % n <= (next + n - c) % n;
+            assert!(
+                !f.iter().all(|&v| on_side(v)),
+                "a facet {f:?} of one side of the saddle (corners {c}, {next})"
+            );
+        }
+    }
 }
 
 #[test]

@@ -28,11 +28,15 @@
 //!    quad/triangle cage.
 //!
 //! Differences from the paper, each for robustness: a path's inner vertices must be off every
-//! border (the paper penalises touching a boundary with 90°; forbidding it makes every cut a
-//! chord that splits a disc into two discs); between equal scores the cut that halves the
-//! contour is preferred ([`BALANCE_DEGREES`]); a target of genus above 0 or in several pieces is
-//! refused ([`CurvatureLineError::Topology`]): the topological contour of §4.4 is a disc only
-//! for a sphere with holes.
+//! border (forbidding it makes every cut a chord that splits a disc into two discs), and the
+//! paper's 90° for a path vertex on a boundary is given at the cage's scale: to an inner vertex
+//! nearer the border than [`NEAR_BORDER`] × its distance to the path's nearer end (on a target
+//! of fine triangles a path one triangle inside a boundary touches nothing, and on a saddle the
+//! path just inside a straight side follows a principal direction and scored best); a cut that
+//! leaves one side a sliver along it is refused ([`SLIVER_RATIO`]); between equal scores the
+//! cut that halves the contour is preferred ([`BALANCE_DEGREES`]); a target of genus above 0 or
+//! in several pieces is refused ([`CurvatureLineError::Topology`]): the topological contour of
+//! §4.4 is a disc only for a sphere with holes.
 //!
 //! Cost: the curve fits near-linear in the boundary vertices; one Dijkstra per control point of
 //! a contour, over the contour's region (`O(R log R)`), per cut; the cut regions shrink, so
@@ -56,6 +60,14 @@ use regions::{Path, Surface, NONE};
 /// a cut leaving all but two control points on one side costs this many degrees more than one
 /// that halves it.
 pub const BALANCE_DEGREES: f64 = 2.0;
+
+/// An inner vertex of a path nearer the border than this fraction of its distance to the
+/// path's nearer end point counts as touching the border (90° in eq. 4, see `Scorer::score`).
+pub const NEAR_BORDER: f64 = 0.5;
+
+/// A cut is refused when the control points on one side of it all lie within this fraction
+/// of its length of its line ([`sliver`]).
+pub const SLIVER_RATIO: f64 = 0.15;
 
 /// The most control points the boundary curves may have together; a target whose loops need
 /// more is left to the QEM initializer ([`CurvatureLineError::TooManyControlPoints`]).
@@ -251,7 +263,7 @@ pub fn curvature_line_cage(
             faces.extend(facets(&pts, &ids));
             continue;
         }
-        match best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges) {
+        match best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage) {
             Some((new, a, b)) => {
                 edges.insert(key(a, b));
                 report.cuts += 1;
@@ -301,16 +313,28 @@ impl<'a> Scorer<'a> {
     }
 
     /// `min(Σ θmin, Σ θmax) / n` in degrees over the path's vertices, against the segment
-    /// between its end points (§4.3, eq. 4).
-    fn score(&self, surface: &Surface, path: &Path) -> f64 {
+    /// between its end points (§4.3, eq. 4). An inner vertex nearer the border (`border`:
+    /// distances from [`Surface::border_distance`]) than [`NEAR_BORDER`] × its distance to the
+    /// nearer end point touches the border at the cage's scale and counts 90° (the paper's
+    /// penalty, measured at the scale of the edge rather than of the target's triangles).
+    fn score(&self, surface: &Surface, path: &Path, border: &[f64]) -> f64 {
         let (&a, &b) = (
             path.vertices.first().expect("a path"),
             path.vertices.last().expect("a path"),
         );
-        let d = sub(surface.positions[b as usize], surface.positions[a as usize]);
+        let (pa, pb) = (surface.positions[a as usize], surface.positions[b as usize]);
+        let d = sub(pb, pa);
         let len = norm(d);
         let (mut s1, mut s2) = (0.0, 0.0);
-        for &v in &path.vertices {
+        let last = path.vertices.len() - 1;
+        for (i, &v) in path.vertices.iter().enumerate() {
+            let x = surface.positions[v as usize];
+            let end = norm(sub(x, pa)).min(norm(sub(x, pb)));
+            if i != 0 && i != last && border[v as usize] < NEAR_BORDER * end {
+                s1 += 90.0;
+                s2 += 90.0;
+                continue;
+            }
             let p = match self.point_of.get(v as usize) {
                 Some(&p) => p as usize,
                 None => {
@@ -381,6 +405,7 @@ fn link_loops(
     let loop_at = |v: u32| owner.iter().find(|o| o.0 == v).map(|o| o.1);
     let n = surface.positions.len();
     let s: &Surface = surface;
+    let border = s.border_distance(0);
     let mut heap: BinaryHeap<Candidate> = owner
         .par_iter()
         .map_init(
@@ -394,7 +419,7 @@ fn link_loops(
                     .filter_map(|&(b, _)| {
                         let p = Surface::path_to(a, b, &buf.dist, &buf.pred)?;
                         Some(Candidate {
-                            key: scorer.score(s, &p),
+                            key: scorer.score(s, &p, &border),
                             a,
                             b,
                             stamp: 0,
@@ -420,7 +445,7 @@ fn link_loops(
             continue;
         };
         if c.stamp != links {
-            let key = scorer.score(surface, &p);
+            let key = scorer.score(surface, &p, &surface.border_distance(0));
             heap.push(Candidate {
                 key,
                 stamp: links,
@@ -478,10 +503,13 @@ fn best_cut(
     occ: &[u32],
     id_at: &[u32],
     edges: &HashSet<(u32, u32)>,
+    cage: &[[f64; 3]],
 ) -> Option<(u32, u32, u32)> {
     let k = occ.len();
+    let at = |o: usize| cage[id_at[occ[o] as usize] as usize];
     let n = surface.positions.len();
     let s: &Surface = surface;
+    let border = s.border_distance(r);
     let mut cands: Vec<(f64, usize, usize)> = (0..k)
         .into_par_iter()
         .map_init(
@@ -496,10 +524,22 @@ fn best_cut(
                         if a == b || edges.contains(&key(a, b)) {
                             return None;
                         }
+                        // Neither side may be a sliver along the chord.
+                        let sides = [(i..=j).collect::<Vec<_>>(), (j..k).chain(0..=i).collect()];
+                        if sides
+                            .iter()
+                            .any(|side| sliver(side.iter().map(|&o| at(o)), at(i), at(j)))
+                        {
+                            return None;
+                        }
                         let p = Surface::path_to(occ[i], occ[j], &buf.dist, &buf.pred)?;
                         let side = (j - i + 1) as f64;
                         let imbalance = (side - (k as f64 + 2.0 - side)).abs() / k as f64;
-                        Some((scorer.score(s, &p) + BALANCE_DEGREES * imbalance, i, j))
+                        Some((
+                            scorer.score(s, &p, &border) + BALANCE_DEGREES * imbalance,
+                            i,
+                            j,
+                        ))
                     })
                     .collect::<Vec<_>>()
             },
@@ -514,6 +554,20 @@ fn best_cut(
         }
     }
     None
+}
+
+/// Whether the control points `side` (from one end of a chord `a`–`b` to the other) all lie
+/// within [`SLIVER_RATIO`] × its length of the chord's line: the facet they would close is a
+/// sliver (two control points of one straight side of the contour joined: on a saddle the
+/// path just inside that side follows a principal direction and scored best).
+fn sliver(side: impl Iterator<Item = [f64; 3]>, a: [f64; 3], b: [f64; 3]) -> bool {
+    let d = sub(b, a);
+    let len = norm(d);
+    if len <= 0.0 {
+        return true;
+    }
+    side.map(|p| norm(cross(sub(p, a), d)) / len)
+        .all(|h| h <= SLIVER_RATIO * len)
 }
 
 /// Whether `pts` lie within `tolerance` × their diameter of their best plane (Newell normal

@@ -225,6 +225,44 @@ impl Surface {
         }
     }
 
+    /// Distance along the edges of `region` from every one of its vertices to its border
+    /// (multi-source Dijkstra from the border vertices); `INFINITY` off the region. Cost
+    /// `O(E log E)` over the region's edges.
+    pub fn border_distance(&self, region: u32) -> Vec<f64> {
+        let mut dist = vec![f64::INFINITY; self.positions.len()];
+        let mut heap = BinaryHeap::new();
+        for &f in &self.faces_of[region as usize] {
+            for &v in &self.tris[f as usize] {
+                if self.on_border[v as usize] && dist[v as usize] > 0.0 {
+                    dist[v as usize] = 0.0;
+                    heap.push(Entry(0.0, v));
+                }
+            }
+        }
+        while let Some(Entry(d, u)) = heap.pop() {
+            if d > dist[u as usize] {
+                continue;
+            }
+            let (lo, hi) = (
+                self.offsets[u as usize] as usize,
+                self.offsets[u as usize + 1] as usize,
+            );
+            for &(w, e) in &self.adjacent[lo..hi] {
+                if self.border[e as usize]
+                    || self.label[self.edge_face[e as usize] as usize] != region
+                {
+                    continue;
+                }
+                let nd = d + dist2(self.positions[u as usize], self.positions[w as usize]).sqrt();
+                if nd < dist[w as usize] {
+                    dist[w as usize] = nd;
+                    heap.push(Entry(nd, w));
+                }
+            }
+        }
+        dist
+    }
+
     /// The path to `terminal` found by [`Self::dijkstra`] from `source`, or `None` when it was
     /// not reached. Cost `O(path)`.
     pub fn path_to(source: u32, terminal: u32, dist: &[f64], pred: &[(u32, u32)]) -> Option<Path> {
