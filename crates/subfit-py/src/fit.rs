@@ -179,7 +179,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
 #[pyo3(signature = (
     points, faces=None, normals=None, *, scheme="loop", method="sdm", step="lm",
     tolerance=None, max_error=None, max_control_points=None, control_points=None,
-    as_points=false, init=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
+    as_points=false, init=None, init_method=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
     max_depth=5, local=false, local_rings=None, error_scale=None, name=None, progress=None
@@ -199,6 +199,7 @@ pub fn fit(
     control_points: Option<i64>,
     as_points: bool,
     init: Option<(PyReadonlyArray2<'_, f64>, FaceArrays<'_>)>,
+    init_method: Option<&str>,
     lambda_start: f64,
     lambda_end: Option<f64>,
     sample_level: i64,
@@ -256,6 +257,16 @@ pub fn fit(
             return Err(value_error(format!("normals[{i}] is zero")));
         }
         mesh.normals = Some(nr);
+    }
+    match init_method {
+        None | Some("auto") => {}
+        Some("qem") => opts.init = InitialCage::Qem,
+        Some("curvature-lines") => opts.init = InitialCage::CurvatureLines,
+        Some(other) => {
+            return Err(value_error(format!(
+                "init must be a cage, \"auto\", \"qem\" or \"curvature-lines\", got {other:?}"
+            )))
+        }
     }
     if let Some((v, (c, i))) = &init {
         if control_points.is_some() {

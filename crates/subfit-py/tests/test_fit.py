@@ -104,3 +104,26 @@ def test_mesh_target_and_given_initial_cage(fitted):
     np.testing.assert_array_equal(g.faces, m.faces)
     with pytest.raises(ValueError, match="control_points"):
         subfit.fit(points, init=m, control_points=100)
+
+
+def test_curvature_line_start_on_an_open_patch():
+    # Half of a cylinder (one boundary loop, four corners): Lavoué et al.'s cage of the boundary
+    # curve's control points, fitted with the quad/triangle scheme; "qem" is the other start.
+    n = 24
+    a, z = np.meshgrid(np.linspace(0.0, np.pi, n), np.linspace(0.0, 1.0, n))
+    pos = np.stack([0.5 * np.cos(a), 0.5 * np.sin(a), z], axis=-1).reshape(-1, 3)
+    idx = np.arange(n * n).reshape(n, n)
+    quads = np.stack([idx[:-1, :-1], idx[:-1, 1:], idx[1:, 1:], idx[1:, :-1]], -1).reshape(-1, 4)
+    tris = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+    f = subfit.fit(pos, faces=tris, scheme="quad-tri", init="curvature-lines", tolerance=2e-3)
+    assert f.report["init"]["source"] == "CurvatureLines"
+    assert f.report["init"]["curvature_lines"]["corners"] == 4
+    assert f.report["init"]["control_points"] <= 30
+    assert f.reached
+    q = subfit.fit(pos, faces=tris, scheme="quad-tri", init="qem", tolerance=2e-3)
+    assert q.report["init"]["source"] == "Mesh"
+    with pytest.raises(ValueError, match="curvature-lines"):
+        subfit.fit(pos, faces=tris, init="lines")
+    # Loop needs triangles: said before anything is fitted.
+    with pytest.raises(ValueError, match="quad-tri"):
+        subfit.fit(pos, faces=tris, scheme="loop", init="curvature-lines")

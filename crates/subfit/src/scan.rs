@@ -830,6 +830,12 @@ fn validate(o: &FitScanOptions) -> Result<(), Error> {
     if o.quad_dominant == Some(true) && o.scheme == Some(Scheme::Loop) {
         return bad("--quad-dominant makes quads, and the Loop scheme needs triangles: use --scheme catmull-clark (or drop --quad-dominant)".into());
     }
+    if matches!(o.init, InitialCage::CurvatureLines) && o.scheme == Some(Scheme::Loop) {
+        return bad("--init curvature-lines makes a cage of quads and triangles, and the Loop scheme needs triangles: use --scheme quad-tri (its default) or catmull-clark".into());
+    }
+    if matches!(o.init, InitialCage::CurvatureLines) && o.control_points.is_some() {
+        return bad("--control-points sets the size of the QEM initial mesh; a curvature-line cage takes the control points its boundary curves need".into());
+    }
     if matches!(o.init, InitialCage::Given { .. }) && o.control_points.is_some() {
         return bad("--control-points sets the size of the automatic initial mesh; it cannot be used with --init FILE".into());
     }

@@ -195,7 +195,9 @@ def fit(
     **options
         The other flags of ``subfit fit``, same names and defaults: ``step`` ("lm", "armijo",
         "none"), ``control_points`` (initial cage size), ``as_points`` (ignore ``faces``),
-        ``init`` (a :class:`Surface`, :class:`Fit` or ``(vertices, faces)`` initial cage),
+        ``init`` (a :class:`Surface`, :class:`Fit` or ``(vertices, faces)`` initial cage, or how
+        to build one: ``"auto"``, ``"qem"``, ``"curvature-lines"`` — Lavoué et al.'s cage for an
+        open mesh of genus 0, with ``scheme="quad-tri"`` or ``"catmull-clark"``),
         ``lambda_start`` (1e-3, ``--lambda``), ``lambda_end``, ``sample_level`` (3),
         ``max_iterations`` (100), ``stage_iterations`` (6), ``one_sided`` (False),
         ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),
@@ -243,7 +245,9 @@ def fit(
     face_arrays = None if faces is None else faces_to_flat(faces)
     nrm = None if normals is None else as_float_rows("normals", normals)
     init = options.pop("init", None)
-    if init is not None:
+    if isinstance(init, str):
+        options["init_method"] = init
+    elif init is not None:
         if isinstance(init, (Surface, Fit)):
             iv, ifaces = init.vertices, init.faces
         elif isinstance(init, (tuple, list)) and len(init) == 2:

@@ -37,6 +37,7 @@ def fit(
     control_points: Optional[int] = None,
     as_points: bool = False,
     init: Optional[Tuple[F64, FaceArrays]] = None,
+    init_method: Optional[str] = None,
     lambda_start: float = 1e-3,
     lambda_end: Optional[float] = None,
     sample_level: int = 3,
