@@ -247,6 +247,22 @@ pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
             f.concave_sectors, f.concave_points
         ),
         _ => String::new(),
+    } + &match &i.curvature_lines {
+        Some(c) => match (c.used, c.alternative, &c.reason) {
+            (true, Some(q), _) => format!(
+                "; kept over the QEM start ({} → {} control points, {})",
+                q.initial_control_points,
+                q.control_points,
+                if q.tolerance_reached {
+                    "within the tolerances"
+                } else {
+                    "outside them"
+                }
+            ),
+            (false, _, Some(why)) => format!("; not the curvature-line start: {why}"),
+            _ => String::new(),
+        },
+        None => String::new(),
     }
 }
 
