@@ -280,7 +280,13 @@ fn curvature_lines(
         r.links,
         r.cuts
     );
-    out!("time: total {:.3} s", t0.elapsed().as_secs_f64());
+    out!(
+        "time: curves {:.3} s, links {:.3} s, cuts {:.3} s, total {:.3} s",
+        r.seconds.curves,
+        r.seconds.links,
+        r.seconds.cuts,
+        t0.elapsed().as_secs_f64()
+    );
     out!("wrote {}", a.output.display());
     Ok(ExitCode::SUCCESS)
 }

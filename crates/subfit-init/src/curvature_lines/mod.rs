@@ -51,7 +51,7 @@ use std::collections::{BinaryHeap, HashSet};
 use rayon::prelude::*;
 use subfit_mesh::vec3::{cross, dot, norm, sub};
 use subfit_mesh::{Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags, UnionFind, SHARPNESS_INFINITE};
-use subfit_target::{boundary_corners, Target};
+use subfit_target::{boundary_corners, SurfaceFrame, Target};
 
 use boundary_curve::fit_boundary_curve;
 use regions::{Path, Surface, NONE};
@@ -123,6 +123,20 @@ pub struct CurvatureLineReport {
     pub cuts: usize,
     /// Faces of the cage.
     pub faces: usize,
+    /// Seconds spent on the boundary curves, the links between loops (with the target
+    /// analysis of the paths) and the recursive cutting.
+    pub seconds: CurvatureLineTimes,
+}
+
+/// Wall-clock seconds per step of [`curvature_line_cage`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CurvatureLineTimes {
+    /// Boundary curves (§4.2).
+    pub curves: f64,
+    /// The mesh's half-edges and the links of the topological contour (§4.4).
+    pub links: f64,
+    /// Recursive cutting and facets (§4.4).
+    pub cuts: f64,
 }
 
 /// Why [`curvature_line_cage`] gave no cage.
@@ -195,6 +209,7 @@ pub fn curvature_line_cage(
     report.boundary_loops = bc.loops.len();
 
     // 1. Boundary curves: their control points are the cage's vertices.
+    let t = std::time::Instant::now();
     let mut cage = Vec::new();
     let mut tags = Tags::new();
     let mut id_at = vec![NONE; dense.positions.len()];
@@ -227,8 +242,10 @@ pub fn curvature_line_cage(
             allowed: options.max_control_points,
         });
     }
+    report.seconds.curves = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
     let mut surface = Surface::new(dense.positions.clone(), tris);
-    let scorer = Scorer::new(target, dense.positions.len());
+    let scorer = Scorer::new(target, &dense.positions);
 
     // 2–3. Link the loops into one contour.
     let loop_of: Vec<Vec<u32>> = bc
@@ -242,6 +259,9 @@ pub fn curvature_line_cage(
         })
         .collect();
     report.links = link_loops(&mut surface, &scorer, &loop_of, &id_at, &mut edges)?;
+
+    report.seconds.links = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
 
     // 4. Cut recursively; planar contours become facets.
     let mut faces: Vec<Vec<u32>> = Vec::new();
@@ -287,6 +307,7 @@ pub fn curvature_line_cage(
         });
     }
     report.faces = out.faces.len();
+    report.seconds.cuts = t.elapsed().as_secs_f64();
     Ok((out, tags, report))
 }
 
@@ -295,21 +316,28 @@ fn key(a: u32, b: u32) -> (u32, u32) {
 }
 
 /// Eq. 4 along target paths.
-struct Scorer<'a> {
-    target: &'a Target,
-    /// Per dense vertex: its target point (the target merges duplicates).
-    point_of: Vec<u32>,
+struct Scorer {
+    /// Per dense vertex: the principal frame of its target point (the target merges
+    /// duplicates; a vertex it does not know takes its nearest point's).
+    frames: Vec<SurfaceFrame>,
 }
 
-impl<'a> Scorer<'a> {
-    fn new(target: &'a Target, vertices: usize) -> Self {
+impl Scorer {
+    /// Evaluates the frames once (in parallel): a path's vertices are scored many times.
+    fn new(target: &Target, positions: &[[f64; 3]]) -> Self {
         let map = target.input_to_point();
-        let point_of = if map.len() == vertices {
-            map.to_vec()
-        } else {
-            Vec::new()
-        };
-        Self { target, point_of }
+        let frames = positions
+            .par_iter()
+            .enumerate()
+            .map(|(v, x)| {
+                let p = match map.get(v) {
+                    Some(&p) if map.len() == positions.len() => p as usize,
+                    _ => target.index().nearest(x).index as usize,
+                };
+                target.quadrics()[p].frame_at(0.0, 0.0)
+            })
+            .collect();
+        Self { frames }
     }
 
     /// `min(Σ θmin, Σ θmax) / n` in degrees over the path's vertices, against the segment
@@ -335,17 +363,8 @@ impl<'a> Scorer<'a> {
                 s2 += 90.0;
                 continue;
             }
-            let p = match self.point_of.get(v as usize) {
-                Some(&p) => p as usize,
-                None => {
-                    self.target
-                        .index()
-                        .nearest(&surface.positions[v as usize])
-                        .index as usize
-                }
-            };
-            let f = self.target.quadrics()[p].frame_at(0.0, 0.0);
-            let (t1, t2) = crate::quads::direction_angles(d, len, &f);
+            let f = &self.frames[v as usize];
+            let (t1, t2) = crate::quads::direction_angles(d, len, f);
             s1 += t1;
             s2 += t2;
         }
