@@ -166,6 +166,9 @@ pub enum CurvatureLineError {
     /// A contour could be neither cut nor made into facets (or the loops could not be linked).
     #[error("no legal cut of a contour of {0} control points")]
     Stuck(usize),
+    /// The cage came out not a manifold (a diagonal of a facet that another facet has too).
+    #[error("the cage came out not a manifold: {0}")]
+    Cage(String),
     /// The cage came out with another topology than the target's.
     #[error("the cage came out with genus {genus} and {loops} boundary loop(s)")]
     Result {
@@ -280,17 +283,34 @@ pub fn curvature_line_cage(
         let distinct = ids.iter().collect::<HashSet<_>>().len() == ids.len();
         let pts: Vec<[f64; 3]> = ids.iter().map(|&i| cage[i as usize]).collect();
         if distinct && (ids.len() <= 4 || planar(&pts, options.planar_tolerance)) {
-            faces.extend(facets(&pts, &ids));
-            continue;
+            let f = facets(&pts, &ids);
+            // A diagonal that is already an edge elsewhere would make it non-manifold: cut.
+            if inner_edges(&f, &ids).all(|e| !edges.contains(&e)) {
+                edges.extend(inner_edges(&f, &ids));
+                faces.extend(f);
+                continue;
+            }
         }
-        match best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage) {
+        // A contour through a control point twice (a link's end) must be cut: a sliver is
+        // better than no cage.
+        let cut =
+            best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage, false).or_else(|| {
+                (!distinct)
+                    .then(|| best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage, true))
+                    .flatten()
+            });
+        match cut {
             Some((new, a, b)) => {
                 edges.insert(key(a, b));
                 report.cuts += 1;
                 stack.push(r);
                 stack.push(new);
             }
-            None if distinct => faces.extend(facets(&pts, &ids)),
+            None if distinct => {
+                let f = facets(&pts, &ids);
+                edges.extend(inner_edges(&f, &ids));
+                faces.extend(f);
+            }
             None => return Err(CurvatureLineError::Stuck(ids.len())),
         }
     }
@@ -299,7 +319,7 @@ pub fn curvature_line_cage(
         polys.push(f);
     }
     let out = PolyMesh::new(cage, polys);
-    let he = HalfEdgeMesh::from_mesh(&out).map_err(|e| CurvatureLineError::Mesh(e.to_string()))?;
+    let he = HalfEdgeMesh::from_mesh(&out).map_err(|e| CurvatureLineError::Cage(e.to_string()))?;
     if he.genus() != 0 || he.boundary_loops().len() != loops {
         return Err(CurvatureLineError::Result {
             genus: he.genus(),
@@ -513,8 +533,10 @@ impl Ord for Candidate {
 
 /// Cuts region `r` (contour control points `occ`, mesh vertices in walk order) along its
 /// best-scored legal edge: non-adjacent in the contour, two different control points not yet
-/// joined by an edge, a path off the border. Returns the new region and the edge's control
-/// points, or `None` when no candidate cuts.
+/// joined by an edge, a path off the border, no sliver on either side unless
+/// `allow_slivers`. Returns the new region and the edge's control points, or `None` when no
+/// candidate cuts.
+#[allow(clippy::too_many_arguments)]
 fn best_cut(
     surface: &mut Surface,
     scorer: &Scorer,
@@ -523,6 +545,7 @@ fn best_cut(
     id_at: &[u32],
     edges: &HashSet<(u32, u32)>,
     cage: &[[f64; 3]],
+    allow_slivers: bool,
 ) -> Option<(u32, u32, u32)> {
     let k = occ.len();
     let at = |o: usize| cage[id_at[occ[o] as usize] as usize];
@@ -545,9 +568,10 @@ fn best_cut(
                         }
                         // Neither side may be a sliver along the chord.
                         let sides = [(i..=j).collect::<Vec<_>>(), (j..k).chain(0..=i).collect()];
-                        if sides
-                            .iter()
-                            .any(|side| sliver(side.iter().map(|&o| at(o)), at(i), at(j)))
+                        if !allow_slivers
+                            && sides
+                                .iter()
+                                .any(|side| sliver(side.iter().map(|&o| at(o)), at(i), at(j)))
                         {
                             return None;
                         }
@@ -611,6 +635,18 @@ fn planar(pts: &[[f64; 3]], tolerance: f64) -> bool {
         .fold(0.0, f64::max);
     pts.iter()
         .all(|p| dot(sub(*p, c), normal).abs() <= tolerance * diameter)
+}
+
+/// The edges of `faces` (control point ids) that are not sides of the contour `ids` (its
+/// consecutive pairs): the diagonals the facets add.
+fn inner_edges<'a>(faces: &'a [Vec<u32>], ids: &[u32]) -> impl Iterator<Item = (u32, u32)> + 'a {
+    let sides: HashSet<(u32, u32)> = (0..ids.len())
+        .map(|i| key(ids[i], ids[(i + 1) % ids.len()]))
+        .collect();
+    faces
+        .iter()
+        .flat_map(|f| (0..f.len()).map(move |i| key(f[i], f[(i + 1) % f.len()])))
+        .filter(move |e| !sides.contains(e))
 }
 
 /// The facets of a contour of distinct control points `ids` at `pts`: convex pieces
