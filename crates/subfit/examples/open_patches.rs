@@ -7,8 +7,10 @@
 //! ```
 //!
 //! * `plate_hole.obj`: the square `[-1, 1]²` bent to `z = 0.25 x² − 0.1 y² + 0.1 x y` with a
-//!   round hole of radius 0.35 in the middle: 38 rings of 25 vertices between the hole and the
-//!   square's edge (950 vertices, as the paper's Fig. 12a); two boundary loops.
+//!   round hole of radius 0.35 in the middle: 40 rays of 25 vertices from the hole to the
+//!   square's edge (1,000 vertices; the paper's Fig. 12a has 950), rays every 9° so that the
+//!   square's corners are vertices (with 38 rays the corners were cut off by a chord between
+//!   two 45° turns, too gentle to be taken for corners); two boundary loops.
 //! * `half_cylinder.obj`: half of a cylinder of radius 0.5 and length 1, 18 × 18 vertices (324,
 //!   as Fig. 12b); one boundary loop with four corners.
 //! * `saddle.obj`: `z = 0.3 (x² − y²)` over `[-1, 1]²`, 13 × 13 vertices (169, as Fig. 12c's
@@ -62,7 +64,7 @@ fn unit_cube(mut m: PolyMesh) -> PolyMesh {
 
 /// The bent square plate with a round hole (see the module docs).
 fn plate_with_hole() -> PolyMesh {
-    grid(38, 25, true, |u, v| {
+    grid(40, 25, true, |u, v| {
         let t = std::f64::consts::TAU * u;
         let (c, s) = (t.cos(), t.sin());
         // Where the ray from the centre at angle t leaves the square [-1, 1]².
