@@ -130,32 +130,7 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     })?;
 
     let t = Instant::now();
-    let out = PolyMesh::new(
-        cage.positions
-            .iter()
-            .map(|&p| target.to_original(p))
-            .collect(),
-        cage.faces.clone(),
-    );
-    let wopts = WriteOptions {
-        format: None,
-        encoding: Encoding::Ascii,
-        single_precision: false,
-    };
-    crate::interrupt::watch_dir(&a.output);
-    if subfit::io::Format::from_path(&a.output) == Some(subfit::io::Format::Obj) {
-        subfit::io::write_obj_with_tags_file(&a.output, &out, &report.tags)?;
-    } else {
-        if !report.tags.is_empty() {
-            eprintln!(
-                "subfit: warning: {} has no place for the cage's {} crease and {} corner tags (write .obj to keep them)",
-                a.output.display(),
-                report.tags.creases().len(),
-                report.tags.corners().len()
-            );
-        }
-        subfit::io::write_file(&a.output, &out, &wopts)?;
-    }
+    let out = write_cage(&a, &target, &cage, &report.tags)?;
     let write_time = t.elapsed();
 
     print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
@@ -240,29 +215,7 @@ fn curvature_lines(
             a.target.display()
         )
     })?;
-    let out = PolyMesh::new(
-        cage.positions
-            .iter()
-            .map(|&p| target.to_original(p))
-            .collect(),
-        cage.faces.clone(),
-    );
-    crate::interrupt::watch_dir(&a.output);
-    if Format::from_path(&a.output) == Some(Format::Obj) {
-        subfit::io::write_obj_with_tags_file(&a.output, &out, &tags)?;
-    } else {
-        eprintln!(
-            "subfit: warning: {} has no place for the cage's {} corner tags (write .obj to keep them)",
-            a.output.display(),
-            tags.corners().len()
-        );
-        let wopts = WriteOptions {
-            format: None,
-            encoding: Encoding::Ascii,
-            single_precision: false,
-        };
-        subfit::io::write_file(&a.output, &out, &wopts)?;
-    }
+    let out = write_cage(a, target, &cage, &tags)?;
     let quads = out.faces.iter().filter(|f| f.len() == 4).count();
     out!(
         "boundary curves: {} loop(s), control points {:?}, {} corner(s), largest distance of a boundary vertex {:.2e} unit cube",
@@ -289,6 +242,43 @@ fn curvature_lines(
     );
     out!("wrote {}", a.output.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `cage` (normalized units) in the target's coordinates to `a.output`, with its tags
+/// into an .obj (another format has no place for them: a warning); returns what was written.
+fn write_cage(
+    a: &InitArgs,
+    target: &Target,
+    cage: &PolyMesh,
+    tags: &subfit::mesh::Tags,
+) -> anyhow::Result<PolyMesh> {
+    let out = PolyMesh::new(
+        cage.positions
+            .iter()
+            .map(|&p| target.to_original(p))
+            .collect(),
+        cage.faces.clone(),
+    );
+    crate::interrupt::watch_dir(&a.output);
+    if Format::from_path(&a.output) == Some(Format::Obj) {
+        subfit::io::write_obj_with_tags_file(&a.output, &out, tags)?;
+    } else {
+        if !tags.is_empty() {
+            eprintln!(
+                "subfit: warning: {} has no place for the cage's {} crease and {} corner tags (write .obj to keep them)",
+                a.output.display(),
+                tags.creases().len(),
+                tags.corners().len()
+            );
+        }
+        let wopts = WriteOptions {
+            format: None,
+            encoding: Encoding::Ascii,
+            single_precision: false,
+        };
+        subfit::io::write_file(&a.output, &out, &wopts)?;
+    }
+    Ok(out)
 }
 
 fn print_summary(

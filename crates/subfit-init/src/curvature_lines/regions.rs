@@ -178,6 +178,27 @@ impl Surface {
         (walk.len() == total).then_some(walk)
     }
 
+    /// The edges of `region` at `u` that are not border: `(neighbour, edge, length)`.
+    fn inner_edges(&self, region: u32, u: u32) -> impl Iterator<Item = (u32, u32, f64)> + '_ {
+        let (lo, hi) = (
+            self.offsets[u as usize] as usize,
+            self.offsets[u as usize + 1] as usize,
+        );
+        self.adjacent[lo..hi]
+            .iter()
+            .filter(move |&&(_, e)| {
+                !self.border[e as usize]
+                    && self.label[self.edge_face[e as usize] as usize] == region
+            })
+            .map(move |&(w, e)| {
+                (
+                    w,
+                    e,
+                    dist2(self.positions[u as usize], self.positions[w as usize]).sqrt(),
+                )
+            })
+    }
+
     /// Dijkstra in `region` from `source` (a border vertex): shortest edge paths whose inner
     /// vertices are off the border, ending at border vertices. Fills `dist` and `pred`
     /// (per vertex: distance and `(previous vertex, edge)`; `dist` must come in all infinite,
@@ -202,17 +223,8 @@ impl Surface {
             if u != source && self.on_border[u as usize] {
                 continue;
             }
-            let (lo, hi) = (
-                self.offsets[u as usize] as usize,
-                self.offsets[u as usize + 1] as usize,
-            );
-            for &(w, e) in &self.adjacent[lo..hi] {
-                if self.border[e as usize]
-                    || self.label[self.edge_face[e as usize] as usize] != region
-                {
-                    continue;
-                }
-                let nd = d + dist2(self.positions[u as usize], self.positions[w as usize]).sqrt();
+            for (w, e, len) in self.inner_edges(region, u) {
+                let nd = d + len;
                 if nd < dist[w as usize] {
                     if dist[w as usize].is_infinite() {
                         touched.push(w);
@@ -243,17 +255,8 @@ impl Surface {
             if d > dist[u as usize] {
                 continue;
             }
-            let (lo, hi) = (
-                self.offsets[u as usize] as usize,
-                self.offsets[u as usize + 1] as usize,
-            );
-            for &(w, e) in &self.adjacent[lo..hi] {
-                if self.border[e as usize]
-                    || self.label[self.edge_face[e as usize] as usize] != region
-                {
-                    continue;
-                }
-                let nd = d + dist2(self.positions[u as usize], self.positions[w as usize]).sqrt();
+            for (w, _, len) in self.inner_edges(region, u) {
+                let nd = d + len;
                 if nd < dist[w as usize] {
                     dist[w as usize] = nd;
                     heap.push(Entry(nd, w));
