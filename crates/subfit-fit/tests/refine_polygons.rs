@@ -490,3 +490,29 @@ fn small_triangle_clusters_split_into_quads_large_ones_are_bisected() {
     assert_eq!(r.stats.red, 1, "only the marked quad is split fully");
     assert_eq!(r.stats.new_points, 5);
 }
+
+/// The quad/triangle scheme refines a triangle-dominant cage with its own split (four
+/// triangles, Loop's), so an all-triangle cage refines exactly as under Loop; a quad-dominant
+/// cage splits its triangles into three quads and stays quad-dominant.
+#[test]
+fn quad_triangle_refinement_follows_the_cage() {
+    let tris = torus_mesh(1.0, 0.4, 8, 6, true);
+    let qt = Options::new(Scheme::QuadTriangle);
+    for seed in 0..4 {
+        let marked = random_marks(tris.faces.len(), 0.3, seed);
+        let a = refine_polygons(&tris, &Tags::new(), &marked, &qt).unwrap();
+        let b = refine_polygons(&tris, &Tags::new(), &marked, &Options::new(Scheme::Loop)).unwrap();
+        assert_conforming(&tris, &a, "triangle torus");
+        assert!(a.mesh.faces.is_triangles(), "seed {seed}");
+        assert_eq!(a.mesh.faces, b.mesh.faces, "seed {seed}");
+        for (p, q) in a.mesh.positions.iter().zip(&b.mesh.positions) {
+            let d = (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max);
+            assert!(d < 1e-12, "seed {seed}: {p:?} vs {q:?}");
+        }
+    }
+    let mixed = mixed_torus();
+    assert!(quad_fraction(&mixed) >= 0.5);
+    let r = refine_polygons(&mixed, &Tags::new(), &vec![true; mixed.faces.len()], &qt).unwrap();
+    assert_conforming(&mixed, &r, "mixed torus");
+    assert_eq!(quad_fraction(&r.mesh), 1.0);
+}
