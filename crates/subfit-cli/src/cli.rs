@@ -350,7 +350,10 @@ pub struct FitArgs {
     /// Error that maps to red in error.ply (unit-cube units) [default: the final E_max].
     #[arg(long)]
     pub error_scale: Option<f64>,
-    /// Subdivision scheme; `auto` picks Loop for all-triangle meshes, Catmull-Clark otherwise.
+    /// Subdivision scheme; `auto`: the quad/triangle scheme for an open mesh target (unless the
+    /// cage is given; on the automatic cage's triangles it is Loop, and the curvature-line start
+    /// brings quads; control.usda is then written as Loop when the cage has no quads), Loop for
+    /// other all-triangle cages, Catmull-Clark otherwise.
     #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
     pub scheme: SchemeArg,
     /// Pair the cage's triangles into quads along the target's principal curvature directions

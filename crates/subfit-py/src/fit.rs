@@ -177,7 +177,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
 /// Runs the pipeline on arrays (see the Python `subfit.fit` for the documented API).
 #[pyfunction]
 #[pyo3(signature = (
-    points, faces=None, normals=None, *, scheme="loop", method="sdm", step="lm",
+    points, faces=None, normals=None, *, scheme="auto", method="sdm", step="lm",
     tolerance=None, max_error=None, max_control_points=None, control_points=None,
     as_points=false, init=None, init_method=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,

@@ -113,7 +113,10 @@ pub fn write(
         let scheme = match scheme.to_ascii_lowercase().as_str() {
             "loop" => UsdScheme::Loop,
             "catmull-clark" | "catmull_clark" | "catmullclark" | "cc" => UsdScheme::CatmullClark,
-            "quad-tri" | "quad_tri" | "quadtriangle" | "quad-triangle" => UsdScheme::QuadTriangle,
+            // As the CLI writes it: Loop when the cage has no quads (the same surface).
+            "quad-tri" | "quad_tri" | "quadtriangle" | "quad-triangle" => {
+                subfit::usd_scheme(subfit::subdiv::Scheme::QuadTriangle, &mesh.faces)
+            }
             "none" => UsdScheme::None,
             _ => {
                 return Err(value_error(format!(

@@ -41,7 +41,7 @@ pub mod tolerance;
 pub use budget_starts::BUDGET_STARTS;
 pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
-pub use outputs::{log_csv, OUTPUTS};
+pub use outputs::{log_csv, usd_scheme, OUTPUTS};
 pub use pipeline_report::Report;
 pub use repair::repair_mesh;
 pub use scan::{

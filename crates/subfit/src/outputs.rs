@@ -13,7 +13,7 @@ use subfit_fit::StagesReport;
 use subfit_io::ply::VertexProperty;
 use subfit_io::usda::{UsdBoundary, UsdScheme};
 use subfit_io::{Encoding, WriteOptions};
-use subfit_mesh::PolyMesh;
+use subfit_mesh::{PolyMesh, Polygons};
 use subfit_report::error_color;
 use subfit_subdiv::{BoundaryRule, Scheme};
 
@@ -46,7 +46,7 @@ impl Fitted {
         let check = || self.cancel.check().map_err(|_| Error::Interrupted);
         check()?;
         subfit_io::write_obj_with_tags_file(&dir.join("control.obj"), &self.cage, &self.tags)?;
-        let usd_scheme = usd_scheme(self.scheme);
+        let usd_scheme = usd_scheme(self.scheme, &self.cage.faces);
         let usd_boundary = usd_boundary(self.fit.boundary);
         check()?;
         subfit_io::write_usda_file(
@@ -231,11 +231,16 @@ pub fn log_csv(r: &StagesReport) -> String {
     s
 }
 
-/// The USD `subdivisionScheme` a cage of `scheme` is written with.
-pub(crate) fn usd_scheme(scheme: Scheme) -> UsdScheme {
+/// The USD `subdivisionScheme` a cage of `scheme` with `faces` is written with. A
+/// quad/triangle cage of triangles only is written as `loop`: on triangles the scheme is Loop
+/// (Stam & Loop 2003; checked against OpenSubdiv's Loop in `subfit-subdiv`'s golden tests), so
+/// USD shows the fitted surface exactly, where USD's nearest scheme for quads and triangles
+/// together (Catmull-Clark with the smooth triangle rule) would not.
+pub fn usd_scheme(scheme: Scheme, faces: &Polygons) -> UsdScheme {
     match scheme {
         Scheme::Loop => UsdScheme::Loop,
         Scheme::CatmullClark => UsdScheme::CatmullClark,
+        Scheme::QuadTriangle if faces.is_triangles() => UsdScheme::Loop,
         Scheme::QuadTriangle => UsdScheme::QuadTriangle,
     }
 }

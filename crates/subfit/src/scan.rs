@@ -17,11 +17,13 @@ use subfit_fit::{
     StageEvent, StageOptions, StageReport, StagesResult,
 };
 use subfit_init::{default_control_points, initial_control_mesh, InitOptions, SimplifyOptions};
+use subfit_io::usda::UsdScheme;
 use subfit_mesh::{Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::{FeatureOptions, Target, TargetOptions};
 
 use crate::error::Error;
+use crate::outputs::usd_scheme;
 use crate::tolerance::{
     edge_count, noise_floored, target_tolerances, with_sampling_margin, ToleranceKind,
     NOISE_FLOOR_FACTOR, SCAN_RMS,
@@ -90,8 +92,10 @@ pub struct FitScanOptions {
     /// Ignore the target's faces and fit its points (and normals), as for a scan; the faces'
     /// genus still tells the initial mesh what to aim for. Default false.
     pub as_points: bool,
-    /// Subdivision scheme; `None` (default): Loop for an all-triangle cage, Catmull-Clark
-    /// otherwise.
+    /// Subdivision scheme; `None` (default): for an all-triangle cage the quad/triangle scheme
+    /// when the target is an open mesh and the cage is not given (Lavoué et al.; on triangles
+    /// it is Loop), Loop otherwise; Catmull-Clark for other cages, and quad/triangle for the
+    /// curvature-line start.
     pub scheme: Option<Scheme>,
     /// Pair the triangles of the initial cage into quads before the fit
     /// ([`subfit_init::pair_triangles`]: a quad-dominant cage along the target's principal
@@ -467,7 +471,15 @@ pub(crate) fn fit_scan_from(
             // Lavoué's cages are quad/triangle.
             Scheme::QuadTriangle
         } else if control.faces.is_triangles() {
-            Scheme::Loop
+            // Open mesh targets take the quad/triangle scheme (Lavoué et al.), whose quads come
+            // from the start (the curvature-line cage); on the triangles of an automatic cage
+            // it is Loop, refined as Loop ([`subfit_fit::TriangleSplit::for_cage`]).
+            let open_mesh = target_topology.is_some_and(|t| t.boundary_loops > 0);
+            if open_mesh && !matches!(options.init, InitialCage::Given { .. }) {
+                Scheme::QuadTriangle
+            } else {
+                Scheme::Loop
+            }
         } else {
             Scheme::CatmullClark
         });
@@ -570,7 +582,7 @@ pub(crate) fn fit_scan_from(
         ),
         data_to_surface: DistanceStats::of(&to_surface),
     };
-    let usd_difference = if scheme == Scheme::QuadTriangle {
+    let usd_difference = if usd_scheme(scheme, &result.mesh.faces) == UsdScheme::QuadTriangle {
         let d = usd_difference(
             &result.mesh,
             &result.tags,

@@ -909,7 +909,7 @@ impl Sequence {
             &self.faces,
             &self.positions,
             &self.tags,
-            crate::outputs::usd_scheme(self.scheme),
+            crate::outputs::usd_scheme(self.scheme, &self.faces),
             crate::outputs::usd_boundary(self.boundary),
             fps,
         )?;
@@ -926,7 +926,7 @@ impl Sequence {
             &self.faces,
             &self.positions,
             &self.tags,
-            crate::outputs::usd_scheme(self.scheme),
+            crate::outputs::usd_scheme(self.scheme, &self.faces),
             crate::outputs::usd_boundary(self.boundary),
             fps,
             &mut out,

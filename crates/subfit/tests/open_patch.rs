@@ -182,3 +182,33 @@ fn a_half_cylinder_keeps_the_curvature_line_start_and_its_corners() {
     assert_eq!((r.init.genus, r.init.boundary_loops.cage), (0, 1));
     assert!(gap < 0.004, "the rim misses the data's edge by {gap:.2e}");
 }
+
+#[test]
+fn an_open_mesh_gets_the_quad_triangle_scheme_which_on_triangles_is_loop() {
+    // The default scheme of an open mesh target is Lavoué et al.'s quad/triangle; the QEM
+    // start is all triangles, where the scheme and its refinement are Loop's: the same fit,
+    // and control.usda declares Loop (the surface USD shows is the fitted one).
+    let data = spherical_cap(48);
+    let fit = |scheme| {
+        let options = FitScanOptions {
+            init: subfit::InitialCage::Qem,
+            scheme,
+            ..FitScanOptions::default()
+        };
+        fit_and_gap("cap", &data, &options).0
+    };
+    let auto = fit(None);
+    let then_loop = fit(Some(subfit::subdiv::Scheme::Loop));
+    assert_eq!(auto.scheme, subfit::subdiv::Scheme::QuadTriangle);
+    assert!(auto.cage.faces.is_triangles());
+    assert_eq!(auto.cage.faces, then_loop.cage.faces);
+    for (p, q) in auto.cage.positions.iter().zip(&then_loop.cage.positions) {
+        let d = (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max);
+        assert!(d < 1e-9, "{p:?} vs {q:?}");
+    }
+    assert_eq!(
+        subfit::usd_scheme(auto.scheme, &auto.cage.faces),
+        subfit::io::usda::UsdScheme::Loop
+    );
+    assert!(auto.report.usd_difference.is_none());
+}

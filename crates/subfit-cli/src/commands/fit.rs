@@ -266,11 +266,12 @@ pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
     }
 }
 
-/// Blender subdivides Catmull-Clark meshes only: says so when a Loop cage is written.
+/// Blender subdivides Catmull-Clark meshes only: says so when a cage is written as Loop (a
+/// Loop cage, or a quad/triangle cage of triangles only).
 pub fn blender_hint(fitted: &Fitted) {
-    if fitted.scheme == Scheme::Loop {
+    if subfit::usd_scheme(fitted.scheme, &fitted.cage.faces) == subfit::io::usda::UsdScheme::Loop {
         eprintln!(
-            "subfit: hint: Blender subdivides only Catmull-Clark cages; this Loop cage's control.usda imports into Blender as a plain mesh (usdview, Houdini and OpenSubdiv show its Loop limit surface). Use --scheme catmull-clark for Blender."
+            "subfit: hint: Blender subdivides only Catmull-Clark cages; this cage's control.usda declares the Loop scheme and imports into Blender as a plain mesh (usdview, Houdini and OpenSubdiv show its limit surface). Use --scheme catmull-clark for Blender."
         );
     }
 }

@@ -147,7 +147,7 @@ def fit(
     *,
     faces: Optional[FacesLike] = None,
     normals: Optional[npt.ArrayLike] = None,
-    scheme: str = "loop",
+    scheme: str = "auto",
     method: str = "sdm",
     tolerance: Optional[float] = None,
     max_error: Optional[float] = None,
@@ -173,7 +173,9 @@ def fit(
     normals : (n, 3) array_like of float, optional
         Normals of the points (orientation hints; estimated when absent).
     scheme : {"loop", "catmull-clark", "quad-tri", "auto"}
-        Subdivision scheme (``auto``: Loop for an all-triangle cage).
+        Subdivision scheme (``auto``, as ``subfit fit``: the quad/triangle scheme for an open
+        mesh target, which is Loop on the automatic cage's triangles and gets quads from the
+        curvature-line start; Loop for other all-triangle cages, Catmull-Clark otherwise).
     method : {"sdm", "tdm", "pdm"}
         Error term (Cheng et al. 2007): squared, tangent or point distance minimization.
     tolerance : float, optional
@@ -197,7 +199,8 @@ def fit(
         "none"), ``control_points`` (initial cage size), ``as_points`` (ignore ``faces``),
         ``init`` (a :class:`Surface`, :class:`Fit` or ``(vertices, faces)`` initial cage, or how
         to build one: ``"auto"``, ``"qem"``, ``"curvature-lines"`` — Lavoué et al.'s cage for an
-        open mesh of genus 0, with ``scheme="quad-tri"`` or ``"catmull-clark"``),
+        open mesh of genus 0, fitted with the quad/triangle scheme unless ``scheme`` is
+        ``"catmull-clark"``; ``"auto"`` also tries it on small open meshes, as ``subfit fit``),
         ``lambda_start`` (1e-3, ``--lambda``), ``lambda_end``, ``sample_level`` (3),
         ``max_iterations`` (100), ``stage_iterations`` (6), ``one_sided`` (False),
         ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),

@@ -59,8 +59,9 @@ def write(
 
     The format comes from the extension: ``.ply`` (``binary=True`` for little-endian binary),
     ``.obj``, ``.off``, ``.stl`` (``binary=True`` for binary), ``.xyz``/``.pts``, or ``.usda``:
-    a USD subdivision cage with ``scheme`` (``"loop"``, ``"catmull-clark"``, ``"quad-tri"``, ``"none"``),
-    crease/corner ``tags`` (see :class:`subfit.Surface`) and ``boundary`` interpolation
+    a USD subdivision cage with ``scheme`` (``"loop"``, ``"catmull-clark"``, ``"quad-tri"``, ``"none"``;
+    USD has no quad/triangle scheme: such a cage is written as ``catmullClark`` with the smooth
+    triangle rule, or as ``loop``, the same surface, when it has no quads), crease/corner ``tags`` (see :class:`subfit.Surface`) and ``boundary`` interpolation
     (``"edge-only"`` or ``"edge-and-corner"``). ``vertices`` ``(n, 3)``, ``normals``
     ``(n, 3)``, ``colors`` ``(n, 3)`` uint8.
     """
