@@ -228,7 +228,8 @@ impl Lcg {
 /// from 2 × 2 vertices up, holes punched at random (several loops, loops one triangle apart,
 /// strips one triangle wide), noise. Each gives a cage of the target's topology or an error —
 /// never a panic, never a face with a repeated vertex. (3,000 cases of this generator ran
-/// clean, 1,882 of them giving cages; the test keeps 60.)
+/// clean, 1,886 of them giving cages, 4 more than before contours whose convex pieces would
+/// repeat an edge were closed by a fan; the test keeps 60.)
 #[test]
 fn awkward_open_patches_give_a_cage_or_an_error() {
     let mut rng = Lcg(7);

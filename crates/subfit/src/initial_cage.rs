@@ -241,6 +241,7 @@ pub(crate) fn curvature_line_start(
         curve_max_error: r.curve_max_error / diagonal,
         links: r.links,
         cuts: r.cuts,
+        fans: r.fans,
         alternative: None,
     };
     let (quads, triangles, quad_fraction) = face_counts(&cage.faces);

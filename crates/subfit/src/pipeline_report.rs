@@ -195,6 +195,9 @@ pub struct CurvatureLineSummary {
     pub links: usize,
     /// Cuts along lines of curvature.
     pub cuts: usize,
+    /// Contours closed by a fan where no cut was legal
+    /// ([`subfit_init::curvature_lines::CurvatureLineReport::fans`]).
+    pub fans: usize,
     /// Under `--init auto`, what the other start gave (QEM when this one was kept, this one
     /// when QEM was). `None` when only one start was fitted.
     pub alternative: Option<InitAlternative>,

@@ -225,13 +225,14 @@ fn curvature_lines(
         r.curve_max_error
     );
     out!(
-        "cage: {} vertices, {} faces ({quads} quads, {} triangles, {} larger), {} link(s) between loops, {} cut(s) along curvature lines",
+        "cage: {} vertices, {} faces ({quads} quads, {} triangles, {} larger), {} link(s) between loops, {} cut(s) along curvature lines, {} fan(s)",
         out.num_vertices(),
         out.num_faces(),
         out.faces.iter().filter(|f| f.len() == 3).count(),
         out.faces.iter().filter(|f| f.len() > 4).count(),
         r.links,
-        r.cuts
+        r.cuts,
+        r.fans
     );
     out!(
         "time: curves {:.3} s, links {:.3} s, cuts {:.3} s, total {:.3} s",

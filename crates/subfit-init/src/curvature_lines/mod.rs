@@ -36,7 +36,9 @@
 //! leaves one side a sliver along it is refused ([`SLIVER_RATIO`]); between equal scores the
 //! cut that halves the contour is preferred ([`BALANCE_DEGREES`]); a target of genus above 0 or
 //! in several pieces is refused ([`CurvatureLineError::Topology`]): the topological contour of
-//! §4.4 is a disc only for a sphere with holes.
+//! §4.4 is a disc only for a sphere with holes; a contour with no legal cut whose convex
+//! pieces would repeat an edge of the cage (a narrow band between two holes: the armadillo with
+//! 27 holes had one) is closed by a fan of quads from a control point whose diagonals are new.
 //!
 //! Cost: the curve fits near-linear in the boundary vertices; one Dijkstra per control point of
 //! a contour, over the contour's region (`O(R log R)`), per cut; the cut regions shrink, so
@@ -121,6 +123,9 @@ pub struct CurvatureLineReport {
     pub links: usize,
     /// Cuts of the recursive cutting.
     pub cuts: usize,
+    /// Contours closed by a fan because no cut was legal and their convex pieces would have
+    /// repeated an edge of the cage (narrow bands between holes).
+    pub fans: usize,
     /// Faces of the cage.
     pub faces: usize,
     /// Seconds spent on the boundary curves, the links between loops (with the target
@@ -291,27 +296,38 @@ pub fn curvature_line_cage(
                 continue;
             }
         }
-        // A contour through a control point twice (a link's end) must be cut: a sliver is
-        // better than no cage.
+        // A contour through a control point twice (a link's end), or whose facets would add
+        // an edge the cage has elsewhere, must be cut: a sliver is better than no cage.
+        let f = distinct.then(|| facets(&pts, &ids));
+        let closes = f
+            .as_ref()
+            .is_some_and(|f| inner_edges(f, &ids).all(|e| !edges.contains(&e)));
         let cut =
             best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage, false).or_else(|| {
-                (!distinct)
+                (!closes)
                     .then(|| best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage, true))
                     .flatten()
             });
-        match cut {
-            Some((new, a, b)) => {
+        match (cut, f) {
+            (Some((new, a, b)), _) => {
                 edges.insert(key(a, b));
                 report.cuts += 1;
                 stack.push(r);
                 stack.push(new);
             }
-            None if distinct => {
-                let f = facets(&pts, &ids);
+            (None, Some(f)) if closes => {
                 edges.extend(inner_edges(&f, &ids));
                 faces.extend(f);
             }
-            None => return Err(CurvatureLineError::Stuck(ids.len())),
+            (None, Some(_)) => {
+                // No cut, and the convex pieces would repeat an edge: a fan from a control
+                // point none of whose diagonals is an edge yet.
+                let f = fan(&ids, &edges).ok_or(CurvatureLineError::Stuck(ids.len()))?;
+                report.fans += 1;
+                edges.extend(inner_edges(&f, &ids));
+                faces.extend(f);
+            }
+            (None, None) => return Err(CurvatureLineError::Stuck(ids.len())),
         }
     }
     let mut polys = Polygons::new();
@@ -647,6 +663,26 @@ fn inner_edges<'a>(faces: &'a [Vec<u32>], ids: &[u32]) -> impl Iterator<Item = (
         .iter()
         .flat_map(|f| (0..f.len()).map(move |i| key(f[i], f[(i + 1) % f.len()])))
         .filter(move |e| !sides.contains(e))
+}
+
+/// A fan of quads (and one triangle for an odd count) over the contour `ids` (distinct control
+/// points) from the first of its points whose diagonals are not yet `edges`, or `None`.
+fn fan(ids: &[u32], edges: &HashSet<(u32, u32)>) -> Option<Vec<Vec<u32>>> {
+    let n = ids.len();
+    let at = |i: usize, k: usize| ids[(i + k) % n];
+    let i = (0..n).find(|&i| (2..n - 1).all(|k| !edges.contains(&key(at(i, 0), at(i, k)))))?;
+    let mut out = Vec::new();
+    let mut k = 1;
+    while k + 1 < n {
+        if k + 3 <= n {
+            out.push(vec![at(i, 0), at(i, k), at(i, k + 1), at(i, k + 2)]);
+            k += 2;
+        } else {
+            out.push(vec![at(i, 0), at(i, k), at(i, k + 1)]);
+            k += 1;
+        }
+    }
+    Some(out)
 }
 
 /// The facets of a contour of distinct control points `ids` at `pts`: convex pieces
