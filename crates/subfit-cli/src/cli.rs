@@ -347,6 +347,18 @@ pub struct FitArgs {
     /// Rings of faces around the refined region that `--local` also optimizes.
     #[arg(long, default_value_t = 2, requires = "local")]
     pub local_rings: u32,
+    /// Local enrichment (Lavoué et al. 2005 §5.2): an error field (the worst face and the faces
+    /// around it above half its error) of which fewer than `--local-field-share` of the error
+    /// points are at least this fraction of its maximum is a local peak: its faces are merged
+    /// and one control point is added, where the faces of a diffuse field are split.
+    #[arg(long, default_value_t = 0.8, value_parser = local_field_peak)]
+    pub local_field_peak: f64,
+    /// The share of an error field's points close to its maximum below which it is local
+    /// (Lavoué et al.: 50 %); 0 turns local enrichment off. Fields are enriched locally only
+    /// once the RMS tolerance is met, inside the cage (not on its rim) and not around a point
+    /// added so before.
+    #[arg(long, default_value_t = 0.5, value_parser = unit_interval)]
+    pub local_field_share: f64,
     /// Error that maps to red in error.ply (unit-cube units) [default: the final E_max].
     #[arg(long)]
     pub error_scale: Option<f64>,
@@ -735,6 +747,24 @@ pub enum EncodingArg {
 }
 
 /// `--polish-power`: a number in [2, 8].
+fn local_field_peak(s: &str) -> Result<f64, String> {
+    let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if p > 0.5 && p <= 1.0 {
+        Ok(p)
+    } else {
+        Err(format!("{p} is not in (0.5, 1]"))
+    }
+}
+
+fn unit_interval(s: &str) -> Result<f64, String> {
+    let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if (0.0..=1.0).contains(&p) {
+        Ok(p)
+    } else {
+        Err(format!("{p} is not in [0, 1]"))
+    }
+}
+
 fn polish_power(s: &str) -> Result<f64, String> {
     let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
     if (2.0..=8.0).contains(&p) {

@@ -37,60 +37,88 @@ pub const FIELD_THRESHOLD: f64 = 0.5;
 /// faces are split after the field's own when the budget cannot take all.
 const RING_SCORE: f64 = 1e-3;
 
-/// Per face, its score from the error fields around the faces whose largest error (`max`,
-/// normalized units) is above `tolerance_max`: `max_f / (FIELD_THRESHOLD · seed max)` for a
-/// face of a field (≥ 1), just above 1 for a face sharing a vertex with one (the ring), 0 for
-/// the others. `max` has one entry per face of `faces`, on
-/// `num_vertices` vertices.
-pub fn field_scores(
+/// One principal error field: its faces (the seed first) and the seed's largest error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ErrorField {
+    /// The faces of the field, the seed first.
+    pub faces: Vec<u32>,
+    /// The seed face's largest error (Lavoué et al.'s `d_max`).
+    pub seed_max: f64,
+}
+
+/// The faces around each vertex (CSR).
+pub(crate) struct VertexFaces {
+    start: Vec<usize>,
+    around: Vec<u32>,
+}
+
+impl VertexFaces {
+    pub(crate) fn new(faces: &Polygons, num_vertices: usize) -> Self {
+        let mut start = vec![0usize; num_vertices + 1];
+        for f in faces.iter() {
+            for &v in f {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..num_vertices {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut around = vec![0u32; start[num_vertices]];
+        for (fi, f) in faces.iter().enumerate() {
+            for &v in f {
+                around[fill[v as usize]] = fi as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Self { start, around }
+    }
+
+    /// The faces with a corner at `v`.
+    pub(crate) fn of(&self, v: u32) -> &[u32] {
+        &self.around[self.start[v as usize]..self.start[v as usize + 1]]
+    }
+}
+
+/// The error fields around the faces whose largest error (`max`, normalized units, one entry
+/// per face of `faces` on `num_vertices` vertices) is above `tolerance_max`: worst seed first,
+/// each growing over faces that share a vertex with it and whose error is at least
+/// [`FIELD_THRESHOLD`] × the seed's; a face already in a field seeds none. The fields are
+/// disjoint.
+pub fn error_fields(
     faces: &Polygons,
     num_vertices: usize,
     max: &[f64],
     tolerance_max: f64,
-) -> Vec<f64> {
+) -> Vec<ErrorField> {
     let nf = faces.len();
-    let mut score = vec![0.0; nf];
     if tolerance_max <= 0.0 || nf == 0 {
-        return score;
+        return Vec::new();
     }
     let mut seeds: Vec<usize> = (0..nf).filter(|&f| max[f] > tolerance_max).collect();
     if seeds.is_empty() {
-        return score;
+        return Vec::new();
     }
     seeds.sort_by(|&a, &b| max[b].total_cmp(&max[a]).then(a.cmp(&b)));
-    // Faces around each vertex (CSR).
-    let mut start = vec![0usize; num_vertices + 1];
-    for f in faces.iter() {
-        for &v in f {
-            start[v as usize + 1] += 1;
-        }
-    }
-    for v in 0..num_vertices {
-        start[v + 1] += start[v];
-    }
-    let mut fill = start.clone();
-    let mut around = vec![0u32; start[num_vertices]];
-    for (fi, f) in faces.iter().enumerate() {
-        for &v in f {
-            around[fill[v as usize]] = fi as u32;
-            fill[v as usize] += 1;
-        }
-    }
+    let around = VertexFaces::new(faces, num_vertices);
     let mut in_field = vec![false; nf];
     let mut stack = Vec::new();
-    let mut members: Vec<(usize, f64)> = Vec::new();
+    let mut fields = Vec::new();
     for seed in seeds {
         if in_field[seed] {
             continue;
         }
         let floor = FIELD_THRESHOLD * max[seed];
+        let mut field = ErrorField {
+            faces: Vec::new(),
+            seed_max: max[seed],
+        };
         in_field[seed] = true;
         stack.push(seed);
         while let Some(f) = stack.pop() {
-            score[f] = max[f] / floor;
-            members.push((f, floor));
+            field.faces.push(f as u32);
             for &v in faces.face(subfit_mesh::FaceId(f as u32)) {
-                for &g in &around[start[v as usize]..start[v as usize + 1]] {
+                for &g in around.of(v) {
                     let g = g as usize;
                     if !in_field[g] && max[g] >= floor {
                         in_field[g] = true;
@@ -99,15 +127,42 @@ pub fn field_scores(
                 }
             }
         }
+        fields.push(field);
+    }
+    fields
+}
+
+/// Per face, its score from `fields` (of [`error_fields`] over the same `faces`, `max`):
+/// `max_f / (FIELD_THRESHOLD · seed max)` for a face of a field (≥ 1), just above 1 for a
+/// face sharing a vertex with one (the ring), 0 for the others.
+pub fn scores_of_fields(
+    faces: &Polygons,
+    num_vertices: usize,
+    max: &[f64],
+    fields: &[ErrorField],
+) -> Vec<f64> {
+    let mut score = vec![0.0; faces.len()];
+    if fields.is_empty() {
+        return score;
+    }
+    for field in fields {
+        let floor = FIELD_THRESHOLD * field.seed_max;
+        for &f in &field.faces {
+            score[f as usize] = max[f as usize] / floor;
+        }
     }
     // The ring around each field: its faces' shape decides whether the field's new points
     // can move where the data is.
-    for &(f, floor) in &members {
-        for &v in faces.face(subfit_mesh::FaceId(f as u32)) {
-            for &g in &around[start[v as usize]..start[v as usize + 1]] {
-                let g = g as usize;
-                if score[g] == 0.0 {
-                    score[g] = 1.0 + RING_SCORE * max[g] / floor;
+    let around = VertexFaces::new(faces, num_vertices);
+    for field in fields {
+        let floor = FIELD_THRESHOLD * field.seed_max;
+        for &f in &field.faces {
+            for &v in faces.face(subfit_mesh::FaceId(f)) {
+                for &g in around.of(v) {
+                    let g = g as usize;
+                    if score[g] == 0.0 {
+                        score[g] = 1.0 + RING_SCORE * max[g] / floor;
+                    }
                 }
             }
         }
@@ -115,20 +170,26 @@ pub fn field_scores(
     score
 }
 
-/// [`field_scores`] over the larger of each face's surface → data and data → surface maxima.
-pub fn two_sided_field_scores(
+/// Per face, its score from the error fields around the faces whose largest error (`max`,
+/// normalized units) is above `tolerance_max` ([`error_fields`], [`scores_of_fields`]).
+#[cfg(test)]
+pub fn field_scores(
     faces: &Polygons,
     num_vertices: usize,
-    surface: &[FaceError],
-    data: &[FaceError],
+    max: &[f64],
     tolerance_max: f64,
 ) -> Vec<f64> {
-    let max: Vec<f64> = surface
+    let fields = error_fields(faces, num_vertices, max, tolerance_max);
+    scores_of_fields(faces, num_vertices, max, &fields)
+}
+
+/// Per face, the larger of its surface → data and data → surface maxima.
+pub fn two_sided_max(surface: &[FaceError], data: &[FaceError]) -> Vec<f64> {
+    surface
         .iter()
         .zip(data)
         .map(|(s, d)| s.max.max(d.max))
-        .collect();
-    field_scores(faces, num_vertices, &max, tolerance_max)
+        .collect()
 }
 
 #[cfg(test)]

@@ -142,6 +142,7 @@ pub(crate) fn polish_best(
         flips_tried: 0,
         flips_kept: 0,
         refine: None,
+        local_points: 0,
         active_points: None,
         polish: Some(kept),
         time: ts.elapsed(),

@@ -25,8 +25,9 @@ use subfit_subdiv::{sampling_operator, Scheme};
 use subfit_target::Target;
 
 use crate::any_term::AnyTerm;
+use crate::enrich::{error_points, FieldCage};
 use crate::error::FitError;
-use crate::error_field::two_sided_field_scores;
+use crate::error_field::FIELD_THRESHOLD;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
 use crate::polish::polish_best;
@@ -114,6 +115,14 @@ pub struct StageOptions {
     /// while it misses its tolerance, end the stages ([`StageStop::Diminishing`]). Default
     /// [`REFINE_PAYOFF`]; 0 turns the rule off.
     pub refine_payoff: f64,
+    /// Local enrichment ([`crate::enrich`], Lavoué et al. 2005 §5.2): an error field of which
+    /// fewer than [`Self::local_field_share`] of the error points are at least this fraction
+    /// of its maximum is local. Default [`crate::enrich::LOCAL_FIELD_PEAK`] (0.8).
+    pub local_field_peak: f64,
+    /// The share below which an error field is local: its faces are merged into one with one
+    /// new control point, where a diffuse field has every face split. Default
+    /// [`crate::enrich::LOCAL_FIELD_SHARE`] (0.5); 0 turns local enrichment off.
+    pub local_field_share: f64,
 }
 
 impl Default for StageOptions {
@@ -141,6 +150,8 @@ impl Default for StageOptions {
             data_samples: 0,
             polish_power: 3.0,
             refine_payoff: REFINE_PAYOFF,
+            local_field_peak: crate::enrich::LOCAL_FIELD_PEAK,
+            local_field_share: crate::enrich::LOCAL_FIELD_SHARE,
         }
     }
 }
@@ -180,6 +191,12 @@ impl StageOptions {
         }
         if !(self.growth > 0.0 && self.growth.is_finite()) {
             return bad("growth", self.growth);
+        }
+        if !(self.local_field_peak > FIELD_THRESHOLD && self.local_field_peak <= 1.0) {
+            return bad("local_field_peak", self.local_field_peak);
+        }
+        if !(0.0..=1.0).contains(&self.local_field_share) {
+            return bad("local_field_share", self.local_field_share);
         }
         for (name, v) in [
             ("iterations_per_stage", self.iterations_per_stage),
@@ -273,6 +290,9 @@ pub struct StageReport {
     pub flips_kept: usize,
     /// Local refinement after the fit, if any.
     pub refine: Option<RefineStats>,
+    /// Control points added by local enrichment after the fit, one per local error field
+    /// merged ([`crate::enrich`]).
+    pub local_points: usize,
     /// Control points optimized in this stage when it was local ([`StageOptions::local`]);
     /// `None`: all of them.
     pub active_points: Option<usize>,
@@ -464,6 +484,10 @@ pub(crate) struct Measurement {
     surface_faces: Vec<FaceError>,
     /// Data → surface, per control face (the face of each data point's closest point).
     data_faces: Vec<FaceError>,
+    /// The error points of local enrichment ([`crate::enrich`]; empty when it is off): each
+    /// level-`l` sub-face (its largest corner error) and each data point (its distance, a
+    /// boundary vertex's scaled as in `data_faces`), with its control face.
+    points: Vec<(u32, f32)>,
 }
 
 /// Measures `positions` both ways: the squared errors of every sample of the fitter's sampling
@@ -497,11 +521,17 @@ pub(crate) fn measure(
     }
     let rim: Vec<f64> = to_surface[rim_from..].iter().map(|p| p.distance).collect();
     let judged = judged_with_boundary(&two_sided, &rim, stages);
+    let points = if stages.local_field_share > 0.0 && stages.refine {
+        error_points(op, &topo.owners, &err2, &to_surface, rim_from, scale)
+    } else {
+        Vec::new()
+    };
     Measurement {
         two_sided,
         judged,
         surface_faces,
         data_faces,
+        points,
     }
 }
 
@@ -570,6 +600,8 @@ pub fn fit_stages(
     let mut lambda = stages.lambda_start;
     // Refinement depth of every face (0 for the initial faces).
     let mut depth = vec![0u8; mesh.faces.len()];
+    // The points local enrichment added ([`crate::enrich`]): a field around one is diffuse.
+    let mut enriched: Vec<bool> = Vec::new();
     let mut reports: Vec<StageReport> = Vec::new();
     let mut initial = None;
     let mut stop = StageStop::Limit;
@@ -657,6 +689,7 @@ pub fn fit_stages(
             flips_tried: 0,
             flips_kept: 0,
             refine: None,
+            local_points: 0,
             active_points,
             polish: None,
             time: Duration::ZERO,
@@ -704,25 +737,29 @@ pub fn fit_stages(
                 .zip(&m.data_faces)
                 .map(|(s, d)| face_score(s, stages, unmet).max(face_score(d, stages, unmet)))
                 .collect();
-            if unmet.1 {
-                let field = two_sided_field_scores(
-                    &mesh.faces,
-                    n,
-                    &m.surface_faces,
-                    &m.data_faces,
-                    stages.tolerance_max,
-                );
-                for (s, f) in score.iter_mut().zip(field) {
-                    *s = s.max(f);
-                }
-            }
             let mut seed = stages.local.then(|| vec![false; n]);
             let before = mesh.faces.clone();
-            if stages.edge_flips {
+            let mut per_face = (m.surface_faces, m.data_faces);
+            let mut inserted = 0;
+            if unmet.1 {
+                let cage = FieldCage {
+                    mesh: &mut mesh,
+                    tags: &tags,
+                    score: &mut score,
+                    depth: &mut depth,
+                    per_face: &mut per_face,
+                    enriched: &mut enriched,
+                };
+                inserted = cage.enrich(&m.points, stages, unmet.0);
+                report.local_points = inserted;
+                changed |= inserted > 0;
+            }
+            // Flips are judged on the measured cage: not in a stage that inserted points.
+            if stages.edge_flips && inserted == 0 {
                 let (tried, kept) = flip_pass(
                     t.fitter.term(),
                     &mut mesh,
-                    (&m.surface_faces, &m.data_faces),
+                    (&per_face.0, &per_face.1),
                     &mut score,
                     stages,
                     unmet,

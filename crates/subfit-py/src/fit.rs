@@ -64,8 +64,20 @@ fn options(
     max_depth: i64,
     local: bool,
     local_rings: Option<i64>,
+    local_field: (f64, f64),
     error_scale: Option<f64>,
 ) -> PyResult<FitScanOptions> {
+    let (local_field_peak, local_field_share) = local_field;
+    if !(local_field_peak > 0.5 && local_field_peak <= 1.0) {
+        return Err(value_error(format!(
+            "local_field_peak must be in (0.5, 1], got {local_field_peak}"
+        )));
+    }
+    if !(0.0..=1.0).contains(&local_field_share) {
+        return Err(value_error(format!(
+            "local_field_share must be in [0, 1], got {local_field_share}"
+        )));
+    }
     if !(coverage >= 0.0 && coverage.is_finite()) {
         return Err(value_error(format!(
             "coverage must be a finite number >= 0, got {coverage}"
@@ -124,6 +136,8 @@ fn options(
             local,
             local_rings: range("local_rings", local_rings.unwrap_or(2), 0, 1_000)?,
             two_sided: !one_sided,
+            local_field_peak,
+            local_field_share,
             ..StageOptions::default()
         },
         error_scale,
@@ -182,7 +196,8 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     as_points=false, init=None, init_method=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
-    max_depth=5, local=false, local_rings=None, error_scale=None, name=None, progress=None
+    max_depth=5, local=false, local_rings=None, local_field_peak=0.8, local_field_share=0.5,
+    error_scale=None, name=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
@@ -212,6 +227,8 @@ pub fn fit(
     max_depth: i64,
     local: bool,
     local_rings: Option<i64>,
+    local_field_peak: f64,
+    local_field_share: f64,
     error_scale: Option<f64>,
     name: Option<String>,
     progress: Option<Py<PyAny>>,
@@ -237,6 +254,7 @@ pub fn fit(
         max_depth,
         local,
         local_rings,
+        (local_field_peak, local_field_share),
         error_scale,
     )?;
     let positions = vec3s("points", &points, subfit::target::MIN_POINTS)?;

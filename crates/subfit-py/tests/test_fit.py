@@ -104,6 +104,11 @@ def test_mesh_target_and_given_initial_cage(fitted):
     np.testing.assert_array_equal(g.faces, m.faces)
     with pytest.raises(ValueError, match="control_points"):
         subfit.fit(points, init=m, control_points=100)
+    # Local enrichment's thresholds are checked before anything is fitted.
+    with pytest.raises(ValueError, match="local_field_share"):
+        subfit.fit(points, local_field_share=1.5)
+    with pytest.raises(ValueError, match="local_field_peak"):
+        subfit.fit(points, local_field_peak=0.4)
 
 
 def test_curvature_line_start_on_an_open_patch():

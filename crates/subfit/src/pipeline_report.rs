@@ -315,6 +315,14 @@ pub struct OptionsSummary {
     pub local: bool,
     /// Rings around a local change.
     pub local_rings: usize,
+    /// Local enrichment: the fraction of an error field's maximum that counts as close to it
+    /// (Lavoué et al.'s 0.8).
+    #[serde(default)]
+    pub local_field_peak: f64,
+    /// Local enrichment: the share of close error points below which a field is local (one
+    /// control point); 0: off.
+    #[serde(default)]
+    pub local_field_share: f64,
     /// The error power of the last stage's max-error polish (2 or less: none).
     #[serde(default)]
     pub polish_power: f64,
@@ -363,6 +371,10 @@ pub struct StageSummary {
     pub active_points: Option<usize>,
     /// Refinement after the fit: faces marked, red and green splits, new points.
     pub refine: Option<RefineSummary>,
+    /// Control points added after the fit by local enrichment (one per local error field,
+    /// Lavoué et al. 2005 §5.2).
+    #[serde(default)]
+    pub local_points: usize,
     /// The last step only, the polish of the best cage towards a lower maximum error
     /// (`subfit_fit::polish`): whether the polished cage was kept.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -407,6 +419,7 @@ impl From<&StageReport> for StageSummary {
                 green: r.green,
                 new_points: r.new_points,
             }),
+            local_points: s.local_points,
             polish_kept: s.polish,
             time_s: s.time.as_secs_f64(),
         }

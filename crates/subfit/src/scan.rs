@@ -657,6 +657,8 @@ pub(crate) fn fit_scan_from(
             max_depth: st.max_depth,
             local: st.local,
             local_rings: st.local_rings,
+            local_field_peak: st.local_field_peak,
+            local_field_share: st.local_field_share,
             polish_power: st.polish_power,
             imls_radius: (fit.method == subfit_fit::Method::Imls)
                 .then(|| subfit_fit::ImlsTerm::from_options(&target, &fit).radius()),

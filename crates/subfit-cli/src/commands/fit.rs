@@ -110,6 +110,8 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             local_rings: a.local_rings as usize,
             two_sided: !a.one_sided,
             polish_power: a.polish_power,
+            local_field_peak: a.local_field_peak,
+            local_field_share: a.local_field_share,
             ..StageOptions::default()
         },
         error_scale: a.error_scale,

@@ -205,7 +205,8 @@ def fit(
         ``max_iterations`` (100), ``stage_iterations`` (6), ``one_sided`` (False),
         ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),
         ``refine`` (True; ``--no-refine``), ``edge_flips`` (True; ``--no-flips``),
-        ``max_depth`` (5), ``local`` (False), ``local_rings`` (2), ``error_scale``, ``name``
+        ``max_depth`` (5), ``local`` (False), ``local_rings`` (2), ``local_field_peak`` (0.8),
+        ``local_field_share`` (0.5; 0 turns local enrichment off), ``error_scale``, ``name``
         (used in messages).
 
     Returns
