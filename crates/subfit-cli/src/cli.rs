@@ -369,8 +369,9 @@ pub struct FitArgs {
     #[arg(long, value_enum, default_value_t = SchemeArg::Auto)]
     pub scheme: SchemeArg,
     /// Pair the cage's triangles into quads along the target's principal curvature directions
-    /// (a quad-dominant cage, same control points) [default: on for `--scheme catmull-clark`,
-    /// off for Loop and for `auto`, which picks Loop for the all-triangle automatic cage].
+    /// (a quad-dominant cage, same control points) [default: on for `--scheme catmull-clark`
+    /// and `quad-tri`, off for Loop and for `auto`, which keeps the automatic cage's
+    /// triangles].
     #[arg(long, conflicts_with = "no_quad_dominant")]
     pub quad_dominant: bool,
     /// Keep the cage all triangles (see `--quad-dominant`).

@@ -101,7 +101,8 @@ pub struct FitScanOptions {
     /// ([`subfit_init::pair_triangles`]: a quad-dominant cage along the target's principal
     /// directions, same control points). `None` (default): on for an automatic cage when
     /// [`Self::scheme`] is given and is not Loop (Catmull-Clark, quad/triangle), off otherwise
-    /// (an automatic cage is all triangles, so an inferred scheme is Loop). `Some(true)` also
+    /// (an automatic cage stays all triangles: the inferred scheme is Loop, or for an open mesh
+    /// the quad/triangle scheme, which is Loop on triangles). `Some(true)` also
     /// pairs the triangles of a given cage (keeping its tagged creases) and, with no scheme
     /// given, makes the inferred scheme Catmull-Clark; it cannot be combined with Loop.
     /// It replaces [`InitOptions::quad_dominant`] in [`Self::init_options`].
