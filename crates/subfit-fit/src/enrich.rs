@@ -166,30 +166,40 @@ impl FieldCage<'_> {
     }
 }
 
-/// Whether `field` is local: of its error points (`points`: control face and error, over
-/// every face; `in_field` marks the field's faces) with an error of at least
-/// [`FIELD_THRESHOLD`] × its maximum, fewer than `share` have one of at least `peak` × it.
-pub(crate) fn is_local(
-    field: &ErrorField,
+/// Which of `fields` (disjoint, over `num_faces` faces) are local: of a field's error points
+/// (`points`: control face and error) with an error of at least [`FIELD_THRESHOLD`] × its
+/// maximum, fewer than `share` have one of at least `peak` × it. One pass over the points.
+pub(crate) fn local_fields(
+    fields: &[ErrorField],
     points: &[(u32, f32)],
-    in_field: &[bool],
+    num_faces: usize,
     peak: f64,
     share: f64,
-) -> bool {
-    let (low, high) = (FIELD_THRESHOLD * field.seed_max, peak * field.seed_max);
-    let (mut above_low, mut above_high) = (0usize, 0usize);
+) -> Vec<bool> {
+    let mut field_of = vec![u32::MAX; num_faces];
+    for (i, field) in fields.iter().enumerate() {
+        for &f in &field.faces {
+            field_of[f as usize] = i as u32;
+        }
+    }
+    // Per field: error points above the low and the high threshold.
+    let mut counts = vec![(0usize, 0usize); fields.len()];
     for &(f, e) in points {
-        if in_field[f as usize] {
-            let e = e as f64;
-            if e >= low {
-                above_low += 1;
-                if e >= high {
-                    above_high += 1;
+        let i = field_of[f as usize];
+        if i != u32::MAX {
+            let (m, e) = (fields[i as usize].seed_max, e as f64);
+            if e >= FIELD_THRESHOLD * m {
+                counts[i as usize].0 += 1;
+                if e >= peak * m {
+                    counts[i as usize].1 += 1;
                 }
             }
         }
     }
-    above_low > 0 && (above_high as f64) < share * above_low as f64
+    counts
+        .iter()
+        .map(|&(low, high)| low > 0 && (high as f64) < share * low as f64)
+        .collect()
 }
 
 /// A cage after [`insert_points`].
@@ -208,7 +218,7 @@ pub(crate) struct Inserted {
 }
 
 /// Local enrichment of a stage: the fields of `fields` that are local by Lavoué et al.'s test
-/// ([`is_local`] with the thresholds of `stages`, on the error `points`) and form discs are
+/// ([`local_fields`] with the thresholds of `stages`, on the error `points`) and form discs are
 /// merged, one point each ([`insert_points`], at most `room`), and removed from `fields`,
 /// which keeps the others for their faces to be split. `None` (and `fields` unchanged) when
 /// nothing was merged or local enrichment is off.
@@ -221,36 +231,28 @@ pub(crate) fn enrich_locally(
     stages: &StageOptions,
     room: usize,
 ) -> Option<Inserted> {
-    if stages.local_field_share <= 0.0 || points.is_empty() || fields.is_empty() {
+    if stages.local_field_share <= 0.0 || points.is_empty() || fields.is_empty() || room == 0 {
         return None;
     }
-    let mut in_field = vec![false; mesh.faces.len()];
-    let mut local = Vec::new();
-    let mut index = Vec::new();
-    for (i, field) in fields.iter().enumerate() {
-        for &f in &field.faces {
-            in_field[f as usize] = true;
-        }
-        if is_local(
-            field,
-            points,
-            &in_field,
-            stages.local_field_peak,
-            stages.local_field_share,
-        ) {
-            local.push(field);
-            index.push(i);
-        }
-        for &f in &field.faces {
-            in_field[f as usize] = false;
-        }
-    }
+    let is_local = local_fields(
+        fields,
+        points,
+        mesh.faces.len(),
+        stages.local_field_peak,
+        stages.local_field_share,
+    );
+    let index: Vec<usize> = (0..fields.len()).filter(|&i| is_local[i]).collect();
+    let local: Vec<&ErrorField> = index.iter().map(|&i| &fields[i]).collect();
     let mut r = insert_points(mesh, tags, &local, enriched, room)?;
     r.merged = r.merged.iter().map(|&k| index[k]).collect();
-    let mut k = 0;
+    let mut merged = vec![false; fields.len()];
+    for &i in &r.merged {
+        merged[i] = true;
+    }
+    let mut i = 0;
     fields.retain(|_| {
-        k += 1;
-        !r.merged.contains(&(k - 1))
+        i += 1;
+        !merged[i - 1]
     });
     Some(r)
 }
@@ -434,14 +436,26 @@ mod tests {
 
     #[test]
     fn a_peak_is_local_and_a_plateau_is_not() {
-        let in_field = [true, false];
-        // Error points of face 0: one at the peak, three just above half of it.
+        // Error points of face 0 (the field); face 1 is outside it.
+        let local =
+            |points: &[(u32, f32)], peak| local_fields(&[field(&[0])], points, 2, peak, 0.5)[0];
+        // One point at the peak, three just above half of it.
         let peak = [(0, 1.0), (0, 0.6), (0, 0.55), (0, 0.52), (1, 1.0), (1, 0.9)];
-        assert!(is_local(&field(&[0]), &peak, &in_field, 0.8, 0.5));
+        assert!(local(&peak, 0.8));
         let plateau = [(0, 1.0), (0, 0.95), (0, 0.85), (0, 0.6), (1, 0.1)];
-        assert!(!is_local(&field(&[0]), &plateau, &in_field, 0.8, 0.5));
+        assert!(!local(&plateau, 0.8));
         // The thresholds are the caller's.
-        assert!(is_local(&field(&[0]), &plateau, &in_field, 0.96, 0.5));
+        assert!(local(&plateau, 0.96));
+        // Two fields at once: each judged on its own points and maximum.
+        let two = [
+            field(&[0]),
+            ErrorField {
+                faces: vec![1],
+                seed_max: 2.0,
+            },
+        ];
+        let points = [(0, 1.0), (0, 0.6), (0, 0.55), (1, 2.0), (1, 1.9), (1, 1.7)];
+        assert_eq!(local_fields(&two, &points, 2, 0.8, 0.5), vec![true, false]);
     }
 
     #[test]

@@ -521,7 +521,8 @@ pub(crate) fn measure(
     }
     let rim: Vec<f64> = to_surface[rim_from..].iter().map(|p| p.distance).collect();
     let judged = judged_with_boundary(&two_sided, &rim, stages);
-    let points = if stages.local_field_share > 0.0 && stages.refine {
+    // Only a missed maximum makes error fields (and local enrichment).
+    let points = if stages.local_field_share > 0.0 && stages.refine && stages.tolerance_max > 0.0 {
         error_points(op, &topo.owners, &err2, &to_surface, rim_from, scale)
     } else {
         Vec::new()
