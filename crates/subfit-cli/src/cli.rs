@@ -747,30 +747,27 @@ pub enum EncodingArg {
     BinaryBe,
 }
 
-/// `--polish-power`: a number in [2, 8].
+/// A number that `ok` accepts; the error names the interval `range`.
+fn number_in(s: &str, ok: impl Fn(f64) -> bool, range: &str) -> Result<f64, String> {
+    let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if ok(p) {
+        Ok(p)
+    } else {
+        Err(format!("{p} is not in {range}"))
+    }
+}
+
+/// `--local-field-peak`: a number in (0.5, 1].
 fn local_field_peak(s: &str) -> Result<f64, String> {
-    let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
-    if p > 0.5 && p <= 1.0 {
-        Ok(p)
-    } else {
-        Err(format!("{p} is not in (0.5, 1]"))
-    }
+    number_in(s, |p| p > 0.5 && p <= 1.0, "(0.5, 1]")
 }
 
+/// `--local-field-share`: a number in [0, 1].
 fn unit_interval(s: &str) -> Result<f64, String> {
-    let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
-    if (0.0..=1.0).contains(&p) {
-        Ok(p)
-    } else {
-        Err(format!("{p} is not in [0, 1]"))
-    }
+    number_in(s, |p| (0.0..=1.0).contains(&p), "[0, 1]")
 }
 
+/// `--polish-power`: a number in [2, 8].
 fn polish_power(s: &str) -> Result<f64, String> {
-    let p: f64 = s.parse().map_err(|e| format!("{e}"))?;
-    if (2.0..=8.0).contains(&p) {
-        Ok(p)
-    } else {
-        Err(format!("{p} is not in [2, 8]"))
-    }
+    number_in(s, |p| (2.0..=8.0).contains(&p), "[2, 8]")
 }

@@ -367,6 +367,70 @@ pub fn octahedron_mesh(a: f64, b: f64, c: f64) -> PolyMesh {
     PolyMesh::new(pos, Polygons::from_triangles(&tris))
 }
 
+/// The unit geodesic sphere: the icosahedron (12 vertices, 20 faces) with each triangle split
+/// into four through its edges' midpoints, pushed onto the sphere, `levels` times
+/// (`10·4^levels + 2` vertices), outward winding.
+pub fn geodesic_sphere(levels: usize) -> PolyMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let on_sphere = |p: [f64; 3]| unit(p).unwrap_or(p);
+    let mut pos: Vec<[f64; 3]> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .into_iter()
+    .map(on_sphere)
+    .collect();
+    let mut tris: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::with_capacity(4 * tris.len());
+        let mut m = |a: u32, b: u32, pos: &mut Vec<[f64; 3]>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (p, q) = (pos[a as usize], pos[b as usize]);
+                pos.push(on_sphere([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                pos.len() as u32 - 1
+            })
+        };
+        for [a, b, c] in tris {
+            let (ab, bc, ca) = (m(a, b, &mut pos), m(b, c, &mut pos), m(c, a, &mut pos));
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    PolyMesh::new(pos, Polygons::from_triangles(&tris))
+}
+
 /// An axis-aligned cube of half-size `h` as 8 vertices and 6 outward quads.
 pub fn cube_mesh(h: f64) -> PolyMesh {
     let mut pos = Vec::with_capacity(8);

@@ -4,77 +4,18 @@
 
 #![allow(clippy::print_stdout)]
 
-use std::collections::HashMap;
-
-use subfit::mesh::{PolyMesh, Polygons};
+use subfit::mesh::PolyMesh;
 use subfit::{fit_scan, FitScanOptions, Input};
 
-/// A sphere of radius 0.5 (icosahedron, `levels` geodesic subdivisions) with a Gaussian bump of
-/// height 6 % and angular width 0.08 rad.
+/// A sphere of radius 0.5 (the geodesic sphere of `levels` subdivisions) with a Gaussian bump
+/// of height 6 % and angular width 0.08 rad.
 fn bumpy_sphere(levels: usize) -> PolyMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let unit = |p: [f64; 3]| {
-        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        [p[0] / l, p[1] / l, p[2] / l]
-    };
-    let mut v: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .into_iter()
-    .map(unit)
-    .collect();
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut mid = HashMap::new();
-        let mut next = Vec::with_capacity(4 * f.len());
-        let mut m = |a: u32, b: u32, v: &mut Vec<[f64; 3]>| {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (p, q) = (v[a as usize], v[b as usize]);
-                v.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
-                v.len() as u32 - 1
-            })
-        };
-        for [a, b, c] in f {
-            let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = next;
-    }
-    let d = unit([0.3, 0.5, 0.8]);
-    let positions = v
-        .into_iter()
+    let sphere = subfit::mesh::shapes::geodesic_sphere(levels);
+    let l = (0.3f64 * 0.3 + 0.5 * 0.5 + 0.8 * 0.8).sqrt();
+    let d = [0.3 / l, 0.5 / l, 0.8 / l];
+    let positions = sphere
+        .positions
+        .iter()
         .map(|p| {
             let angle = (p[0] * d[0] + p[1] * d[1] + p[2] * d[2])
                 .clamp(-1.0, 1.0)
@@ -83,7 +24,7 @@ fn bumpy_sphere(levels: usize) -> PolyMesh {
             [r * p[0], r * p[1], r * p[2]]
         })
         .collect();
-    PolyMesh::new(positions, Polygons::from_triangles(&f))
+    PolyMesh::new(positions, sphere.faces)
 }
 
 #[test]

@@ -304,50 +304,10 @@ impl Surface {
         }
         let faces = std::mem::take(&mut self.faces_of[region as usize]);
         let new = self.faces_of.len() as u32;
-        // Flood the side of the first face.
-        let mut side: HashMap<u32, bool> = faces.iter().map(|&f| (f, false)).collect();
-        let mut stack = vec![faces[0]];
-        side.insert(faces[0], true);
-        while let Some(f) = stack.pop() {
-            for i in 0..3 {
-                let h = 3 * f + i;
-                if self.border[self.edge_of[h as usize] as usize] {
-                    continue;
-                }
-                let g = self.twin[h as usize] / 3;
-                if let Some(s) = side.get_mut(&g) {
-                    if !*s {
-                        *s = true;
-                        stack.push(g);
-                    }
-                }
-            }
-        }
+        // The side of the first face; exactly two parts: the rest must be connected too.
+        let side = self.flood(&faces);
         let (a, b): (Vec<u32>, Vec<u32>) = faces.iter().partition(|f| side[f]);
-        // Exactly two parts: the rest must be connected too.
-        let two = !b.is_empty() && {
-            let mut seen: HashMap<u32, bool> = b.iter().map(|&f| (f, false)).collect();
-            let mut stack = vec![b[0]];
-            seen.insert(b[0], true);
-            let mut count = 1;
-            while let Some(f) = stack.pop() {
-                for i in 0..3 {
-                    let h = 3 * f + i;
-                    if self.border[self.edge_of[h as usize] as usize] {
-                        continue;
-                    }
-                    let g = self.twin[h as usize] / 3;
-                    if let Some(s) = seen.get_mut(&g) {
-                        if !*s {
-                            *s = true;
-                            count += 1;
-                            stack.push(g);
-                        }
-                    }
-                }
-            }
-            count == b.len()
-        };
+        let two = !b.is_empty() && self.flood(&b).values().all(|&s| s);
         if !two {
             for &e in &path.edges {
                 self.border[e as usize] = false;
@@ -364,6 +324,30 @@ impl Surface {
         self.faces_of[region as usize] = a;
         self.faces_of.push(b);
         Some(new)
+    }
+
+    /// The faces of `faces` (not empty) reached from the first across non-border edges
+    /// (`true`) and the others (`false`).
+    fn flood(&self, faces: &[u32]) -> HashMap<u32, bool> {
+        let mut reached: HashMap<u32, bool> = faces.iter().map(|&f| (f, false)).collect();
+        let mut stack = vec![faces[0]];
+        reached.insert(faces[0], true);
+        while let Some(f) = stack.pop() {
+            for i in 0..3 {
+                let h = 3 * f + i;
+                if self.border[self.edge_of[h as usize] as usize] {
+                    continue;
+                }
+                let g = self.twin[h as usize] / 3;
+                if let Some(r) = reached.get_mut(&g) {
+                    if !*r {
+                        *r = true;
+                        stack.push(g);
+                    }
+                }
+            }
+        }
+        reached
     }
 
     /// Makes `path`'s edges border without splitting anything (a link between two boundary

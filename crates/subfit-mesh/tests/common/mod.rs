@@ -105,46 +105,10 @@ pub fn cube() -> (Polygons, Vec<[f64; 3]>) {
     (faces, pos)
 }
 
-/// The icosahedron (12 vertices, 20 faces), outward, with positions.
+/// The icosahedron (12 vertices, 20 faces), outward, with positions (on the unit sphere).
 pub fn icosahedron() -> (Polygons, Vec<[f64; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let pos = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let faces = Polygons::from_triangles(&[
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ]);
-    (faces, pos)
+    let m = subfit_mesh::shapes::geodesic_sphere(0);
+    (m.faces, m.positions)
 }
 
 /// Reads vertices and faces of an OFF or OBJ file (only what the shared data uses: OFF with
