@@ -456,12 +456,13 @@ pub struct SequenceArgs {
     /// Data term of every frame: SDM (Cheng et al.) or IMLS (Xie et al.).
     #[arg(long, value_enum, default_value_t = MethodArg::Sdm)]
     pub method: MethodArg,
-    /// Nodes of the embedded deformation that carries the previous frame's cage onto each new
-    /// frame before its fit (it follows motion along the surface, which closest points do not
-    /// see); 0 turns the tracking off.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(0..=2000))]
+    /// Nodes of the embedded deformation, inside the body, that carries the template onto each
+    /// new frame before its fit (it follows motion along the surface, which closest points do
+    /// not see); 0 turns the tracking off (each frame then starts from the previous cage).
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(0..=2000))]
     pub track_nodes: u32,
-    /// Weight α of the as-rigid-as-possible term towards the template.
+    /// Weight α of the as-rigid-as-possible term towards the template (as the tracking carried
+    /// it onto the frame).
     #[arg(long, default_value_t = 0.01)]
     pub arap: f64,
     /// Umbrella smoothing λ per frame.

@@ -22,7 +22,7 @@ use crate::options::{FitOptions, Optimizer, StepControl};
 use crate::report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
 use crate::smooth::Laplacian;
 use crate::solve::{CholeskySolver, NormalSolver, SolveFailure};
-use crate::surface_term::fan_triangles;
+use crate::surface_term::{control_gradient, fan_triangles};
 use crate::term::{DataTerm, Mat3};
 
 mod first_order;
@@ -773,18 +773,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         };
         if let (Some(st), Some((sop, tris))) = (&self.options.surface_term, &self.surface) {
             // Half the gradient of w·value: ½ w Cₛᵀ ∇value, over the active points.
-            let (_, grad) = st
-                .term
-                .value_and_gradient(&sop.position.apply(control), tris);
-            let mut gp = vec![[0.0; 3]; control.len()];
-            for (k, gk) in grad.iter().enumerate() {
-                let (cols, ws) = sop.position.row(k);
-                for (&j, &w) in cols.iter().zip(ws) {
-                    for a in 0..3 {
-                        gp[j as usize][a] += w * gk[a];
-                    }
-                }
-            }
+            let gp = control_gradient(st.term.as_ref(), sop, tris, control);
             let c = 0.5 * st.weight;
             match points {
                 None => g.iter_mut().zip(&gp).for_each(|(g, p)| {

@@ -1,65 +1,67 @@
-//! Frame-to-frame tracking of a cage by an embedded deformation graph (Sumner, Schmid & Pauly,
-//! "Embedded deformation for shape manipulation", SIGGRAPH 2007, §§3–4; used for non-rigid
-//! registration by Li, Adams, Guibas & Pauly, "Robust single-view geometry and motion
-//! reconstruction", SIGGRAPH Asia 2009, §4): the warm start of a sequence's next frame.
+//! Tracking of a cage by an embedded deformation graph (Sumner, Schmid & Pauly, "Embedded
+//! deformation for shape manipulation", SIGGRAPH 2007, §§3–4; used for non-rigid registration
+//! by Li, Adams, Guibas & Pauly, "Robust single-view geometry and motion reconstruction",
+//! SIGGRAPH Asia 2009, §4): the warm start of each frame of a sequence.
 //!
 //! **Why.** A fit that starts from the previous frame's cage moves each point along the
-//! surface's normal only: closest points say nothing about sliding. Where the new frame moved
+//! surface's normal only: closest points say nothing about sliding. Where the frame moved
 //! *along* the surface — the flanks of a bend, a twist of an elliptic section, a spin — the cage
 //! stays behind, and the tracked points drift a few per cent of the diagonal per frame
-//! (`subfit bench sequence`). An ARAP term on the cage itself cannot carry the motion across:
-//! its pairs are the cage's edges, a thin shell, and a shell follows a sideways motion only
-//! through second-order strains. Here the motion is a smooth field of local rigid motions,
-//! coupled through space: nodes on the far side of a limb move with the near side.
+//! (`subfit bench sequence`). Here the motion is a smooth field of local affine motions,
+//! coupled through space, and what the frame does not show is decided by that field's
+//! smoothness.
 //!
-//! **Model.** `m` nodes `g_k` (control vertices picked by farthest-point sampling of the
-//! template, [`DeformationGraph::new`]), each with an affine map `A_k` and a translation `t_k`;
-//! a point `x` moves to `x' = Σ_k w_k(x) (A_k (x − g_k) + g_k + t_k)` over its `s` nearest nodes,
+//! **Model.** `m` nodes with rest positions `g_k` ([`DeformationGraph`]), each with an affine
+//! map `A_k` and a translation `t_k`; a point `x` of the rest shape moves to
+//! `x' = Σ_k w_k(x) (A_k (x − g_k) + g_k + t_k)` over its `s` nearest nodes,
 //! `w_k ∝ (1 − ‖x − g_k‖ / d_{s+1})²` (Sumner eq. 1, 3). With the samples' foot points `y` and
-//! target normals `n` on the new frame, Gauss-Newton minimizes
+//! target normals `n` on the frame, Gauss-Newton minimizes
 //!
 //! ```text
 //! E = 1/S Σ_samples [ (nᵀ(x' − y))² + β ‖x' − y‖² ]                 (fit, Li et al. eq. 4)
 //!   + γ/P Σ_(k,l) ‖A_k (g_l − g_k) + g_k + t_k − (g_l + t_l)‖²        (regularity, Sumner eq. 6)
 //!   + ρ/m Σ_k Σ_(a≤b) (c_aᵀc_b − δ_ab)²                              (rigidity, Sumner eq. 5)
+//!   + μ/m Σ_k Σ_(entries e) ‖(I − Π_k) a_e‖²                          (second order)
 //! ```
 //!
 //! over the `P` directed pairs of each node and its `K` nearest nodes, `c_a` the columns of
 //! `A_k`; the rigidity rows are linearized exactly, so a turn costs nothing to first order (a
-//! penalty `‖A_k − R_k‖²` with `R_k` held for the step charges a turn like a shear: a rigid
-//! turn of the body by 0.15 rad was then followed only in part, 0.040 → 0.025 from the true
-//! motion, against 4.4e-4 now, `tests/track.rs`). 12 unknowns a node; foot points
-//! recomputed every iteration; a sample whose foot point is farther than
+//! penalty `‖A_k − R_k‖²` with `R_k` held for the step charges a turn like a shear).
+//! The second-order term takes each entry `e` of the linear parts over node `k` and its
+//! neighbours (`a_e`, one value a node) less its least-squares linear trend in position
+//! (`Π_k`): a bend whose rate goes on across the neighbourhood costs nothing, a bend that stops
+//! does — the regularity alone prefers a rigid piece past the last node the data pins down
+//! (thin-plate smoothness of the deformation gradient, as in Botsch & Sorkine, "On linear
+//! variational surface deformation methods", TVCG 2008, §3, for displacements). 12 unknowns a
+//! node; foot points recomputed every iteration; a sample whose foot point is farther than
 //! [`TrackOptions::max_distance`] or whose moved normal is more than 60° from the target's is
 //! left out (Li et al. §4's pruning). The normal matrix is dense `12m × 12m`, factored by
-//! Cholesky each iteration (`m` = 30 by default in sequences: 360 unknowns).
+//! Cholesky each iteration (`m` = 60 in sequences: 720 unknowns).
 //!
-//! **Weights, measured** (`subfit bench sequence`'s generated body, 8,000-vertex frames,
-//! frame 0 → 1, whose true motion is 2.08 % of the diagonal RMS; drift left after one step
-//! from rest, RMS): the regularity penalizes bending at the node spacing (`κ h²`) and the
-//! rigidity the frame's change of thickness (4 % per frame), so stiff weights cannot fit the
-//! frame (γ = 100, ρ = 1e-3: 1.7 % left, plane residual stuck at 4e-3). With 30 nodes and ρ =
-//! 1e-4: γ = 0.1 leaves 1.18 %, 0.01 0.93 %, 1e-3 0.67 %, **1e-4 0.40 %**, 1e-5 0.49 % (the
-//! middle of the body starts to slide); 15 nodes 1.18 %, 45–60 nodes 0.51–0.76 %. β > 0 pulls
-//! each point to its closest point, i.e. against sliding. Stiffness annealing as in Li et
-//! al. (half the iterations with γ and ρ 100–10,000 times higher, then the given weights with
-//! each sample held along the surface where the stiff phase put it) made it worse, 1.44–1.69 %:
-//! the stiff solution is wrong where the body bends. From rest to frame 3 (5.7 % of motion):
-//! 1.5 % left. The rest of the motion along the surface is not observable by a local tracker
-//! on this smooth body (most of it at the rounded ends), and it accumulates over a sequence
-//! (see `subfit::sequence`). A rigid turn is followed to 1.1 % of itself (`tests/track.rs`).
+//! **From the template, nodes inside.** A sequence maps the *template* onto every frame (the
+//! motion template → frame, warm-started from the previous frames'), not the previous frame
+//! onto the next: what one frame gets wrong along the surface is then not carried into the
+//! next, and a body that returns to its rest pose returns its points. The nodes lie inside the
+//! body ([`DeformationGraph::interior`], halfway to the shrinking-ball medial points): one node
+//! then carries a whole piece of a limb, both sides at once, so a bend, a twist or a change of
+//! thickness is one smooth field of affine maps, where nodes on the surface let each side
+//! slide on its own (a thickness wave was followed as a slide).
 //!
-//! Over a sequence the one-step optimum is not the best: softer ties also let the cage slide
-//! where the frame shows nothing to follow. Largest drift over 30 frames (`subfit bench
-//! sequence --vertices 8000 --control-points 500`, moderate motion / the same body held
-//! still): γ = 1e-4 9.50 % / 1.30 %, **1e-3 7.89 % / 0.58 %**, 0.01 10.46 % / 0.14 %, 1 13.2 %
-//! / 0.04 %, against 0.023 % for the still body without tracking. What is left on a still
-//! body is removed by [`TrackOptions::stop_rms`]: no iteration once the residual is what the
-//! data's noise and tessellation leave anyway. A least-motion term towards the rest or the
-//! predicted position (full or tangential) stopped the slide but also the twist and bend
-//! (14.6 % moderate) and was not kept.
+//! **Weights, measured** on `subfit bench sequence --vertices 8000 --control-points 500`
+//! (largest drift of the tracked limit points over 30 frames, fraction of the diagonal,
+//! default / large tangential motion, geometry only, no ARAP in the fit): surface nodes tracked
+//! frame to frame (the previous version, with ARAP) 7.3 % on the default motion; from the
+//! template with nodes inside 3.7 % / 4.8 %;
+//! with the second-order term μ = 1e-6 and 12 nodes a sample 2.4 % / 3.3 % (μ = 1e-5 3.1 % /
+//! 4.0 %, 1e-4 4.2 % / 6.4 %: stiffer, it bends what does not bend); nodes at depth 0.3 /
+//! 0.7 / 1 (the medial points) of the way in 3.4 / 4.1 / 5.9 % (default motion, μ = 3e-5);
+//! 40 / 90 nodes 4.3 / 3.7 % against 3.6 % for 60; γ = 1e-3 and 3e-5 both worse than 1e-4.
+//! Fitted to the true correspondences of the bend alone, the same graph reproduces it to 0.1 %
+//! of the diagonal: what is left is the choice among motions the surfaces cannot tell apart
+//! (a slide over a rounded end), not the graph's reach.
 //!
-//! **Cost** per step: `iterations × (S foot points + S·(12s)² + (12m)³/3 flops)`.
+//! **Cost** per step: `iterations × (S foot points + S·(12s)² + (12m)³/3 flops)`, plus once
+//! per graph O(S log S) for the medial points and O(m·K³) for the projectors.
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
@@ -73,12 +75,15 @@ use subfit_target::Target;
 pub struct TrackOptions {
     /// Gauss-Newton iterations. Default 20.
     pub iterations: usize,
-    /// Nodes each sample is skinned to (`s`). Default 4.
+    /// Nodes each sample is skinned to (`s`). Default 12.
     pub skin: usize,
-    /// Weight `γ` of the regularity term. Default 1e-3 (see the module docs).
+    /// Weight `γ` of the regularity term. Default 1e-4 (see the module docs).
     pub regularity: f64,
-    /// Weight `ρ` of the rigidity term. Default 1e-4.
+    /// Weight `ρ` of the rigidity term. Default 1e-6.
     pub rigidity: f64,
+    /// Weight `μ` of the second-order term (the linear parts' departure from a linear field
+    /// over each neighbourhood). Default 1e-6.
+    pub second_order: f64,
     /// Weight `β` of the point-to-point part of the fit. Default 0.
     pub point_weight: f64,
     /// Samples whose foot point is farther than this (normalized units) are left out.
@@ -94,9 +99,10 @@ impl Default for TrackOptions {
     fn default() -> Self {
         Self {
             iterations: 20,
-            skin: 4,
-            regularity: 1e-3,
-            rigidity: 1e-4,
+            skin: 12,
+            regularity: 1e-4,
+            rigidity: 1e-6,
+            second_order: 1e-6,
             point_weight: 0.0,
             max_distance: 0.1,
             stop_rms: 0.0,
@@ -104,61 +110,196 @@ impl Default for TrackOptions {
     }
 }
 
-/// The nodes of an embedded deformation: control-vertex indices and each node's nearest nodes
-/// (fixed at construction, from the template's positions).
+/// The nodes of an embedded deformation: their rest positions and each node's nearest nodes
+/// (fixed at construction).
 #[derive(Clone, Debug)]
 pub struct DeformationGraph {
-    nodes: Vec<u32>,
+    positions: Vec<[f64; 3]>,
     neighbors: Vec<Vec<u32>>,
+    /// Per node, the projector `I − Π` (row-major, `q × q` over the node and its neighbours)
+    /// that removes a field's best linear trend in position (the second-order term).
+    detrend: Vec<Vec<f64>>,
 }
 
 impl DeformationGraph {
-    /// Picks `count` nodes among `template`'s points by farthest-point sampling (from point 0)
-    /// and links each to its `neighbors` nearest nodes. Cost: O(n · count + count²).
-    pub fn new(template: &[[f64; 3]], count: usize, neighbors: usize) -> Self {
-        let n = template.len();
+    /// Picks `count` nodes among `points` by farthest-point sampling (from point 0) and links
+    /// each to its `neighbors` nearest nodes. Cost: O(n · count + count²).
+    pub fn new(points: &[[f64; 3]], count: usize, neighbors: usize) -> Self {
+        let n = points.len();
         let count = count.min(n).max(1.min(n));
-        let mut nodes = Vec::with_capacity(count);
+        let mut positions = Vec::with_capacity(count);
         let mut d2 = vec![f64::INFINITY; n];
         let mut next = 0usize;
-        while nodes.len() < count {
-            nodes.push(next as u32);
-            let g = template[next];
+        while positions.len() < count {
+            let g = points[next];
+            positions.push(g);
             d2.par_iter_mut()
-                .zip(template.par_iter())
+                .zip(points.par_iter())
                 .for_each(|(d, &p)| *d = d.min(dist2(p, g)));
             next = (0..n).max_by(|&a, &b| d2[a].total_cmp(&d2[b])).unwrap_or(0);
             if d2[next] == 0.0 {
                 break;
             }
         }
-        let k = neighbors.min(nodes.len().saturating_sub(1));
-        let neighbors = nodes
+        let k = neighbors.min(positions.len().saturating_sub(1));
+        let neighbors: Vec<Vec<u32>> = positions
             .par_iter()
             .map(|&a| {
-                let mut by: Vec<(f64, u32)> = nodes
+                let mut by: Vec<(f64, u32)> = positions
                     .iter()
                     .enumerate()
-                    .filter(|&(_, &b)| b != a)
-                    .map(|(j, &b)| (dist2(template[a as usize], template[b as usize]), j as u32))
+                    .map(|(j, &b)| (dist2(a, b), j as u32))
+                    .filter(|&(d, _)| d > 0.0)
                     .collect();
                 by.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
                 by.truncate(k);
                 by.into_iter().map(|(_, j)| j).collect()
             })
             .collect();
-        Self { nodes, neighbors }
+        let detrend = neighbors
+            .iter()
+            .enumerate()
+            .map(|(k, nb)| detrend(&positions, k, nb))
+            .collect();
+        Self {
+            positions,
+            neighbors,
+            detrend,
+        }
+    }
+
+    /// Nodes inside a closed body: [`Self::new`] over the points `depth` of the way from each
+    /// sample (unit outward `normals`) to its medial point ([`medial_points`]); `depth` 0 puts
+    /// them on the surface. Inner nodes carry a cross-section as one piece (its bend, twist,
+    /// change of thickness), where nodes on the surface let each side slide on its own.
+    ///
+    /// # Panics
+    /// If `samples` and `normals` differ in length.
+    #[track_caller]
+    pub fn interior(
+        samples: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        depth: f64,
+        count: usize,
+        neighbors: usize,
+    ) -> Self {
+        assert_eq!(samples.len(), normals.len(), "one normal per sample");
+        let inner: Vec<[f64; 3]> = medial_points(samples, normals)
+            .iter()
+            .zip(samples)
+            .map(|(c, p)| std::array::from_fn(|a| p[a] + depth * (c[a] - p[a])))
+            .collect();
+        Self::new(&inner, count, neighbors)
     }
 
     /// Number of nodes.
     pub fn len(&self) -> usize {
-        self.nodes.len()
+        self.positions.len()
     }
 
     /// True without nodes.
     pub fn is_empty(&self) -> bool {
-        self.nodes.is_empty()
+        self.positions.is_empty()
     }
+
+    /// The nodes' rest positions.
+    pub fn positions(&self) -> &[[f64; 3]] {
+        &self.positions
+    }
+}
+
+/// `I − Π` over node `k` and its neighbours `nb`, `Π` the least-squares projector onto the
+/// fields linear in position (`1, x, y, z`); empty when there are too few nodes to leave
+/// anything (fewer than 5) or they are coplanar.
+fn detrend(g: &[[f64; 3]], k: usize, nb: &[u32]) -> Vec<f64> {
+    let ids: Vec<usize> = std::iter::once(k)
+        .chain(nb.iter().map(|&l| l as usize))
+        .collect();
+    let q = ids.len();
+    if q < 5 {
+        return Vec::new();
+    }
+    let scale = ids
+        .iter()
+        .map(|&l| dist2(g[l], g[k]))
+        .fold(0.0, f64::max)
+        .sqrt()
+        .max(1e-300);
+    let b = Mat::<f64>::from_fn(q, 4, |r, c| {
+        if c == 0 {
+            1.0
+        } else {
+            (g[ids[r]][c - 1] - g[k][c - 1]) / scale
+        }
+    });
+    let btb = b.transpose() * &b;
+    let Ok(llt) = btb.llt(Side::Lower) else {
+        return Vec::new();
+    };
+    // Coplanar neighbourhoods are nearly singular: leave them out.
+    let diag_min = (0..4).map(|i| btb[(i, i)]).fold(f64::INFINITY, f64::min);
+    if diag_min < 1e-6 * q as f64 {
+        return Vec::new();
+    }
+    let pi = &b * llt.solve(b.transpose());
+    (0..q * q)
+        .map(|e| {
+            let (r, c) = (e / q, e % q);
+            f64::from(u8::from(r == c)) - pi[(r, c)]
+        })
+        .collect()
+}
+
+/// Shrinking-ball medial points (Ma, Bae & Mukherjee, "3D medial axis point approximation
+/// using nearest neighbors and the normal field", Visual Computer 2012): for each sample `p`
+/// with unit outward normal `n`, the centre `p − r n` of the largest ball touching `p` that
+/// holds no other sample, `r` shrunk from half the samples' diagonal by
+/// `r = ‖p − q‖² / (2 nᵀ(p − q))` through the nearest sample `q` to the centre until `p` itself
+/// is nearest. A sample whose ball never touches another (the open side of a sheet) is its own
+/// medial point.
+/// Cost: O(n log n) for the kd-tree, then a few nearest-point queries per sample (parallel).
+///
+/// # Panics
+/// If `samples` and `normals` differ in length.
+#[track_caller]
+pub fn medial_points(samples: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    assert_eq!(samples.len(), normals.len(), "one normal per sample");
+    let Some(index) = subfit_target::neighbors::PointIndex::new(samples) else {
+        return samples.to_vec();
+    };
+    let bound =
+        subfit_mesh::bounding_box(samples).map_or(0.0, |(lo, hi)| 0.5 * dist2(lo, hi).sqrt());
+    (0..samples.len())
+        .into_par_iter()
+        .map(|i| {
+            let (p, n) = (samples[i], normals[i]);
+            let mut r = bound;
+            let mut touched = false;
+            for _ in 0..64 {
+                let c = std::array::from_fn(|a| p[a] - r * n[a]);
+                let q = index.nearest(&c);
+                let j = q.index as usize;
+                if j == i || q.distance >= r * (1.0 - 1e-9) {
+                    break;
+                }
+                let d = sub(p, samples[j]);
+                let den = 2.0 * dot3(n, d);
+                if den <= 0.0 {
+                    break;
+                }
+                let shrunk = dot3(d, d) / den;
+                if shrunk >= r {
+                    break;
+                }
+                r = shrunk;
+                touched = true;
+            }
+            if !touched {
+                return p;
+            }
+            std::array::from_fn(|a| p[a] - r * n[a])
+        })
+        .collect()
 }
 
 /// Per-node affine motions of one tracking step: `x ↦ A_k (x − g_k) + g_k + t_k`.
@@ -179,19 +320,27 @@ impl NodeMotion {
         }
     }
 
-    /// The same motion once more, from where this one ended (constant velocity): a node that
-    /// moved by `(A, t)` moves by `(A, A t)` — exact for a steady spin about a fixed axis.
-    pub fn repeated(&self) -> Self {
+    /// The motion one step on at constant velocity, from `before` (the previous step's
+    /// motion) through this one: each node's `A` and `t` extrapolated linearly (a turn by
+    /// `δ` a step is predicted to `O(δ²)`).
+    ///
+    /// # Panics
+    /// If the two have different numbers of nodes.
+    #[track_caller]
+    pub fn extrapolated(&self, before: &Self) -> Self {
+        assert_eq!(self.linear.len(), before.linear.len(), "same nodes");
         Self {
-            linear: self.linear.clone(),
-            translations: self
+            linear: self
                 .linear
                 .iter()
-                .zip(&self.translations)
-                .map(|(a, &t)| {
-                    let x = a * v(t);
-                    [x.x, x.y, x.z]
-                })
+                .zip(&before.linear)
+                .map(|(a, b)| 2.0 * a - b)
+                .collect(),
+            translations: self
+                .translations
+                .iter()
+                .zip(&before.translations)
+                .map(|(a, b)| std::array::from_fn(|k| 2.0 * a[k] - b[k]))
                 .collect(),
         }
     }
@@ -329,14 +478,15 @@ impl Normal {
     }
 }
 
-/// Moves `cage` (the previous frame's control points, normalized units) onto `target` (the new
-/// frame): an embedded deformation fitted to bring `samples` (points of the previous frame's
-/// limit surface, with unit `normals`) onto the target; returns the moved cage, the node
-/// motion (to predict the next frame) and figures. `initial`: the motion to start from (e.g.
-/// a constant-velocity prediction, [`NodeMotion::repeated`]); `None` starts from rest.
+/// Moves `cage` (control points in the graph's rest configuration, normalized units: in a
+/// sequence the template's) onto `target` (the frame): an embedded deformation of the graph's
+/// rest positions fitted to bring `samples` (points of the rest limit surface, with unit
+/// `normals`) onto the target; returns the moved cage, the node motion (the warm start of the
+/// next frame) and figures. `initial`: the motion to start from (e.g. the previous frame's,
+/// [`NodeMotion::extrapolated`]); `None` starts from rest.
 ///
 /// # Panics
-/// If `samples` and `normals` differ in length, or the graph's nodes are not among `cage`.
+/// If `samples` and `normals` differ in length.
 #[track_caller]
 pub fn track(
     graph: &DeformationGraph,
@@ -349,7 +499,7 @@ pub fn track(
 ) -> (Vec<[f64; 3]>, NodeMotion, TrackStats) {
     assert_eq!(samples.len(), normals.len(), "one normal per sample");
     let m = graph.len();
-    let g: Vec<[f64; 3]> = graph.nodes.iter().map(|&i| cage[i as usize]).collect();
+    let g = &graph.positions;
     let mut motion = initial
         .filter(|x| x.linear.len() == m)
         .cloned()
@@ -358,12 +508,12 @@ pub fn track(
     if m == 0 || samples.is_empty() {
         return (cage.to_vec(), motion, stats);
     }
-    let skin = Skin::new(samples, &g, options.skin);
+    let skin = Skin::new(samples, g, options.skin);
     let pairs: usize = graph.neighbors.iter().map(Vec::len).sum();
     for it in 0..options.iterations {
         let moved: Vec<[f64; 3]> = (0..samples.len())
             .into_par_iter()
-            .map(|i| skin.apply(i, samples[i], &g, &motion))
+            .map(|i| skin.apply(i, samples[i], g, &motion))
             .collect();
         let moved_normals: Vec<[f64; 3]> = (0..samples.len())
             .into_par_iter()
@@ -460,6 +610,35 @@ pub fn track(
                 }
             }
         }
+        // Second-order rows: each entry of the linear parts over a node's neighbourhood, less
+        // its best linear trend in position. A bend that goes on at the same rate costs
+        // nothing, a bend that stops does.
+        let w2 = options.second_order / m as f64;
+        if w2 > 0.0 {
+            for (k, nb) in graph.neighbors.iter().enumerate() {
+                let p = &graph.detrend[k];
+                if p.is_empty() {
+                    continue;
+                }
+                let ids: Vec<usize> = std::iter::once(k)
+                    .chain(nb.iter().map(|&l| l as usize))
+                    .collect();
+                let q = ids.len();
+                for e in 0..9 {
+                    let (a, c) = (e / 3, e % 3);
+                    for r in 0..q {
+                        j.clear();
+                        let mut res = 0.0;
+                        for (s, &l) in ids.iter().enumerate() {
+                            let coef = p[r * q + s];
+                            res += coef * motion.linear[l][(a, c)];
+                            j.push((PER * l + e, coef));
+                        }
+                        sys.row(&j, res, w2);
+                    }
+                }
+            }
+        }
         // A little Levenberg damping keeps unobserved nodes put.
         let nn = sys.n;
         let trace: f64 = (0..nn).map(|i| sys.h[i * nn + i]).sum::<f64>() / nn as f64;
@@ -481,10 +660,10 @@ pub fn track(
         }
         stats.iterations = it + 1;
     }
-    let cage_skin = Skin::new(cage, &g, options.skin);
+    let cage_skin = Skin::new(cage, g, options.skin);
     let moved_cage = (0..cage.len())
         .into_par_iter()
-        .map(|i| cage_skin.apply(i, cage[i], &g, &motion))
+        .map(|i| cage_skin.apply(i, cage[i], g, &motion))
         .collect();
     (moved_cage, motion, stats)
 }
@@ -542,4 +721,61 @@ fn plane_rms(samples: &[[f64; 3]], matches: &[(usize, [f64; 3], [f64; 3])]) -> f
 
 fn v(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A few scattered nodes: a field linear in position is left alone by every node's
+    /// projector, a quadratic one is not.
+    #[test]
+    fn the_second_order_projector_removes_exactly_the_linear_fields() {
+        let points: Vec<[f64; 3]> = (0..40)
+            .map(|i| {
+                let t = f64::from(i);
+                [(1.3 * t).sin(), (0.7 * t).cos(), 0.05 * t - 1.0]
+            })
+            .collect();
+        let graph = DeformationGraph::new(&points, 25, 8);
+        let g = graph.positions();
+        let linear: Vec<f64> = g
+            .iter()
+            .map(|p| 0.3 + 2.0 * p[0] - p[1] + 0.5 * p[2])
+            .collect();
+        let quadratic: Vec<f64> = g.iter().map(|p| p[0] * p[0] + p[1] * p[2]).collect();
+        let (mut lin, mut quad) = (0.0f64, 0.0f64);
+        for (k, nb) in graph.neighbors.iter().enumerate() {
+            let p = &graph.detrend[k];
+            assert!(!p.is_empty(), "node {k} has a projector");
+            let ids: Vec<usize> = std::iter::once(k)
+                .chain(nb.iter().map(|&l| l as usize))
+                .collect();
+            let q = ids.len();
+            for r in 0..q {
+                let apply = |f: &[f64]| (0..q).map(|s| p[r * q + s] * f[ids[s]]).sum::<f64>();
+                lin = lin.max(apply(&linear).abs());
+                quad = quad.max(apply(&quadratic).abs());
+            }
+        }
+        assert!(lin < 1e-12, "linear field left {lin}");
+        assert!(quad > 1e-3, "quadratic field left {quad}");
+    }
+
+    /// Two steps of a motion linear in time predict the third exactly.
+    #[test]
+    fn extrapolation_continues_a_steady_motion() {
+        let at = |s: f64| NodeMotion {
+            linear: vec![Matrix3::identity() * (1.0 + 0.1 * s); 2],
+            translations: vec![[s, -2.0 * s, 0.5], [0.0, s, s]],
+        };
+        let next = at(2.0).extrapolated(&at(1.0));
+        let want = at(3.0);
+        for k in 0..2 {
+            assert!((next.linear[k] - want.linear[k]).norm() < 1e-12);
+            for a in 0..3 {
+                assert!((next.translations[k][a] - want.translations[k][a]).abs() < 1e-12);
+            }
+        }
+    }
 }

@@ -86,3 +86,40 @@ fn a_turn_along_the_surface_is_followed() {
     eprintln!("{stats:?}; distance to the true motion: RMS {before:.4} -> {after:.6}");
     assert!(after < 0.02 * before, "RMS {before} -> {after}");
 }
+
+/// Samples of a sphere of radius 0.4 centred at `c` and an elongated capsule-like body: the
+/// shrinking balls of a sphere end at its centre, and interior nodes at depth ½ lie halfway
+/// in.
+#[test]
+fn medial_points_and_interior_nodes_lie_inside() {
+    let sphere = subfit_mesh::shapes::geodesic_sphere(4);
+    let (c, r) = ([0.3, -0.2, 0.5], 0.4);
+    let samples: Vec<[f64; 3]> = sphere
+        .positions
+        .iter()
+        .map(|p| std::array::from_fn(|a| c[a] + r * p[a]))
+        .collect();
+    let normals = sphere.positions.clone();
+    let medial = subfit_fit::track::medial_points(&samples, &normals);
+    let worst = medial
+        .iter()
+        .map(|&m| dist2(m, c).sqrt())
+        .fold(0.0, f64::max);
+    assert!(worst < 0.02 * r, "medial point {worst} from the centre");
+    let graph = DeformationGraph::interior(&samples, &normals, 0.5, 30, 8);
+    assert_eq!(graph.len(), 30);
+    for &g in graph.positions() {
+        let d = dist2(g, c).sqrt();
+        assert!(
+            (d - 0.5 * r).abs() < 0.02 * r,
+            "node at {d} from the centre"
+        );
+    }
+    // An open side: a flat square's balls touch nothing below it; its samples stay put.
+    let flat: Vec<[f64; 3]> = (0..400)
+        .map(|i| [f64::from(i % 20) / 19.0, f64::from(i / 20) / 19.0, 0.0])
+        .collect();
+    let up = vec![[0.0, 0.0, 1.0]; flat.len()];
+    let m = subfit_fit::track::medial_points(&flat, &up);
+    assert_eq!(m, flat);
+}

@@ -50,7 +50,7 @@ fn frame(item: &Bound<'_, PyAny>, index: usize) -> PyResult<Input> {
     frames, *, template=None, control_points=None, scheme_name="auto", method="sdm",
     arap=0.01, lambda_=1e-5, iterations=12, tolerance=5e-4, sample_level=2,
     silhouette_views=8, silhouette_resolution=128,
-    silhouette_weight=subfit::DEFAULT_SILHOUETTE_WEIGHT, track_nodes=30, progress=None
+    silhouette_weight=subfit::DEFAULT_SILHOUETTE_WEIGHT, track_nodes=60, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_sequence_py(

@@ -1,6 +1,6 @@
-//! The tracking step of a sequence (see [`crate::sequence`]'s module docs): the previous
-//! frame's cage carried onto the new frame by an embedded deformation
-//! ([`subfit_fit::track`]) before the frame's fit.
+//! The tracking step of a sequence (see [`crate::sequence`]'s module docs): the template
+//! carried onto each new frame by an embedded deformation ([`subfit_fit::track`]) whose nodes
+//! lie inside the body, warm-started from the previous frames' motions, before the frame's fit.
 
 use serde::Serialize;
 use subfit_fit::track::{plane_rms_to, track, DeformationGraph, NodeMotion, TrackOptions};
@@ -12,13 +12,16 @@ use crate::sequence::LimitStencils;
 /// The embedded-deformation tracking step of a sequence ([`subfit_fit::track`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackingOptions {
-    /// Nodes of the deformation graph. Default 30 (more nodes follow finer motion but let
-    /// regions slide where the frame shows nothing; see [`subfit_fit::track`]).
+    /// Nodes of the deformation graph. Default 60 (see [`crate::sequence`]'s module docs).
     pub nodes: usize,
     /// Nearest nodes each node is tied to. Default 8.
     pub neighbors: usize,
-    /// Start each step from the previous step's motion repeated (constant velocity,
-    /// [`NodeMotion::repeated`]). Default true.
+    /// Where the nodes lie: this fraction of the way from the template's limit surface to its
+    /// medial points ([`DeformationGraph::interior`]); 0 puts them on the surface. Default 0.5.
+    pub depth: f64,
+    /// Start each frame from the motion of the two previous frames extrapolated (constant
+    /// velocity, [`NodeMotion::extrapolated`]); otherwise from the previous frame's motion.
+    /// Default true.
     pub predict: bool,
     /// Refinement level of the limit samples that are tracked. Default 1.
     pub level: usize,
@@ -34,8 +37,9 @@ pub struct TrackingOptions {
 impl Default for TrackingOptions {
     fn default() -> Self {
         Self {
-            nodes: 30,
+            nodes: 60,
             neighbors: 8,
+            depth: 0.5,
             predict: true,
             level: 1,
             discrepancy: 1.5,
@@ -60,27 +64,37 @@ pub struct TrackingReport {
     pub stop_rms: f64,
 }
 
-/// The step's state between frames: its graph (on the template), the limit samples it tracks
-/// and its last motion.
+/// The step's state between frames: its graph (inside the template), the limit stencils of
+/// the samples it tracks, the template with its samples, and the last two motions (template →
+/// frame).
 pub(crate) struct Tracking {
     graph: DeformationGraph,
     samples: LimitStencils,
+    template: Vec<[f64; 3]>,
+    rest: (Vec<[f64; 3]>, Vec<[f64; 3]>),
     motion: Option<NodeMotion>,
+    before: Option<NodeMotion>,
     /// The previous frame's point-to-plane RMS against its own frame ([`Self::settle`]).
     floor: f64,
 }
 
 impl Tracking {
-    /// The graph on `template`, samples from `op` (the limit at [`TrackingOptions::level`]).
+    /// The graph inside `template`, samples from `op` (the limit at
+    /// [`TrackingOptions::level`]).
     pub(crate) fn new(template: &[[f64; 3]], op: SamplingOperator, o: &TrackingOptions) -> Self {
+        let samples = LimitStencils {
+            position: op.position,
+            tangent1: op.tangent1,
+            tangent2: op.tangent2,
+        };
+        let rest = samples_of(&samples, template);
         Self {
-            graph: DeformationGraph::new(template, o.nodes, o.neighbors),
-            samples: LimitStencils {
-                position: op.position,
-                tangent1: op.tangent1,
-                tangent2: op.tangent2,
-            },
+            graph: DeformationGraph::interior(&rest.0, &rest.1, o.depth, o.nodes, o.neighbors),
+            samples,
+            template: template.to_vec(),
+            rest,
             motion: None,
+            before: None,
             floor: 0.0,
         }
     }
@@ -88,46 +102,34 @@ impl Tracking {
     /// Records how closely `cage`, fitted to `target`, lies on it (the samples' RMS
     /// point-to-plane distance): the next step's floor.
     pub(crate) fn settle(&mut self, cage: &[[f64; 3]], target: &Target, o: &TrackingOptions) {
-        let (samples, normals) = self.samples_of(cage);
+        let (samples, normals) = samples_of(&self.samples, cage);
         self.floor = plane_rms_to(&samples, &normals, target, o.step.max_distance).0;
     }
 
-    fn samples_of(&self, cage: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
-        let samples = self.samples.position.apply(cage);
-        let normals = normals_from_tangents(
-            &self.samples.tangent1.apply(cage),
-            &self.samples.tangent2.apply(cage),
-        );
-        (samples, normals)
-    }
-
-    /// Carries `cage` (the previous frame's) onto `target`; returns the moved cage.
+    /// Carries the template onto `target` (the next frame); returns the moved cage.
     pub(crate) fn step(
         &mut self,
-        cage: &[[f64; 3]],
         target: &Target,
         o: &TrackingOptions,
     ) -> (Vec<[f64; 3]>, TrackingReport) {
-        let (samples, normals) = self.samples_of(cage);
         let step = TrackOptions {
             stop_rms: o.discrepancy * self.floor,
             ..o.step.clone()
         };
-        let initial = self
-            .motion
-            .as_ref()
-            .filter(|_| o.predict)
-            .map(NodeMotion::repeated);
+        let initial = match (&self.motion, &self.before) {
+            (Some(last), Some(before)) if o.predict => Some(last.extrapolated(before)),
+            (last, _) => last.clone(),
+        };
         let (moved, motion, stats) = track(
             &self.graph,
-            cage,
-            &samples,
-            &normals,
+            &self.template,
+            &self.rest.0,
+            &self.rest.1,
             target,
             initial.as_ref(),
             &step,
         );
-        self.motion = Some(motion);
+        self.before = self.motion.replace(motion);
         let report = TrackingReport {
             matched: stats.matched,
             rms_before: stats.rms_before,
@@ -137,4 +139,14 @@ impl Tracking {
         };
         (moved, report)
     }
+}
+
+/// The limit samples of `cage` and their unit normals.
+fn samples_of(stencils: &LimitStencils, cage: &[[f64; 3]]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let samples = stencils.position.apply(cage);
+    let normals = normals_from_tangents(
+        &stencils.tangent1.apply(cage),
+        &stencils.tangent2.apply(cage),
+    );
+    (samples, normals)
 }

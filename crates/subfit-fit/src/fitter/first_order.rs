@@ -81,17 +81,10 @@ impl<T: DataTerm> Fitter<'_, T> {
         // Half-gradients, doubled at the end.
         let mut g = self.pattern.gradient(&r, control, w_e, w_s);
         if let (Some(st), Some((sop, tris))) = (&self.options.surface_term, &self.surface) {
-            let (_, grad) = st
-                .term
-                .value_and_gradient(&sop.position.apply(control), tris);
             let c = 0.5 * st.weight;
-            for (k, gk) in grad.iter().enumerate() {
-                let (cols, ws) = sop.position.row(k);
-                for (&j, &w) in cols.iter().zip(ws) {
-                    for a in 0..3 {
-                        g[j as usize][a] += c * w * gk[a];
-                    }
-                }
+            let gp = crate::surface_term::control_gradient(st.term.as_ref(), sop, tris, control);
+            for (g, p) in g.iter_mut().zip(&gp) {
+                (0..3).for_each(|a| g[a] += c * p[a]);
             }
         }
         if let Some(arap) = self.arap.as_ref().and_then(|a| a.ready()) {

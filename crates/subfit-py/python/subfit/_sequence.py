@@ -104,13 +104,13 @@ def fit_sequence(
     """Fits one cage to every frame of a deforming scan: the pipeline of ``subfit sequence``.
 
     The template is the first frame fitted as :func:`subfit.fit` would (or ``template``, a
-    cage in the first frame's coordinates); each next frame starts from the previous frame's
-    cage, carried onto it by an embedded deformation (``track_nodes`` nodes, 0: off; it follows
-    motion along the surface), and is fitted with the data term, smoothing, an
-    as-rigid-as-possible term towards
-    the template and a soft silhouette term from ``silhouette_views`` views (Xie et al. 2023
-    §4.2; 0 turns it off). Every frame's cage has the template's connectivity and vertex
-    order.
+    cage in the first frame's coordinates); each next frame starts from the template carried
+    onto it by an embedded deformation (``track_nodes`` nodes inside the body, 0: off, each
+    frame then starts from the previous cage; it follows motion along the surface), and is
+    fitted with the data term, smoothing, an as-rigid-as-possible term towards the template
+    (as the tracking carried it) and a soft silhouette term from ``silhouette_views`` views
+    (Xie et al. 2023 §4.2; 0 turns it off). Every frame's cage has the template's connectivity
+    and vertex order.
 
     Parameters
     ----------
@@ -130,7 +130,7 @@ def fit_sequence(
         The other flags of ``subfit sequence``: ``scheme`` ("auto"), ``method`` ("sdm" or
         "imls"), ``arap`` (0.01), ``lambda_`` (1e-5), ``iterations`` (12), ``tolerance``
         (5e-4), ``sample_level`` (2), ``silhouette_resolution`` (128),
-        ``silhouette_weight``, ``track_nodes`` (30).
+        ``silhouette_weight``, ``track_nodes`` (60).
 
     Raises
     ------
