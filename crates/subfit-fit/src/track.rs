@@ -209,8 +209,9 @@ impl DeformationGraph {
 }
 
 /// `I − Π` over node `k` and its neighbours `nb`, `Π` the least-squares projector onto the
-/// fields linear in position (`1, x, y, z`); empty when there are too few nodes to leave
-/// anything (fewer than 5) or they are coplanar.
+/// fields linear in position (`1, x, y, z`), from the thin SVD of that basis over the nodes
+/// (directions with a singular value below 1e-6 of the largest are dropped: on a flat
+/// neighbourhood the fields linear in its plane); empty with fewer than 5 nodes.
 fn detrend(g: &[[f64; 3]], k: usize, nb: &[u32]) -> Vec<f64> {
     let ids: Vec<usize> = std::iter::once(k)
         .chain(nb.iter().map(|&l| l as usize))
@@ -225,27 +226,26 @@ fn detrend(g: &[[f64; 3]], k: usize, nb: &[u32]) -> Vec<f64> {
         .fold(0.0, f64::max)
         .sqrt()
         .max(1e-300);
-    let b = Mat::<f64>::from_fn(q, 4, |r, c| {
+    let b = nalgebra::DMatrix::<f64>::from_fn(q, 4, |r, c| {
         if c == 0 {
             1.0
         } else {
             (g[ids[r]][c - 1] - g[k][c - 1]) / scale
         }
     });
-    let btb = b.transpose() * &b;
-    let Ok(llt) = btb.llt(Side::Lower) else {
+    let svd = b.svd(true, false);
+    let Some(u) = svd.u else {
         return Vec::new();
     };
-    // Coplanar neighbourhoods are nearly singular: leave them out.
-    let diag_min = (0..4).map(|i| btb[(i, i)]).fold(f64::INFINITY, f64::min);
-    if diag_min < 1e-6 * q as f64 {
-        return Vec::new();
-    }
-    let pi = &b * llt.solve(b.transpose());
+    let top = svd.singular_values.max();
+    let kept: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&c| svd.singular_values[c] > 1e-6 * top)
+        .collect();
     (0..q * q)
         .map(|e| {
             let (r, c) = (e / q, e % q);
-            f64::from(u8::from(r == c)) - pi[(r, c)]
+            let pi: f64 = kept.iter().map(|&m| u[(r, m)] * u[(c, m)]).sum();
+            f64::from(u8::from(r == c)) - pi
         })
         .collect()
 }
@@ -760,6 +760,32 @@ mod tests {
         }
         assert!(lin < 1e-12, "linear field left {lin}");
         assert!(quad > 1e-3, "quadratic field left {quad}");
+    }
+
+    /// Nodes on a plane: the projector still removes the fields linear in the plane.
+    #[test]
+    fn a_flat_neighbourhood_keeps_its_projector() {
+        let points: Vec<[f64; 3]> = (0..36)
+            .map(|i| {
+                let (x, y) = (f64::from(i % 6), f64::from(i / 6));
+                // The plane x + y + z = 0, not along an axis.
+                [x, y, -x - y]
+            })
+            .collect();
+        let graph = DeformationGraph::new(&points, 36, 8);
+        let g = graph.positions();
+        let linear: Vec<f64> = g.iter().map(|p| 1.0 + p[0] - 3.0 * p[1]).collect();
+        for (k, nb) in graph.neighbors.iter().enumerate() {
+            let p = &graph.detrend[k];
+            let ids: Vec<usize> = std::iter::once(k)
+                .chain(nb.iter().map(|&l| l as usize))
+                .collect();
+            let q = ids.len();
+            for r in 0..q {
+                let v: f64 = (0..q).map(|s| p[r * q + s] * linear[ids[s]]).sum();
+                assert!(v.abs() < 1e-9, "node {k}: {v}");
+            }
+        }
     }
 
     /// Two steps of a motion linear in time predict the third exactly.
