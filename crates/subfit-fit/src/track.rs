@@ -206,6 +206,17 @@ impl DeformationGraph {
     pub fn positions(&self) -> &[[f64; 3]] {
         &self.positions
     }
+
+    /// Node `k` and its neighbours, in the order of its second-order projector.
+    fn neighbourhood(&self, k: usize) -> Vec<usize> {
+        neighbourhood(k, &self.neighbors[k])
+    }
+}
+
+fn neighbourhood(k: usize, nb: &[u32]) -> Vec<usize> {
+    std::iter::once(k)
+        .chain(nb.iter().map(|&l| l as usize))
+        .collect()
 }
 
 /// `I − Π` over node `k` and its neighbours `nb`, `Π` the least-squares projector onto the
@@ -213,9 +224,7 @@ impl DeformationGraph {
 /// (directions with a singular value below 1e-6 of the largest are dropped: on a flat
 /// neighbourhood the fields linear in its plane); empty with fewer than 5 nodes.
 fn detrend(g: &[[f64; 3]], k: usize, nb: &[u32]) -> Vec<f64> {
-    let ids: Vec<usize> = std::iter::once(k)
-        .chain(nb.iter().map(|&l| l as usize))
-        .collect();
+    let ids = neighbourhood(k, nb);
     let q = ids.len();
     if q < 5 {
         return Vec::new();
@@ -615,14 +624,11 @@ pub fn track(
         // nothing, a bend that stops does.
         let w2 = options.second_order / m as f64;
         if w2 > 0.0 {
-            for (k, nb) in graph.neighbors.iter().enumerate() {
-                let p = &graph.detrend[k];
+            for (k, p) in graph.detrend.iter().enumerate() {
                 if p.is_empty() {
                     continue;
                 }
-                let ids: Vec<usize> = std::iter::once(k)
-                    .chain(nb.iter().map(|&l| l as usize))
-                    .collect();
+                let ids = graph.neighbourhood(k);
                 let q = ids.len();
                 for e in 0..9 {
                     let (a, c) = (e / 3, e % 3);
@@ -727,6 +733,21 @@ fn v(a: [f64; 3]) -> Vector3<f64> {
 mod tests {
     use super::*;
 
+    /// The largest entry of `(I − Π_k) f` over all nodes `k` (`f` one value a node).
+    fn largest_left(graph: &DeformationGraph, f: &[f64]) -> f64 {
+        let mut most = 0.0f64;
+        for (k, p) in graph.detrend.iter().enumerate() {
+            assert!(!p.is_empty(), "node {k} has a projector");
+            let ids = graph.neighbourhood(k);
+            let q = ids.len();
+            for r in 0..q {
+                let v: f64 = (0..q).map(|s| p[r * q + s] * f[ids[s]]).sum();
+                most = most.max(v.abs());
+            }
+        }
+        most
+    }
+
     /// A few scattered nodes: a field linear in position is left alone by every node's
     /// projector, a quadratic one is not.
     #[test]
@@ -744,20 +765,10 @@ mod tests {
             .map(|p| 0.3 + 2.0 * p[0] - p[1] + 0.5 * p[2])
             .collect();
         let quadratic: Vec<f64> = g.iter().map(|p| p[0] * p[0] + p[1] * p[2]).collect();
-        let (mut lin, mut quad) = (0.0f64, 0.0f64);
-        for (k, nb) in graph.neighbors.iter().enumerate() {
-            let p = &graph.detrend[k];
-            assert!(!p.is_empty(), "node {k} has a projector");
-            let ids: Vec<usize> = std::iter::once(k)
-                .chain(nb.iter().map(|&l| l as usize))
-                .collect();
-            let q = ids.len();
-            for r in 0..q {
-                let apply = |f: &[f64]| (0..q).map(|s| p[r * q + s] * f[ids[s]]).sum::<f64>();
-                lin = lin.max(apply(&linear).abs());
-                quad = quad.max(apply(&quadratic).abs());
-            }
-        }
+        let (lin, quad) = (
+            largest_left(&graph, &linear),
+            largest_left(&graph, &quadratic),
+        );
         assert!(lin < 1e-12, "linear field left {lin}");
         assert!(quad > 1e-3, "quadratic field left {quad}");
     }
@@ -773,19 +784,13 @@ mod tests {
             })
             .collect();
         let graph = DeformationGraph::new(&points, 36, 8);
-        let g = graph.positions();
-        let linear: Vec<f64> = g.iter().map(|p| 1.0 + p[0] - 3.0 * p[1]).collect();
-        for (k, nb) in graph.neighbors.iter().enumerate() {
-            let p = &graph.detrend[k];
-            let ids: Vec<usize> = std::iter::once(k)
-                .chain(nb.iter().map(|&l| l as usize))
-                .collect();
-            let q = ids.len();
-            for r in 0..q {
-                let v: f64 = (0..q).map(|s| p[r * q + s] * linear[ids[s]]).sum();
-                assert!(v.abs() < 1e-9, "node {k}: {v}");
-            }
-        }
+        let linear: Vec<f64> = graph
+            .positions()
+            .iter()
+            .map(|p| 1.0 + p[0] - 3.0 * p[1])
+            .collect();
+        let left = largest_left(&graph, &linear);
+        assert!(left < 1e-9, "linear field left {left}");
     }
 
     /// Two steps of a motion linear in time predict the third exactly.

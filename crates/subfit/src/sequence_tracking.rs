@@ -2,6 +2,8 @@
 //! carried onto each new frame by an embedded deformation ([`subfit_fit::track`]) whose nodes
 //! lie inside the body, warm-started from the previous frames' motions, before the frame's fit.
 
+use std::sync::Arc;
+
 use serde::Serialize;
 use subfit_fit::track::{plane_rms_to, track, DeformationGraph, NodeMotion, TrackOptions};
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
@@ -70,7 +72,7 @@ pub struct TrackingReport {
 pub(crate) struct Tracking {
     graph: DeformationGraph,
     samples: LimitStencils,
-    template: Vec<[f64; 3]>,
+    template: Arc<Vec<[f64; 3]>>,
     rest: (Vec<[f64; 3]>, Vec<[f64; 3]>),
     motion: Option<NodeMotion>,
     before: Option<NodeMotion>,
@@ -81,17 +83,21 @@ pub(crate) struct Tracking {
 impl Tracking {
     /// The graph inside `template`, samples from `op` (the limit at
     /// [`TrackingOptions::level`]).
-    pub(crate) fn new(template: &[[f64; 3]], op: SamplingOperator, o: &TrackingOptions) -> Self {
+    pub(crate) fn new(
+        template: Arc<Vec<[f64; 3]>>,
+        op: SamplingOperator,
+        o: &TrackingOptions,
+    ) -> Self {
         let samples = LimitStencils {
             position: op.position,
             tangent1: op.tangent1,
             tangent2: op.tangent2,
         };
-        let rest = samples_of(&samples, template);
+        let rest = samples_of(&samples, &template);
         Self {
             graph: DeformationGraph::interior(&rest.0, &rest.1, o.depth, o.nodes, o.neighbors),
             samples,
-            template: template.to_vec(),
+            template,
             rest,
             motion: None,
             before: None,
