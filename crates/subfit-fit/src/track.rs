@@ -60,6 +60,23 @@
 //! of the diagonal: what is left is the choice among motions the surfaces cannot tell apart
 //! (a slide over a rounded end), not the graph's reach.
 //!
+//! **What the frames determine** (`cargo run --release -p subfit-fit --example
+//! drift_identifiability`, frame 8 of the default motion, the strongest bend, 60 nodes):
+//! fitted to the true correspondences ([`fit_correspondences`]) the graph is within 0.087 %
+//! of the truth and leaves 1.43e-4 point-to-plane RMS; tracking started *there* goes back to
+//! the same 2.3 % drift (1.76e-4) as tracking from the template; with all priors a hundred
+//! times weaker and a frame four times denser it slides 2.0 % away while fitting the frame
+//! *better* than the truth (4.3e-5). With 200 nodes: the truth 6.2e-5, the weak-prior motion
+//! 2.3e-5 at 4.0 % drift. Sliding the material over the surface is free as far as the frames
+//! go, so the priors decide — and the generated motion is not the one a generic prior
+//! prefers: its surface strain (mean squared relative change of edge length, 2.45e-2) is
+//! *larger* than the tracked motion's (2.22e-2), so a least-strain (ARAP) prior would turn
+//! away from it too. On the bench's sequence (8000 vertices, 500 control points, largest drift
+//! over 30 frames, 2.2 % with the defaults) rigidity ×10 / ×100 / ×1000 gave 2.8 / 3.1 /
+//! 3.4 %, no rigidity 2.5 %, a symmetric (trapezoidal) regularity without rigidity 2.6 %.
+//! Below 1 % would need a prior built for this family of motions (cross-sections carried
+//! along an axis, Barr's deformations), not a generic one.
+//!
 //! **Cost** per step: `iterations × (S foot points + S·(12s)² + (12m)³/3 flops)`, plus once
 //! per graph O(S log S) for the medial points and O(m·K³) for the projectors.
 
@@ -456,6 +473,38 @@ impl Skin {
     }
 }
 
+impl Skin {
+    /// The gradient of `dirᵀx'` for point `i` at rest position `x` (sparse, into `j`):
+    /// `δx' = Σ_k w_k (δA_k (x − g_k) + δt_k)`.
+    fn jacobian(
+        &self,
+        j: &mut Vec<(usize, f64)>,
+        i: usize,
+        x: [f64; 3],
+        g: &[[f64; 3]],
+        dir: [f64; 3],
+    ) {
+        j.clear();
+        let (ids, w) = self.row(i);
+        for (&k, &wk) in ids.iter().zip(w) {
+            if wk == 0.0 {
+                continue;
+            }
+            let k = k as usize;
+            let d = sub(x, g[k]);
+            for (a, &da) in dir.iter().enumerate() {
+                if da == 0.0 {
+                    continue;
+                }
+                for (c, &dc) in d.iter().enumerate() {
+                    j.push((PER * k + 3 * a + c, wk * da * dc));
+                }
+                j.push((PER * k + 9 + a, wk * da));
+            }
+        }
+    }
+}
+
 /// Unknowns per node: `A` row-major (9), then `t` (3).
 const PER: usize = 12;
 
@@ -473,6 +522,36 @@ impl Normal {
             h: vec![0.0; n * n],
             b: vec![0.0; n],
         }
+    }
+
+    /// Solves the system with a little Levenberg damping (1e-6 of the mean diagonal, which
+    /// keeps unobserved nodes put) and adds the step to `motion`; false when the factorization
+    /// fails.
+    fn solve_into(&self, motion: &mut NodeMotion) -> bool {
+        let nn = self.n;
+        let trace: f64 = (0..nn).map(|i| self.h[i * nn + i]).sum::<f64>() / nn as f64;
+        let h = Mat::<f64>::from_fn(nn, nn, |a, c| {
+            self.h[a * nn + c] + if a == c { 1e-6 * trace.max(1e-30) } else { 0.0 }
+        });
+        let rhs = Mat::<f64>::from_fn(nn, 1, |a, _| self.b[a]);
+        let Ok(llt) = h.llt(Side::Lower) else {
+            return false;
+        };
+        let x = llt.solve(&rhs);
+        for (k, (lin, t)) in motion
+            .linear
+            .iter_mut()
+            .zip(&mut motion.translations)
+            .enumerate()
+        {
+            for a in 0..3 {
+                for c in 0..3 {
+                    lin[(a, c)] += x[(PER * k + 3 * a + c, 0)];
+                }
+                t[a] += x[(PER * k + 9 + a, 0)];
+            }
+        }
+        true
     }
 
     /// Adds `w (jᵀj, −jᵀr)` for one residual row `r` with sparse gradient `j`.
@@ -544,34 +623,14 @@ pub fn track(
         let mut j: Vec<(usize, f64)> = Vec::with_capacity(PER * options.skin);
         // Fit rows: δx'_i = Σ_k w_k (Σ_c d_c δA_k[i][c] + δt_k[i]), d = x − g_k.
         for &(i, y, n) in &matches {
-            let (ids, w) = skin.row(i);
             let r = sub(moved[i], y);
-            let row = |j: &mut Vec<(usize, f64)>, dir: [f64; 3]| {
-                j.clear();
-                for (&k, &wk) in ids.iter().zip(w) {
-                    if wk == 0.0 {
-                        continue;
-                    }
-                    let k = k as usize;
-                    let d = sub(samples[i], g[k]);
-                    for (a, &da) in dir.iter().enumerate() {
-                        if da == 0.0 {
-                            continue;
-                        }
-                        for (c, &dc) in d.iter().enumerate() {
-                            j.push((PER * k + 3 * a + c, wk * da * dc));
-                        }
-                        j.push((PER * k + 9 + a, wk * da));
-                    }
-                }
-            };
-            row(&mut j, n);
+            skin.jacobian(&mut j, i, samples[i], g, n);
             sys.row(&j, dot3(n, r), wf);
             if beta > 0.0 {
                 for a in 0..3 {
                     let mut e = [0.0; 3];
                     e[a] = 1.0;
-                    row(&mut j, e);
+                    skin.jacobian(&mut j, i, samples[i], g, e);
                     sys.row(&j, r[a], wf * beta);
                 }
             }
@@ -645,24 +704,8 @@ pub fn track(
                 }
             }
         }
-        // A little Levenberg damping keeps unobserved nodes put.
-        let nn = sys.n;
-        let trace: f64 = (0..nn).map(|i| sys.h[i * nn + i]).sum::<f64>() / nn as f64;
-        let h = Mat::<f64>::from_fn(nn, nn, |a, c| {
-            sys.h[a * nn + c] + if a == c { 1e-6 * trace.max(1e-30) } else { 0.0 }
-        });
-        let rhs = Mat::<f64>::from_fn(nn, 1, |a, _| sys.b[a]);
-        let Ok(llt) = h.llt(Side::Lower) else {
+        if !sys.solve_into(&mut motion) {
             break;
-        };
-        let x = llt.solve(&rhs);
-        for k in 0..m {
-            for a in 0..3 {
-                for c in 0..3 {
-                    motion.linear[k][(a, c)] += x[(PER * k + 3 * a + c, 0)];
-                }
-                motion.translations[k][a] += x[(PER * k + 9 + a, 0)];
-            }
         }
         stats.iterations = it + 1;
     }
@@ -672,6 +715,64 @@ pub fn track(
         .map(|i| cage_skin.apply(i, cage[i], g, &motion))
         .collect();
     (moved_cage, motion, stats)
+}
+
+/// `points` (in the graph's rest configuration) moved by `motion`, each skinned to its `skin`
+/// nearest nodes as in [`track`]. Cost: O(#points · m).
+pub fn deform(
+    graph: &DeformationGraph,
+    points: &[[f64; 3]],
+    motion: &NodeMotion,
+    skin: usize,
+) -> Vec<[f64; 3]> {
+    if graph.is_empty() || motion.linear.len() != graph.len() {
+        return points.to_vec();
+    }
+    let sk = Skin::new(points, &graph.positions, skin);
+    (0..points.len())
+        .into_par_iter()
+        .map(|i| sk.apply(i, points[i], &graph.positions, motion))
+        .collect()
+}
+
+/// The motion of `graph` that carries `points` (rest positions) closest to `targets` in the
+/// least-squares sense, each point skinned to its `skin` nearest nodes: known
+/// correspondences (markers, or a generator's ground truth), no smoothness term, only
+/// [`track`]'s slight damping. It is what the graph can represent at best, the reference a
+/// tracker's drift is measured against (`examples/drift_identifiability.rs`). One linear
+/// solve: O(#points · (12 skin)² + (12 m)³).
+///
+/// # Panics
+/// If `points` and `targets` differ in length.
+#[track_caller]
+pub fn fit_correspondences(
+    graph: &DeformationGraph,
+    points: &[[f64; 3]],
+    targets: &[[f64; 3]],
+    skin: usize,
+) -> NodeMotion {
+    assert_eq!(points.len(), targets.len(), "one target per point");
+    let m = graph.len();
+    let mut motion = NodeMotion::identity(m);
+    if m == 0 || points.is_empty() {
+        return motion;
+    }
+    let g = &graph.positions;
+    let sk = Skin::new(points, g, skin);
+    let mut sys = Normal::new(PER * m);
+    let w = 1.0 / points.len() as f64;
+    let mut j = Vec::with_capacity(PER * skin);
+    for (i, (&x, &y)) in points.iter().zip(targets).enumerate() {
+        // At rest x' = x: the residual is x − y, the problem linear.
+        for a in 0..3 {
+            let mut e = [0.0; 3];
+            e[a] = 1.0;
+            sk.jacobian(&mut j, i, x, g, e);
+            sys.row(&j, x[a] - y[a], w);
+        }
+    }
+    sys.solve_into(&mut motion);
+    motion
 }
 
 /// The RMS point-to-plane distance of `samples` (unit `normals`) to `target`, over the samples
@@ -791,6 +892,43 @@ mod tests {
             .collect();
         let left = largest_left(&graph, &linear);
         assert!(left < 1e-9, "linear field left {left}");
+    }
+
+    /// Correspondences of an affine motion: the graph reproduces it.
+    #[test]
+    fn correspondences_of_an_affine_motion_are_reproduced() {
+        let points: Vec<[f64; 3]> = (0..200)
+            .map(|i| {
+                let t = f64::from(i);
+                [(1.7 * t).sin(), (0.9 * t).cos(), (0.37 * t).sin() * 0.5]
+            })
+            .collect();
+        let graph = DeformationGraph::new(&points, 12, 6);
+        let a = Matrix3::new(1.1, 0.2, 0.0, -0.1, 0.9, 0.3, 0.05, 0.0, 1.2);
+        let targets: Vec<[f64; 3]> = points
+            .iter()
+            .map(|&p| {
+                let q = a * v(p);
+                [q.x + 0.3, q.y - 0.2, q.z + 1.0]
+            })
+            .collect();
+        let motion = fit_correspondences(&graph, &points, &targets, 4);
+        let moved = deform(&graph, &points, &motion, 4);
+        let worst = moved
+            .iter()
+            .zip(&targets)
+            .map(|(p, q)| dist2(*p, *q).sqrt())
+            .fold(0.0, f64::max);
+        // The damping (1e-6 of the mean diagonal) leaves a few millionths.
+        assert!(worst < 2e-5, "largest miss {worst}");
+        // At rest the motion is the identity and moves nothing.
+        let still = deform(&graph, &points, &NodeMotion::identity(graph.len()), 4);
+        let moved = still
+            .iter()
+            .zip(&points)
+            .map(|(p, q)| dist2(*p, *q).sqrt())
+            .fold(0.0, f64::max);
+        assert!(moved < 1e-12, "the identity moved a point by {moved}");
     }
 
     /// Two steps of a motion linear in time predict the third exactly.
