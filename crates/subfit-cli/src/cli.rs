@@ -162,6 +162,10 @@ pub struct BenchSequenceArgs {
     /// Nodes of the tracking step (0: off) [default: `subfit sequence`'s].
     #[arg(long)]
     pub track_nodes: Option<u32>,
+    /// Markers at their true places in every frame, spread over frame 0 (as `subfit sequence
+    /// --markers` takes them from motion capture); 0: none.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10_000))]
+    pub markers: u32,
     /// ARAP weight α towards the template [default: `subfit sequence`'s].
     #[arg(long)]
     pub arap: Option<f64>,
@@ -461,6 +465,12 @@ pub struct SequenceArgs {
     /// not see); 0 turns the tracking off (each frame then starts from the previous cage).
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(0..=2000))]
     pub track_nodes: u32,
+    /// Known places of markers over the frames (motion capture, tracked texture features), a
+    /// CSV file with the header frame,marker,x,y,z (frame: 0 the first FRAME given; positions
+    /// in the frames' units). The tracking pulls them there, which pins what the surfaces
+    /// leave free: sliding along them. Every marker must be in frame 0.
+    #[arg(long)]
+    pub markers: Option<PathBuf>,
     /// Weight α of the as-rigid-as-possible term towards the template (as the tracking carried
     /// it onto the frame).
     #[arg(long, default_value_t = 0.01)]

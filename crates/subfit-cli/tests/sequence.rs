@@ -114,3 +114,75 @@ fn a_bad_frame_is_named_and_nothing_is_written() {
         .unwrap_or_default();
     assert!(left.is_empty(), "{left:?}");
 }
+
+/// `--markers`: a marker file is read and its markers reach the tracking of every frame
+/// (report.json); a marker in a frame that is not given, a bad line, or markers without the
+/// tracking step are refused with nothing written.
+#[test]
+fn markers_are_read_and_bad_marker_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = frames(dir.path(), 2, 1500);
+    let seq = DeformingSequence::new(DeformingParams {
+        frames: 12,
+        ..DeformingParams::default()
+    })
+    .unwrap();
+    let rest = seq.frame(0, 1500, 7);
+    let mut csv = String::from("frame,marker,x,y,z\n");
+    for i in rest.spread_vertices(6) {
+        for t in 0..2 {
+            let p = seq.deform(t, rest.material[i]);
+            csv += &format!("{t},v{i},{},{},{}\n", p[0], p[1], p[2]);
+        }
+    }
+    let run = |markers: &str, extra: &[&str], out: &std::path::Path| {
+        let path = dir.path().join("markers.csv");
+        std::fs::write(&path, markers).unwrap();
+        let mut args: Vec<&str> = vec!["sequence"];
+        args.extend(files.iter().map(String::as_str));
+        args.extend(["--control-points", "80", "--silhouette-views", "0"]);
+        args.extend(extra);
+        args.extend([
+            "--markers",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        subfit(&args)
+    };
+    let out = dir.path().join("ok");
+    let r = run(&csv, &[], &out);
+    // 80 control points may leave a frame short of the tolerance (exit 1, outputs written).
+    assert!(
+        matches!(r.status.code(), Some(0 | 1)),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
+    assert_eq!(report["frames"][1]["tracking"]["markers"], 6, "{report}");
+    for (markers, extra, says) in [
+        (
+            format!("{csv}2,v0,0,0,0\n"),
+            &[][..],
+            "given in frame 2, but only 2 frames",
+        ),
+        (
+            "frame,marker,x,y,z\n0,a,1,2,x\n".to_string(),
+            &[][..],
+            "markers.csv:2: z must be",
+        ),
+        (
+            csv.clone(),
+            &["--track-nodes", "0"][..],
+            "--markers needs the tracking step",
+        ),
+    ] {
+        let out = dir.path().join("refused");
+        let r = run(&markers, extra, &out);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{err}");
+        assert!(err.contains(says), "{err}");
+        assert!(!out.exists() || std::fs::read_dir(&out).unwrap().next().is_none());
+    }
+}

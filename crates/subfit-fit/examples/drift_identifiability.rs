@@ -4,7 +4,9 @@
 //! thickness wave) the template — frame 0's vertices — is carried onto frame `F` by the
 //! embedded deformation of [`subfit_fit::track`], as `subfit sequence` does (from the
 //! template, warm-started from the previous frames' motions, default weights, run to
-//! convergence), and compared with where its material really went. Then, on the same graph:
+//! convergence), and compared with where its material really went; then again with 12 and 32
+//! [`Marker`]s (vertices spread over the template) pulled to their true places in every frame.
+//! Then, on the same graph:
 //!
 //! 1. **the reference**: the motion fitted to the true correspondences
 //!    ([`fit_correspondences`]) — what the graph can represent at best;
@@ -23,7 +25,8 @@
 #![allow(clippy::print_stdout)]
 
 use subfit_fit::track::{
-    deform, fit_correspondences, track, DeformationGraph, NodeMotion, TrackOptions,
+    deform, fit_correspondences, track, DeformationGraph, Marker, NodeMotion, Samples,
+    TrackOptions, TrackStats,
 };
 use subfit_mesh::deforming::DeformingSequence;
 use subfit_mesh::vec3::{cross, dist2, normalize, sub};
@@ -57,6 +60,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let normals = vertex_normals(&samples, &triangles);
     let graph = DeformationGraph::interior(&samples, &normals, DEPTH, nodes, NEIGHBORS);
     let options = TrackOptions::default();
+    let rest_samples = Samples {
+        positions: &samples,
+        normals: &normals,
+    };
     let target_options = TargetOptions {
         normalization: Some(norm),
         ..TargetOptions::default()
@@ -77,33 +84,55 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         graph.len()
     );
 
-    // The tracker, as a sequence runs it.
-    let (mut now, mut before): (Option<NodeMotion>, Option<NodeMotion>) = (None, None);
-    let mut tracked = samples.clone();
-    let mut target = None;
-    for t in 1..=last {
-        let tg = frame(t, vertices)?;
-        let start = match (&now, &before) {
-            (Some(a), Some(b)) => Some(a.extrapolated(b)),
-            (a, _) => a.clone(),
-        };
-        let (moved, motion, stats) = track(
-            &graph,
-            &samples,
-            &samples,
-            &normals,
-            &tg,
-            start.as_ref(),
-            &options,
-        );
-        if t == last {
-            line("tracked as a sequence does", drift(&moved), stats.rms_after);
+    // The tracker, as a sequence runs it; then with markers at their true positions.
+    let targets: Vec<Target> = (1..=last)
+        .map(|t| frame(t, vertices))
+        .collect::<Result<_, _>>()?;
+    let run = |picks: &[usize]| {
+        let (mut now, mut before): (Option<NodeMotion>, Option<NodeMotion>) = (None, None);
+        let mut out = (samples.clone(), TrackStats::default());
+        for (t, tg) in (1..=last).zip(&targets) {
+            let markers: Vec<Marker> = picks
+                .iter()
+                .map(|&i| Marker {
+                    rest: samples[i],
+                    position: norm.to_normalized(seq.deform(t, rest.material[i])),
+                })
+                .collect();
+            let start = match (&now, &before) {
+                (Some(a), Some(b)) => Some(a.extrapolated(b)),
+                (a, _) => a.clone(),
+            };
+            let (moved, motion, stats) = track(
+                &graph,
+                &samples,
+                rest_samples,
+                tg,
+                &markers,
+                start.as_ref(),
+                &options,
+            );
+            out = (moved, stats);
+            before = now.replace(motion);
         }
-        tracked = moved;
-        before = now.replace(motion);
-        target = Some(tg);
+        out
+    };
+    let (tracked, stats) = run(&[]);
+    line(
+        "tracked as a sequence does",
+        drift(&tracked),
+        stats.rms_after,
+    );
+    for count in [12, 32] {
+        let picks = rest.spread_vertices(count);
+        let (moved, stats) = run(&picks);
+        line(
+            &format!("with {count} markers"),
+            drift(&moved),
+            stats.rms_after,
+        );
     }
-    let target = target.ok_or("no frame tracked")?;
+    let target = targets.last().ok_or("no frame tracked")?;
 
     // 1. The reference: the graph fitted to the true correspondences.
     let reference = fit_correspondences(&graph, &samples, &truth, options.skin);
@@ -115,9 +144,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (_, _, stats) = track(
         &graph,
         &samples,
-        &samples,
-        &normals,
-        &target,
+        rest_samples,
+        target,
+        &[],
         Some(&reference),
         &one,
     );
@@ -135,9 +164,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (moved, _, stats) = track(
         &graph,
         &samples,
-        &samples,
-        &normals,
-        &target,
+        rest_samples,
+        target,
+        &[],
         Some(&reference),
         &long,
     );
@@ -154,9 +183,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (moved, _, stats) = track(
         &graph,
         &samples,
-        &samples,
-        &normals,
+        rest_samples,
         &dense,
+        &[],
         Some(&reference),
         &weak,
     );
@@ -168,9 +197,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (_, _, stats) = track(
         &graph,
         &samples,
-        &samples,
-        &normals,
+        rest_samples,
         &dense,
+        &[],
         Some(&reference),
         &TrackOptions {
             iterations: 1,

@@ -3,7 +3,7 @@
 //! which closest points alone do not see.
 #![allow(clippy::print_stderr)]
 
-use subfit_fit::track::{track, DeformationGraph, TrackOptions};
+use subfit_fit::track::{track, DeformationGraph, Samples, TrackOptions};
 use subfit_mesh::deforming::{DeformingParams, DeformingSequence};
 use subfit_mesh::vec3::{cross, dist2, norm, sub};
 use subfit_target::{Normalization, Target, TargetOptions};
@@ -73,9 +73,12 @@ fn a_turn_along_the_surface_is_followed() {
     let (out, _, stats) = track(
         &graph,
         &samples,
-        &samples,
-        &normals,
+        Samples {
+            positions: &samples,
+            normals: &normals,
+        },
         &target,
+        &[],
         None,
         &TrackOptions::default(),
     );

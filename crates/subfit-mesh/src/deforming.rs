@@ -132,6 +132,28 @@ pub struct Frame {
     pub material: Vec<[f64; 3]>,
 }
 
+impl Frame {
+    /// `count` vertices spread over the frame (farthest-point sampling from vertex 0, by
+    /// straight-line distance): places for markers whose true position in every frame is
+    /// [`DeformingSequence::deform`] of their material. Cost: O(#V · count).
+    pub fn spread_vertices(&self, count: usize) -> Vec<usize> {
+        let p = &self.mesh.positions;
+        let mut picks = Vec::with_capacity(count.min(p.len()));
+        let mut d2 = vec![f64::INFINITY; p.len()];
+        let mut next = 0;
+        while picks.len() < count.min(p.len()) {
+            picks.push(next);
+            for (d, &q) in d2.iter_mut().zip(p) {
+                *d = d.min(dist2(q, p[next]));
+            }
+            next = (0..p.len())
+                .max_by(|&a, &b| d2[a].total_cmp(&d2[b]))
+                .unwrap_or(0);
+        }
+        picks
+    }
+}
+
 /// The per-frame constants of `Φ_t`.
 #[derive(Clone, Copy, Debug)]
 struct Motion {

@@ -44,13 +44,33 @@ fn frame(item: &Bound<'_, PyAny>, index: usize) -> PyResult<Input> {
     Ok(Input::Mesh { mesh, name })
 }
 
+/// Markers from Python: a path to a marker file (`subfit::read_markers`) or rows
+/// `(frame, name, (x, y, z))`.
+fn marker_observations(m: &Bound<'_, PyAny>) -> PyResult<Vec<subfit::MarkerObservation>> {
+    if let Ok(path) = m.extract::<std::path::PathBuf>() {
+        return subfit::read_markers(&path).map_err(fit_error);
+    }
+    let rows: Vec<(usize, String, [f64; 3])> = m.extract().map_err(|_| {
+        value_error("markers must be a path or rows (frame, name, (x, y, z))")
+    })?;
+    Ok(rows
+        .into_iter()
+        .map(|(frame, marker, position)| subfit::MarkerObservation {
+            frame,
+            marker,
+            position,
+        })
+        .collect())
+}
+
 /// Fits one cage to every frame (see the Python `subfit.fit_sequence`).
 #[pyfunction]
 #[pyo3(name = "fit_sequence", signature = (
     frames, *, template=None, control_points=None, scheme_name="auto", method="sdm",
     arap=0.01, lambda_=1e-5, iterations=12, tolerance=5e-4, sample_level=2,
     silhouette_views=8, silhouette_resolution=128,
-    silhouette_weight=subfit::DEFAULT_SILHOUETTE_WEIGHT, track_nodes=60, progress=None
+    silhouette_weight=subfit::DEFAULT_SILHOUETTE_WEIGHT, track_nodes=60, markers=None,
+    progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit_sequence_py(
@@ -69,6 +89,7 @@ pub fn fit_sequence_py(
     silhouette_resolution: i64,
     silhouette_weight: f64,
     track_nodes: i64,
+    markers: Option<Bound<'_, PyAny>>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeSequence> {
     let method = match method.to_ascii_lowercase().as_str() {
@@ -143,10 +164,19 @@ pub fn fit_sequence_py(
             weight: silhouette_weight,
             ..subfit::SilhouetteOptions::default()
         },
-        tracking: match in_range("track_nodes", track_nodes, 0, 2000)? {
-            0 => None,
-            nodes => Some(subfit::TrackingOptions {
+        tracking: match (
+            in_range("track_nodes", track_nodes, 0, 2000)?,
+            markers.map(|m| marker_observations(&m)).transpose()?,
+        ) {
+            (0, None) => None,
+            (0, Some(_)) => {
+                return Err(value_error(
+                    "markers need the tracking step (track_nodes > 0)",
+                ))
+            }
+            (nodes, markers) => Some(subfit::TrackingOptions {
                 nodes,
+                markers: markers.unwrap_or_default(),
                 ..subfit::TrackingOptions::default()
             }),
         },

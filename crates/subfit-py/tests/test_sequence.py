@@ -82,3 +82,43 @@ def test_tracking_runs_by_default_and_track_nodes_zero_turns_it_off():
             assert f["tracking"]["rms_after"] <= f["tracking"]["rms_before"]
     with pytest.raises(ValueError, match="track_nodes"):
         subfit.fit_sequence(frames(1, []), control_points=60, track_nodes=-1)
+
+
+def marker_rows(count: int):
+    """Four markers on the ellipsoid's axes, at their places in frames 0..count-1."""
+    rows = []
+    for t in range(count):
+        ax = frame_axes(t)
+        for name, p in [("x+", (ax[0], 0, 0)), ("x-", (-ax[0], 0, 0)),
+                        ("z+", (0, 0, ax[2])), ("z-", (0, 0, -ax[2]))]:
+            rows.append((t, name, tuple(float(c) for c in p)))
+    return rows
+
+
+def test_markers_as_rows_or_a_file_reach_the_tracking(tmp_path):
+    path = tmp_path / "markers.csv"
+    path.write_text("frame,marker,x,y,z\n" + "".join(
+        f"{t},{n},{p[0]},{p[1]},{p[2]}\n" for t, n, p in marker_rows(2)))
+    for markers in [marker_rows(2), path, str(path)]:
+        seq = subfit.fit_sequence(
+            frames(2, []), control_points=80, silhouette_views=0, markers=markers,
+        )
+        tracking = seq.report["frames"][1]["tracking"]
+        assert tracking["markers"] == 4, tracking
+        # The markers are pulled to their places (normalized units of the first frame).
+        assert tracking["marker_rms"] < 0.02, tracking
+
+
+def test_bad_markers_are_refused_with_the_reason(tmp_path):
+    with pytest.raises(ValueError, match="tracking step"):
+        subfit.fit_sequence(frames(2, []), control_points=60, track_nodes=0,
+                            markers=marker_rows(2))
+    with pytest.raises(ValueError, match='"late" is not in the first frame'):
+        subfit.fit_sequence(frames(2, []), control_points=60,
+                            markers=marker_rows(2) + [(1, "late", (0.0, 0.0, 0.0))])
+    bad = tmp_path / "bad.csv"
+    bad.write_text("frame,marker,x,y,z\n0,a,1,2\n")
+    with pytest.raises(ValueError, match="bad.csv:2: expected 5 fields"):
+        subfit.fit_sequence(frames(2, []), control_points=60, markers=bad)
+    with pytest.raises(ValueError, match="markers must be"):
+        subfit.fit_sequence(frames(2, []), control_points=60, markers=[1, 2, 3])

@@ -30,6 +30,7 @@ mod budget_starts;
 mod error;
 mod html_report;
 pub mod initial_cage;
+mod markers;
 mod outputs;
 pub mod pipeline_report;
 mod repair;
@@ -41,6 +42,7 @@ pub mod tolerance;
 pub use budget_starts::BUDGET_STARTS;
 pub use error::Error;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
+pub use markers::{parse_markers, read_markers};
 pub use outputs::{log_csv, usd_scheme, OUTPUTS};
 pub use pipeline_report::Report;
 pub use repair::repair_mesh;
@@ -48,9 +50,9 @@ pub use scan::{
     fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
 };
 pub use sequence::{
-    fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence,
-    SequenceFrame, SequenceOptions, SequenceOptionsSummary, SequenceReport, SilhouetteOptions,
-    TrackingOptions, TrackingReport, DEFAULT_SILHOUETTE_WEIGHT,
+    fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, MarkerObservation,
+    Sequence, SequenceFrame, SequenceOptions, SequenceOptionsSummary, SequenceReport,
+    SilhouetteOptions, TrackingOptions, TrackingReport, DEFAULT_SILHOUETTE_WEIGHT,
 };
 
 pub use subfit_fit as fit;

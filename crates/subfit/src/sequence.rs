@@ -64,7 +64,7 @@ use crate::error::Error;
 use crate::pipeline_report::{Reorientation, TwoSidedErrors};
 use crate::repair::read_input;
 use crate::sequence_tracking::Tracking;
-pub use crate::sequence_tracking::{TrackingOptions, TrackingReport};
+pub use crate::sequence_tracking::{MarkerObservation, TrackingOptions, TrackingReport};
 use crate::{fit_scan, FitScanOptions, InitialCage, Input};
 
 /// The silhouette term of a sequence (Xie et al. 2023 §4.2; [`subfit_fit::silhouette`]).
@@ -497,7 +497,7 @@ impl Carry {
             Some(t) => {
                 let op = sampling_operator(&faces, template.len(), &tags, &opts, t.level)
                     .map_err(|e| e.to_string())?;
-                Some(Tracking::new(Arc::clone(&template), op, t))
+                Some(Tracking::new(Arc::clone(&template), op, t, &normalization))
             }
         };
         let template_edges = edges(&faces)
@@ -662,7 +662,7 @@ fn fit_frame(
     let t_track = Instant::now();
     let mut tracking = None;
     if let (Some(tr), Some(o)) = (carry.tracking.as_mut(), options.tracking.as_ref()) {
-        let (moved, report) = tr.step(&target, o);
+        let (moved, report) = tr.step(&target, index, o);
         positions = moved;
         tracking = Some(report);
     }
@@ -870,12 +870,7 @@ fn validate(o: &SequenceOptions) -> Result<(), Error> {
         return bad("--imls-radius must be in (0, 1) (unit-cube units)".into());
     }
     if let Some(t) = &o.tracking {
-        if !(0.0..=1.0).contains(&t.depth) {
-            return bad(format!(
-                "the tracking nodes' depth must be within 0..=1, got {}",
-                t.depth
-            ));
-        }
+        t.check().map_err(Error::Options)?;
     }
     Ok(())
 }

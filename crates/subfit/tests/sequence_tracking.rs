@@ -6,17 +6,39 @@
 #![allow(clippy::print_stderr)]
 
 use subfit::mesh::deforming::{DeformingParams, DeformingSequence, DriftStats, MaterialLookup};
-use subfit::{fit_sequence, FitScanOptions, Input, SequenceOptions, SilhouetteOptions};
+use subfit::{
+    fit_sequence, FitScanOptions, Input, MarkerObservation, SequenceOptions, SilhouetteOptions,
+    TrackingOptions,
+};
 
 /// Frames fitted.
 const FRAMES: usize = 2;
 
 /// The drift of a generated sequence's tracked limit points, frame by frame (fractions of
-/// the diagonal), fitted with 200 control points, with or without tracking.
-fn drift_stats(params: DeformingParams, frames: usize, tracking: bool) -> DriftStats {
+/// the diagonal), fitted with 200 control points, with or without tracking, with `markers`
+/// markers at their true places in every frame.
+fn drift_stats(
+    params: DeformingParams,
+    frames: usize,
+    tracking: bool,
+    markers: usize,
+) -> DriftStats {
     let seq = DeformingSequence::new(params).unwrap();
     let frame0 = seq.frame(0, 3000, 11);
     let lookup = MaterialLookup::new(&frame0);
+    let markers: Vec<MarkerObservation> = frame0
+        .spread_vertices(markers)
+        .into_iter()
+        .flat_map(|i| {
+            let seq = &seq;
+            let m = frame0.material[i];
+            (0..frames).map(move |t| MarkerObservation {
+                frame: t,
+                marker: format!("m{i}"),
+                position: seq.deform(t, m),
+            })
+        })
+        .collect();
     let mut template_fit = FitScanOptions {
         control_points: Some(200),
         ..FitScanOptions::default()
@@ -29,7 +51,10 @@ fn drift_stats(params: DeformingParams, frames: usize, tracking: bool) -> DriftS
             views: 0,
             ..SilhouetteOptions::default()
         },
-        tracking: if tracking { d.tracking.clone() } else { None },
+        tracking: tracking.then(|| TrackingOptions {
+            markers,
+            ..TrackingOptions::default()
+        }),
         ..d
     };
     let frames = (0..frames).map(|i| Input::Mesh {
@@ -67,7 +92,14 @@ fn drift_stats(params: DeformingParams, frames: usize, tracking: bool) -> DriftS
 
 /// Drift RMS of frame 1 (fraction of the diagonal) of the spinning sequence.
 fn drift(tracking: bool) -> f64 {
-    drift_stats(DeformingParams::large_tangential_motion(), FRAMES, tracking).frames[1].rms_relative
+    drift_stats(
+        DeformingParams::large_tangential_motion(),
+        FRAMES,
+        tracking,
+        0,
+    )
+    .frames[1]
+        .rms_relative
 }
 
 #[test]
@@ -90,8 +122,8 @@ fn a_still_subject_does_not_slide() {
         thickness: 0.0,
         ..DeformingParams::default()
     };
-    let with = drift_stats(still.clone(), 6, true).max_relative();
-    let without = drift_stats(still, 6, false).max_relative();
+    let with = drift_stats(still.clone(), 6, true, 0).max_relative();
+    let without = drift_stats(still, 6, false, 0).max_relative();
     eprintln!("still subject, 6 frames: drift max {with:.5} with tracking, {without:.5} without");
     assert!(with <= 1.2 * without + 1e-4, "{with} vs {without}");
 }
@@ -102,29 +134,73 @@ fn a_still_subject_does_not_slide() {
 #[test]
 fn tracking_from_the_template_holds_over_a_sequence() {
     let frames = 10;
-    let with = drift_stats(DeformingParams::default(), frames, true);
-    let without = drift_stats(DeformingParams::default(), frames, false);
+    let with = drift_stats(DeformingParams::default(), frames, true, 0);
+    let without = drift_stats(DeformingParams::default(), frames, false, 0);
     let (w, wo) = (with.max_relative(), without.max_relative());
     eprintln!("default motion, {frames} frames: drift max {w:.5} with tracking, {wo:.5} without");
     assert!(w < 0.5 * wo, "{w} vs {wo}");
 }
 
-#[test]
-fn a_tracking_depth_outside_the_body_is_refused() {
+/// The error of a one-frame sequence with `tracking` (which must be refused).
+fn refusal(tracking: TrackingOptions) -> String {
     let seq = DeformingSequence::new(DeformingParams::default()).unwrap();
     let options = SequenceOptions {
-        tracking: Some(subfit::TrackingOptions {
-            depth: 1.5,
-            ..subfit::TrackingOptions::default()
-        }),
+        tracking: Some(tracking),
         ..SequenceOptions::default()
     };
     let frames = [Input::Mesh {
         mesh: seq.frame(0, 500, 1).mesh,
         name: "frame 0".into(),
     }];
-    let Err(err) = fit_sequence(frames, &options, &mut |_| Ok(()), &mut |_| {}) else {
-        panic!("a depth of 1.5 was accepted");
+    match fit_sequence(frames, &options, &mut |_| Ok(()), &mut |_| {}) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn a_tracking_depth_outside_the_body_is_refused() {
+    let err = refusal(TrackingOptions {
+        depth: 1.5,
+        ..TrackingOptions::default()
+    });
+    assert!(err.contains("depth"), "{err}");
+}
+
+/// Markers at their true places pin what the surfaces leave free: on 10 frames of the default
+/// motion 32 markers cut the largest drift of the tracking.
+#[test]
+fn markers_pin_the_slide_along_the_surface() {
+    let frames = 10;
+    let with = drift_stats(DeformingParams::default(), frames, true, 32);
+    let without = drift_stats(DeformingParams::default(), frames, true, 0);
+    let (w, wo) = (with.max_relative(), without.max_relative());
+    eprintln!("default motion, {frames} frames: drift max {w:.5} with 32 markers, {wo:.5} without");
+    assert!(w < 0.6 * wo, "{w} vs {wo}");
+}
+
+/// A marker must be seen in the first frame; a marker seen twice in a frame is refused.
+#[test]
+fn markers_without_a_place_on_the_template_are_refused() {
+    let at = |frame: usize, marker: &str| MarkerObservation {
+        frame,
+        marker: marker.into(),
+        position: [0.0, 0.0, 1.0],
     };
-    assert!(err.to_string().contains("depth"), "{err}");
+    for (markers, says) in [
+        (
+            vec![at(0, "a"), at(1, "b")],
+            "\"b\" is not in the first frame",
+        ),
+        (
+            vec![at(0, "a"), at(1, "a"), at(1, "a")],
+            "\"a\" is given twice in frame 1",
+        ),
+    ] {
+        let err = refusal(TrackingOptions {
+            markers,
+            ..TrackingOptions::default()
+        });
+        assert!(err.contains(says), "{err}");
+    }
 }

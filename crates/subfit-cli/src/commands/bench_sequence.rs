@@ -9,7 +9,7 @@
 use std::process::ExitCode;
 
 use anyhow::Context;
-use subfit::mesh::deforming::{DeformingParams, DeformingSequence, MaterialLookup};
+use subfit::mesh::deforming::{DeformingParams, DeformingSequence, Frame, MaterialLookup};
 use subfit::{fit_sequence, FitScanOptions, Input, SequenceOptions, SilhouetteOptions};
 
 use crate::cli::{BenchSequenceArgs, MotionArg};
@@ -36,10 +36,11 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
         ],
     };
     out!(
-        "subfit bench sequence: {} frames of ~{} vertices, {} control points",
+        "subfit bench sequence: {} frames of ~{} vertices, {} control points, {} markers",
         a.frames,
         a.vertices,
-        a.control_points
+        a.control_points,
+        a.markers
     );
     let mut rows = Vec::new();
     for (name, params) in motions {
@@ -92,6 +93,25 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// `count` markers spread over `frame0`, at their true places in every frame of `seq`.
+fn markers(
+    seq: &DeformingSequence,
+    frame0: &Frame,
+    count: usize,
+) -> Vec<subfit::MarkerObservation> {
+    let mut out = Vec::new();
+    for i in frame0.spread_vertices(count) {
+        for t in 0..seq.len() {
+            out.push(subfit::MarkerObservation {
+                frame: t,
+                marker: format!("v{i}"),
+                position: seq.deform(t, frame0.material[i]),
+            });
+        }
+    }
+    out
+}
+
 fn run_one(
     a: &BenchSequenceArgs,
     motion: &'static str,
@@ -119,7 +139,11 @@ fn run_one(
         iterations: a.iterations.map_or(d.iterations, |k| k as usize),
         tracking: a
             .track_nodes
-            .map_or(d.tracking.clone(), crate::commands::sequence::tracking),
+            .map_or(d.tracking.clone(), crate::commands::sequence::tracking)
+            .map(|t| subfit::TrackingOptions {
+                markers: markers(seq, &frame0, a.markers as usize),
+                ..t
+            }),
         cancel: crate::interrupt::token(),
         ..d
     };

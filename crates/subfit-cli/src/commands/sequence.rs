@@ -120,10 +120,37 @@ fn options(a: &SequenceArgs) -> anyhow::Result<SequenceOptions> {
             weight: a.silhouette_weight,
             ..subfit::SilhouetteOptions::default()
         },
-        tracking: tracking(a.track_nodes),
+        tracking: match (tracking(a.track_nodes), &a.markers) {
+            (t, None) => t,
+            (None, Some(_)) => {
+                anyhow::bail!("--markers needs the tracking step (--track-nodes > 0)")
+            }
+            (Some(t), Some(path)) => Some(subfit::TrackingOptions {
+                markers: markers(path, a.frames.len())?,
+                ..t
+            }),
+        },
         cancel: crate::interrupt::token(),
         ..SequenceOptions::default()
     })
+}
+
+/// The markers of `path`, each in one of the `frames` frames given.
+fn markers(
+    path: &std::path::Path,
+    frames: usize,
+) -> anyhow::Result<Vec<subfit::MarkerObservation>> {
+    let markers = subfit::read_markers(path)?;
+    if let Some(m) = markers.iter().find(|m| m.frame >= frames) {
+        anyhow::bail!(
+            "{}: marker {:?} is given in frame {}, but only {frames} frames (0..={}) are given",
+            path.display(),
+            m.marker,
+            m.frame,
+            frames.saturating_sub(1)
+        );
+    }
+    Ok(markers)
 }
 
 /// The tracking step with `nodes` nodes (0: off).

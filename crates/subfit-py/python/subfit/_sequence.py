@@ -130,7 +130,11 @@ def fit_sequence(
         The other flags of ``subfit sequence``: ``scheme`` ("auto"), ``method`` ("sdm" or
         "imls"), ``arap`` (0.01), ``lambda_`` (1e-5), ``iterations`` (12), ``tolerance``
         (5e-4), ``sample_level`` (2), ``silhouette_resolution`` (128),
-        ``silhouette_weight``, ``track_nodes`` (60).
+        ``silhouette_weight``, ``track_nodes`` (60), ``markers``: known places of points over
+        the frames (motion capture, tracked features), a path to a CSV file with the header
+        ``frame,marker,x,y,z`` or rows ``(frame, name, (x, y, z))`` (frame 0 the first; every
+        marker must be in frame 0); the tracking pulls them there, which pins what the
+        surfaces leave free, sliding along them.
 
     Raises
     ------

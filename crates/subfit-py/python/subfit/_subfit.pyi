@@ -78,6 +78,8 @@ def fit_sequence(
     silhouette_views: int = 8,
     silhouette_resolution: int = 128,
     silhouette_weight: float = ...,
+    track_nodes: int = 60,
+    markers: Any = None,
     progress: Optional[Callable[[dict], Any]] = None,
 ) -> NativeSequence: ...
 

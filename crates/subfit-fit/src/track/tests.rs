@@ -1,0 +1,118 @@
+//! Unit tests of the tracking step: the second-order projector, extrapolation, fits to known
+//! correspondences.
+
+use super::*;
+
+/// The largest entry of `(I − Π_k) f` over all nodes `k` (`f` one value a node).
+fn largest_left(graph: &DeformationGraph, f: &[f64]) -> f64 {
+    let mut most = 0.0f64;
+    for (k, p) in graph.detrend.iter().enumerate() {
+        assert!(!p.is_empty(), "node {k} has a projector");
+        let ids = graph.neighbourhood(k);
+        let q = ids.len();
+        for r in 0..q {
+            let v: f64 = (0..q).map(|s| p[r * q + s] * f[ids[s]]).sum();
+            most = most.max(v.abs());
+        }
+    }
+    most
+}
+
+/// A few scattered nodes: a field linear in position is left alone by every node's
+/// projector, a quadratic one is not.
+#[test]
+fn the_second_order_projector_removes_exactly_the_linear_fields() {
+    let points: Vec<[f64; 3]> = (0..40)
+        .map(|i| {
+            let t = f64::from(i);
+            [(1.3 * t).sin(), (0.7 * t).cos(), 0.05 * t - 1.0]
+        })
+        .collect();
+    let graph = DeformationGraph::new(&points, 25, 8);
+    let g = graph.positions();
+    let linear: Vec<f64> = g
+        .iter()
+        .map(|p| 0.3 + 2.0 * p[0] - p[1] + 0.5 * p[2])
+        .collect();
+    let quadratic: Vec<f64> = g.iter().map(|p| p[0] * p[0] + p[1] * p[2]).collect();
+    let (lin, quad) = (
+        largest_left(&graph, &linear),
+        largest_left(&graph, &quadratic),
+    );
+    assert!(lin < 1e-12, "linear field left {lin}");
+    assert!(quad > 1e-3, "quadratic field left {quad}");
+}
+
+/// Nodes on a plane: the projector still removes the fields linear in the plane.
+#[test]
+fn a_flat_neighbourhood_keeps_its_projector() {
+    let points: Vec<[f64; 3]> = (0..36)
+        .map(|i| {
+            let (x, y) = (f64::from(i % 6), f64::from(i / 6));
+            // The plane x + y + z = 0, not along an axis.
+            [x, y, -x - y]
+        })
+        .collect();
+    let graph = DeformationGraph::new(&points, 36, 8);
+    let linear: Vec<f64> = graph
+        .positions()
+        .iter()
+        .map(|p| 1.0 + p[0] - 3.0 * p[1])
+        .collect();
+    let left = largest_left(&graph, &linear);
+    assert!(left < 1e-9, "linear field left {left}");
+}
+
+/// Correspondences of an affine motion: the graph reproduces it.
+#[test]
+fn correspondences_of_an_affine_motion_are_reproduced() {
+    let points: Vec<[f64; 3]> = (0..200)
+        .map(|i| {
+            let t = f64::from(i);
+            [(1.7 * t).sin(), (0.9 * t).cos(), (0.37 * t).sin() * 0.5]
+        })
+        .collect();
+    let graph = DeformationGraph::new(&points, 12, 6);
+    let a = Matrix3::new(1.1, 0.2, 0.0, -0.1, 0.9, 0.3, 0.05, 0.0, 1.2);
+    let targets: Vec<[f64; 3]> = points
+        .iter()
+        .map(|&p| {
+            let q = a * v(p);
+            [q.x + 0.3, q.y - 0.2, q.z + 1.0]
+        })
+        .collect();
+    let motion = fit_correspondences(&graph, &points, &targets, 4);
+    let moved = deform(&graph, &points, &motion, 4);
+    let worst = moved
+        .iter()
+        .zip(&targets)
+        .map(|(p, q)| dist2(*p, *q).sqrt())
+        .fold(0.0, f64::max);
+    // The damping (1e-6 of the mean diagonal) leaves a few millionths.
+    assert!(worst < 2e-5, "largest miss {worst}");
+    // At rest the motion is the identity and moves nothing.
+    let still = deform(&graph, &points, &NodeMotion::identity(graph.len()), 4);
+    let moved = still
+        .iter()
+        .zip(&points)
+        .map(|(p, q)| dist2(*p, *q).sqrt())
+        .fold(0.0, f64::max);
+    assert!(moved < 1e-12, "the identity moved a point by {moved}");
+}
+
+/// Two steps of a motion linear in time predict the third exactly.
+#[test]
+fn extrapolation_continues_a_steady_motion() {
+    let at = |s: f64| NodeMotion {
+        linear: vec![Matrix3::identity() * (1.0 + 0.1 * s); 2],
+        translations: vec![[s, -2.0 * s, 0.5], [0.0, s, s]],
+    };
+    let next = at(2.0).extrapolated(&at(1.0));
+    let want = at(3.0);
+    for k in 0..2 {
+        assert!((next.linear[k] - want.linear[k]).norm() < 1e-12);
+        for a in 0..3 {
+            assert!((next.translations[k][a] - want.translations[k][a]).abs() < 1e-12);
+        }
+    }
+}
