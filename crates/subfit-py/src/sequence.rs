@@ -50,9 +50,9 @@ fn marker_observations(m: &Bound<'_, PyAny>) -> PyResult<Vec<subfit::MarkerObser
     if let Ok(path) = m.extract::<std::path::PathBuf>() {
         return subfit::read_markers(&path).map_err(fit_error);
     }
-    let rows: Vec<(usize, String, [f64; 3])> = m.extract().map_err(|_| {
-        value_error("markers must be a path or rows (frame, name, (x, y, z))")
-    })?;
+    let rows: Vec<(usize, String, [f64; 3])> = m
+        .extract()
+        .map_err(|_| value_error("markers must be a path or rows (frame, name, (x, y, z))"))?;
     Ok(rows
         .into_iter()
         .map(|(frame, marker, position)| subfit::MarkerObservation {
