@@ -134,22 +134,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let target = targets.last().ok_or("no frame tracked")?;
 
-    // 1. The reference: the graph fitted to the true correspondences.
+    // 1. The reference: the graph fitted to the true correspondences. One step from it
+    // measures what it leaves on the frame (`rms_before`).
     let reference = fit_correspondences(&graph, &samples, &truth, options.skin);
     let at_reference = deform(&graph, &samples, &reference, options.skin);
-    let one = TrackOptions {
-        iterations: 1,
-        ..options.clone()
+    let from_reference = |frame: &Target, iterations: usize, o: &TrackOptions| {
+        let o = TrackOptions {
+            iterations,
+            ..o.clone()
+        };
+        let (moved, _, stats) = track(
+            &graph,
+            &samples,
+            rest_samples,
+            frame,
+            &[],
+            Some(&reference),
+            &o,
+        );
+        (moved, stats)
     };
-    let (_, _, stats) = track(
-        &graph,
-        &samples,
-        rest_samples,
-        target,
-        &[],
-        Some(&reference),
-        &one,
-    );
+    let (_, stats) = from_reference(target, 1, &options);
     line(
         "reference (true correspondences)",
         drift(&at_reference),
@@ -157,19 +162,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     // 2. The tracker started at the reference.
-    let long = TrackOptions {
-        iterations: 100,
-        ..options.clone()
-    };
-    let (moved, _, stats) = track(
-        &graph,
-        &samples,
-        rest_samples,
-        target,
-        &[],
-        Some(&reference),
-        &long,
-    );
+    let (moved, stats) = from_reference(target, 100, &options);
     line("tracked from the reference", drift(&moved), stats.rms_after);
 
     // 3. Priors a hundred times weaker, a denser frame.
@@ -177,35 +170,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         regularity: options.regularity / 100.0,
         rigidity: options.rigidity / 100.0,
         second_order: options.second_order / 100.0,
-        ..long
+        ..options.clone()
     };
     let dense = frame(last, 4 * vertices)?;
-    let (moved, _, stats) = track(
-        &graph,
-        &samples,
-        rest_samples,
-        &dense,
-        &[],
-        Some(&reference),
-        &weak,
-    );
+    let (moved, stats) = from_reference(&dense, 100, &weak);
     line(
         "weak priors, 4x denser frame",
         drift(&moved),
         stats.rms_after,
     );
-    let (_, _, stats) = track(
-        &graph,
-        &samples,
-        rest_samples,
-        &dense,
-        &[],
-        Some(&reference),
-        &TrackOptions {
-            iterations: 1,
-            ..weak
-        },
-    );
+    let (_, stats) = from_reference(&dense, 1, &weak);
     println!(
         "  (the reference leaves {:.2e} on the denser frame)",
         stats.rms_before

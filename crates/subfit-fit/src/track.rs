@@ -757,12 +757,7 @@ pub fn track(
         }
         stats.iterations = it + 1;
     }
-    let cage_skin = Skin::new(cage, g, options.skin);
-    let moved_cage = (0..cage.len())
-        .into_par_iter()
-        .map(|i| cage_skin.apply(i, cage[i], g, &motion))
-        .collect();
-    (moved_cage, motion, stats)
+    (deform(graph, cage, &motion, options.skin), motion, stats)
 }
 
 /// `points` (in the graph's rest configuration) moved by `motion`, each skinned to its `skin`

@@ -83,21 +83,21 @@ fn correspondences_of_an_affine_motion_are_reproduced() {
         .collect();
     let motion = fit_correspondences(&graph, &points, &targets, 4);
     let moved = deform(&graph, &points, &motion, 4);
-    let worst = moved
-        .iter()
-        .zip(&targets)
-        .map(|(p, q)| dist2(*p, *q).sqrt())
-        .fold(0.0, f64::max);
+    let worst = largest_distance(&moved, &targets);
     // The damping (1e-6 of the mean diagonal) leaves a few millionths.
     assert!(worst < 2e-5, "largest miss {worst}");
     // At rest the motion is the identity and moves nothing.
     let still = deform(&graph, &points, &NodeMotion::identity(graph.len()), 4);
-    let moved = still
-        .iter()
-        .zip(&points)
-        .map(|(p, q)| dist2(*p, *q).sqrt())
-        .fold(0.0, f64::max);
+    let moved = largest_distance(&still, &points);
     assert!(moved < 1e-12, "the identity moved a point by {moved}");
+}
+
+/// The largest distance between corresponding points of `a` and `b`.
+fn largest_distance(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| dist2(*p, *q).sqrt())
+        .fold(0.0, f64::max)
 }
 
 /// Two steps of a motion linear in time predict the third exactly.
