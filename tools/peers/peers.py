@@ -103,7 +103,7 @@ class Runner:
             "kind": row["kind"], "category": row["category"],
             "vertices": row["control_points"], "subfit": str(self.subfit),
             "depth": self.args.depth, "threads": 1,
-            "trim_quantile": trim,
+            "trim_quantile": trim, "fit_method": self.args.fit_method,
             "entry_dir": str(entry_dir),
         }  # fmt: skip
         atomic_write_text(scratch / "job.json", json.dumps(job, indent=1))
@@ -287,6 +287,8 @@ def parse_args(argv):
                    help="density quantile below which an open mesh's Poisson surface is trimmed")
     p.add_argument("--trim-points", type=float, default=TRIM_QUANTILE["points"],
                    help="density quantile below which a point cloud's Poisson surface is trimmed")
+    p.add_argument("--fit-method", choices=("pdm", "sdm"), default="pdm",
+                   help="error term of the remeshes' least-squares fit (pdm: plain)")
     p.add_argument("--timeout", type=float, default=3600.0,
                    help="seconds after which one peer of one entry is stopped")  # fmt: skip
     a = p.parse_args(argv)

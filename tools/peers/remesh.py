@@ -28,16 +28,19 @@ with the request scaled by requested / obtained."""
 ATTEMPTS = 3
 """Remeshes at most per peer (the first and two corrections)."""
 
-FIT_FLAGS = [
-    "--scheme", "catmull-clark",
-    "--no-refine",            # keep the remesh's connectivity: no splits, no edge flips
-    "--no-quad-dominant",     # do not pair the remesh's triangles into quads
-    "--no-features",          # a smooth cage: no crease or corner tags
-    "--method", "pdm",        # point distance minimization: plain least squares
-    "--lambda", "1e-4",       # light umbrella smoothing, lowered per stage to 1e-5
-    "--polish-power", "2",    # no reweighted (L^p) polish: least squares to the end
-]  # fmt: skip
-"""`subfit fit` flags of the peers' fit (plain least squares at fixed connectivity)."""
+def fit_flags(method="pdm"):
+    """`subfit fit` flags of the peers' fit: least squares at fixed connectivity. `method`
+    `pdm` (the default: point distance minimization, plain least squares) or `sdm` (Cheng et
+    al.'s squared distance, subfit's own error term, to separate connectivity from fitting)."""
+    return [
+        "--scheme", "catmull-clark",
+        "--no-refine",            # keep the remesh's connectivity: no splits, no edge flips
+        "--no-quad-dominant",     # do not pair the remesh's triangles into quads
+        "--no-features",          # a smooth cage: no crease or corner tags
+        "--method", method,       # pdm: point distance minimization, plain least squares
+        "--lambda", "1e-4",       # light umbrella smoothing, lowered per stage to 1e-5
+        "--polish-power", "2",    # no reweighted (L^p) polish: least squares to the end
+    ]  # fmt: skip
 
 
 def closest_of(attempt, requested):
@@ -133,14 +136,15 @@ def quadriflow(V, F, vertices, open_surface, seed=0):
     return closest_of(attempt, vertices)
 
 
-def fit_cage(subfit, target, init, out_dir, log, as_points=False):
-    """Fit the cage `init` to `target` by `subfit fit` with `FIT_FLAGS` into `out_dir`; its
+def fit_cage(subfit, target, init, out_dir, log, as_points=False, method="pdm"):
+    """Fit the cage `init` to `target` by `subfit fit` with `fit_flags(method)` into `out_dir`; its
     output goes to the open file `log`. `as_points`: fit to the target's points only (subfit
     refuses a cage whose topology differs from a mesh target's; a point target has none).
     Exit code 1 (tolerance not reached, outputs written) is a result; anything else without a
     control.obj raises RuntimeError with subfit's last lines.
     Returns `(control.obj path, short summary from report.json)`."""
-    cmd = [str(subfit), "fit", str(target), "--init", str(init), *FIT_FLAGS, "-o", str(out_dir)]
+    cmd = [str(subfit), "fit", str(target), "--init", str(init), *fit_flags(method)]
+    cmd += ["-o", str(out_dir)]
     if as_points:
         cmd.append("--as-points")
     n_init = len(read_obj_polygons(init)[0])

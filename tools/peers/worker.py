@@ -126,8 +126,9 @@ def remesher(peer, job, entry_dir):
         as_points = mine != theirs
     with open(entry_dir / "log.txt", "a") as log:
         control, fit_summary = remesh.fit_cage(
-            job["subfit"], job["input"], remesh_file, entry_dir / f"{peer}-fit", log, as_points
-        )
+            job["subfit"], job["input"], remesh_file, entry_dir / f"{peer}-fit", log,
+            as_points, job["fit_method"],
+        )  # fmt: skip
     seconds += time.perf_counter() - start
     shutil.copyfile(control, entry_dir / f".{peer}.obj.tmp")
     (entry_dir / f".{peer}.obj.tmp").replace(entry_dir / f"{peer}.obj")
@@ -136,7 +137,7 @@ def remesher(peer, job, entry_dir):
     notes = [
         f"{what}: asked {job['vertices']} vertices (requests {requests}), "
         f"got {len(RV)} vertices / {len(faces)} faces in {remesh_seconds:.1f} s",
-        f"{fit_summary} (flags: {' '.join(remesh.FIT_FLAGS)})",
+        f"{fit_summary} (flags: {' '.join(remesh.fit_flags(job['fit_method']))})",
     ]
     if surface_note:
         notes.insert(0, surface_note)

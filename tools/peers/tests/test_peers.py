@@ -137,13 +137,16 @@ def test_peers_on_an_icosphere(tmp_path):
     assert by[("sphere", "poisson-qem")]["vertices"] == 100
     assert by[("sphere", "quadriflow")]["quad_fraction"] == 1.0
     assert by[("sphere", "instant-meshes")]["scheme"] == "catmull-clark"
-    # Ground truth: every Poisson + QEM vertex lies near the unit sphere (1 % of the radius).
+    # Ground truth: every Poisson + QEM vertex lies near the unit sphere. 100 vertices make
+    # triangles of area 4π/196 (circumradius 0.22), whose planes sit up to 1 − √(1 − 0.22²)
+    # = 2.5 % inside the sphere; QEM places vertices between the sphere and those planes'
+    # offsets, so within 3 % of the radius.
     import pymeshlab
 
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(out / by[("sphere", "poisson-qem")]["file"]))
     radii = np.linalg.norm(ms.current_mesh().vertex_matrix(), axis=1)
-    assert np.all(np.abs(radii - 1) < 0.01), (radii.min(), radii.max())
+    assert np.all(np.abs(radii - 1) < 0.03), (radii.min(), radii.max())
     # The remeshes are closed genus-0 surfaces like the sphere.
     for peer in ("instant-meshes", "quadriflow"):
         RV, RF = read_obj_polygons(out / "sphere" / f"{peer}-remesh.obj")
