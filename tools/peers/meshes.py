@@ -117,17 +117,49 @@ def euler_and_loops(faces, n_vertices):
             edge_uses[key] = edge_uses.get(key, 0) + 1
     used = {i for face in faces for i in face}
     parent = list(range(n_vertices))
-
-    def root(i):
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
     rim = set()
     for (a, b), uses in edge_uses.items():
         if uses == 1:
             rim.update((a, b))
-            parent[root(a)] = root(b)
-    loops = len({root(i) for i in rim})
+            parent[_root(parent, a)] = _root(parent, b)
+    loops = len({_root(parent, i) for i in rim})
     return len(used) - len(edge_uses) + len(faces), loops
+
+
+def split_nonmanifold_vertices(V, faces):
+    """Give each fan of faces around a vertex its own copy of the vertex (MeshLab's "repair
+    non-manifold vertices by splitting"): faces are in one fan when they share an edge at the
+    vertex. Remeshers leave a few vertices where two fans touch, which `subfit fit` refuses.
+    Returns `(V, faces, copies made)`; non-manifold edges are left as they are."""
+    around = {}
+    for f, face in enumerate(faces):
+        for k, v in enumerate(face):
+            around.setdefault(v, []).append((f, face[k - 1], face[(k + 1) % len(face)]))
+    V = [np.asarray(p, dtype=np.float64) for p in V]
+    faces = [list(face) for face in faces]
+    copies = 0
+    for v, incident in around.items():
+        parent = {f: f for f, _, _ in incident}
+        by_neighbour = {}
+        for f, a, b in incident:
+            for w in (a, b):
+                if w in by_neighbour:
+                    parent[_root(parent, f)] = _root(parent, by_neighbour[w])
+                else:
+                    by_neighbour[w] = f
+        fans = sorted({_root(parent, f) for f, _, _ in incident})
+        for fan in fans[1:]:
+            V.append(V[v].copy())
+            copies += 1
+            for f, _, _ in incident:
+                if _root(parent, f) == fan:
+                    faces[f] = [len(V) - 1 if i == v else i for i in faces[f]]
+    return np.array(V).reshape(-1, 3), faces, copies
+
+
+def _root(parent, i):
+    """Union-find root of `i` in `parent` (a list or dict), with path halving."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i

@@ -27,12 +27,21 @@ import time
 
 from meshes import atomic_write_text
 from poisson_qem import DEPTH, TRIM_QUANTILE
-from worker import PEERS
+from worker import PEERS, clear
 
 HERE = pathlib.Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 ENTRY_NAME = re.compile(r"^[A-Za-z0-9_.-]+(/[A-Za-z0-9_.-]+)*$")
 ROW_KEYS = ("entry", "input", "category", "kind", "control_points")
+DIED = "the worker died"
+"""How the error of a peer whose process crashed or timed out starts: such a peer is redone by
+the next run, where a peer's own failure (e.g. a remesh subfit refuses) is kept."""
+
+
+def fail(message):
+    """Bad input or usage: the message on stderr, exit status 2, nothing written."""
+    print(f"peers: {message}", file=sys.stderr)
+    sys.exit(2)
 
 
 class Runner:
@@ -58,6 +67,8 @@ class Runner:
             if old.get("input") != row["input"]:
                 return False
             if old.get("error") is None and not (self.args.out / old["file"]).exists():
+                return False
+            if (old.get("error") or "").startswith(DIED):
                 return False
         return True
 
@@ -114,6 +125,7 @@ class Runner:
         scratch = entry_dir / ".scratch"
         result_path = scratch / f"result-{peer}.json"
         result_path.unlink(missing_ok=True)
+        clear(peer, entry_dir)
         cmd = [sys.executable, str(HERE / "worker.py"), peer, str(scratch / "job.json")]
         cmd.append(str(result_path))
         start = time.perf_counter()
@@ -135,7 +147,7 @@ class Runner:
         if result_path.exists():
             return json.loads(result_path.read_text())
         seconds = time.perf_counter() - start
-        return {"error": f"the worker died ({code}); see {peer} in log.txt", "seconds": seconds}
+        return {"error": f"{DIED} ({code}); see {peer} in log.txt", "seconds": seconds}
 
     def finish(self, row, peer, result):
         """The peers.json row: contract fields first, paths relative to the peers folder."""
@@ -218,25 +230,25 @@ def read_ours(path, only):
     try:
         data = json.loads(pathlib.Path(path).read_text())
     except (OSError, ValueError) as e:
-        sys.exit(f"peers: {path}: cannot read it as JSON ({e})")
+        fail(f"{path}: cannot read it as JSON ({e})")
     if not isinstance(data, dict) or not isinstance(data.get("rows"), list):
-        sys.exit(f'peers: {path}: expected an object with a "rows" list')
+        fail(f'{path}: expected an object with a "rows" list')
     rows, seen = [], set()
     for i, row in enumerate(data["rows"]):
         where = f"{path}: rows[{i}]"
         if not isinstance(row, dict):
-            sys.exit(f"peers: {where}: not an object")
+            fail(f"{where}: not an object")
         missing = [k for k in ROW_KEYS if k not in row]
         if missing:
-            sys.exit(f"peers: {where}: missing {', '.join(missing)}")
+            fail(f"{where}: missing {', '.join(missing)}")
         entry, cp = row["entry"], row["control_points"]
         if not isinstance(entry, str) or not ENTRY_NAME.match(entry) or ".." in entry.split("/"):
-            sys.exit(f"peers: {where}: entry {entry!r} is not a usable folder name")
+            fail(f"{where}: entry {entry!r} is not a usable folder name")
         if entry in seen:
-            sys.exit(f"peers: {where}: entry {entry!r} appears twice")
+            fail(f"{where}: entry {entry!r} appears twice")
         seen.add(entry)
         if cp is not None and (not isinstance(cp, int) or isinstance(cp, bool) or cp < 4):
-            sys.exit(f"peers: {where}: control_points {cp!r} is not a count of at least 4")
+            fail(f"{where}: control_points {cp!r} is not a count of at least 4")
         if only and entry not in only:
             continue
         if cp is None:
@@ -245,7 +257,7 @@ def read_ours(path, only):
         rows.append(row)
     unknown = set(only or ()) - seen
     if unknown:
-        sys.exit(f"peers: --only {', '.join(sorted(unknown))}: no such entry in {path}")
+        fail(f"--only {', '.join(sorted(unknown))}: no such entry in {path}")
     return rows
 
 
@@ -257,8 +269,8 @@ def find_subfit(given):
         if found:
             return pathlib.Path(found).resolve()
     if given:
-        sys.exit(f"peers: --subfit {given}: not an executable")
-    sys.exit("peers: no subfit binary: `cargo build --release -p subfit-cli`, or pass --subfit")
+        fail(f"--subfit {given}: not an executable")
+    fail("no subfit binary: `cargo build --release -p subfit-cli`, or pass --subfit")
 
 
 def load_existing(out):
@@ -269,7 +281,7 @@ def load_existing(out):
         rows = json.loads(path.read_text())["peers"]
         return {(r["entry"], r["peer"]): r for r in rows}
     except (OSError, ValueError, KeyError, TypeError) as e:
-        sys.exit(f"peers: {path}: exists but is not a peers file ({e}); move it away or fix it")
+        fail(f"{path}: exists but is not a peers file ({e}); move it away or fix it")
 
 
 def parse_args(argv):

@@ -19,6 +19,7 @@ from meshes import (
     connectivity,
     euler_and_loops,
     read_obj_polygons,
+    split_nonmanifold_vertices,
     write_obj,
 )
 
@@ -26,6 +27,24 @@ SURFACE = "poisson-surface.ply"
 """The full-resolution Poisson surface of a point cloud, the remeshers' input."""
 
 PEERS = ("poisson-qem", "instant-meshes", "quadriflow")
+
+
+def outputs(peer):
+    """The files and folders a peer writes into its entry's folder."""
+    if peer == "poisson-qem":
+        names = ["poisson-qem.ply", "poisson-qem-trimmed.ply", "poisson-qem-untrimmed.ply"]
+        return names + [SURFACE, SURFACE + ".json"]
+    return [f"{peer}.obj", f"{peer}-remesh.obj", f"{peer}-fit"]
+
+
+def clear(peer, entry_dir):
+    """Remove a peer's outputs of an earlier run, so a failing run leaves none behind."""
+    for name in outputs(peer):
+        path = entry_dir / name
+        if path.is_dir():
+            shutil.rmtree(path)
+        else:
+            path.unlink(missing_ok=True)
 
 
 def poisson_qem(job, entry_dir):
@@ -117,6 +136,7 @@ def remesher(peer, job, entry_dir):
         out = remesh.quadriflow(V, F, job["vertices"], open_surface)
         what = "QuadriFlow pure-quad remesh"
     RV, faces, requests = out
+    RV, faces, copies = split_nonmanifold_vertices(RV, faces)
     remesh_file = entry_dir / f"{peer}-remesh.obj"
     write_obj(remesh_file, RV, faces)
     remesh_seconds = time.perf_counter() - start
@@ -141,6 +161,8 @@ def remesher(peer, job, entry_dir):
     ]
     if surface_note:
         notes.insert(0, surface_note)
+    if copies:
+        notes.append(f"split {copies} non-manifold vertices of the remesh (one copy per fan)")
     if as_points:
         notes.append(
             f"the remesh's (Euler characteristic, boundary loops) {mine} differ from the "

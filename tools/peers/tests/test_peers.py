@@ -25,6 +25,7 @@ from meshes import (  # noqa: E402 (after the path)
     connectivity,
     euler_and_loops,
     read_obj_polygons,
+    split_nonmanifold_vertices,
     write_obj,
 )
 
@@ -77,6 +78,18 @@ def test_connectivity_of_known_meshes():
     assert euler_and_loops(F, len(V)) == (1, 1)
     cube = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
     assert connectivity(cube, 8)["irregular_vertices"] == 8  # valence 3 inside
+
+
+def test_split_nonmanifold_vertices():
+    # Two fans of two triangles each meet at vertex 0 only (a bow tie of quads' halves).
+    V = np.zeros((7, 3))
+    F = [[0, 1, 2], [0, 2, 3], [0, 4, 5], [0, 5, 6]]
+    V2, F2, copies = split_nonmanifold_vertices(V, F)
+    assert copies == 1 and len(V2) == 8
+    assert F2[:2] == F[:2] and F2[2:] == [[7, 4, 5], [7, 5, 6]]
+    assert euler_and_loops(F2, 8) == (2, 2)  # two discs
+    V, F = icosphere(1)
+    assert split_nonmanifold_vertices(V, F)[2] == 0
 
 
 def test_obj_round_trip_and_compact(tmp_path):
