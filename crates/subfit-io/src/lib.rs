@@ -169,6 +169,11 @@ pub struct FileInfo {
     pub encoding: Encoding,
     /// Size of the file in bytes.
     pub bytes: u64,
+    /// What the reader decided or skipped in a file it still read, one sentence each, for the
+    /// caller to show (columns taken as colours rather than normals, unknown header lines
+    /// skipped, normals averaged, a file read as another variant of its format…). Each names
+    /// the line or element it concerns where there is one; the file path is not repeated.
+    pub warnings: Vec<String>,
 }
 
 /// Options for reading.
@@ -221,8 +226,9 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
     if bytes.is_empty() {
         return Err(Error::file(path, ErrorKind::Empty));
     }
+    let mut warnings = Vec::new();
     let (mesh, encoding) = match format {
-        Format::Ply => ply::read(bytes, path)?,
+        Format::Ply => ply::read(bytes, path, &mut warnings)?,
         Format::Obj => (obj::read(bytes, path)?, Encoding::Ascii),
         Format::Off => (off::read(bytes, path)?, Encoding::Ascii),
         Format::Stl => stl::read(bytes, path, opts.weld_stl)?,
@@ -234,6 +240,7 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
             format,
             encoding,
             bytes: bytes.len() as u64,
+            warnings,
         },
     ))
 }
