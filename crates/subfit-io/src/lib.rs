@@ -9,6 +9,7 @@
 //! partial file is ever left behind.
 
 pub mod error;
+mod mni;
 pub mod obj;
 pub mod off;
 pub mod ply;
@@ -229,7 +230,12 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
     let mut warnings = Vec::new();
     let (mesh, encoding) = match format {
         Format::Ply => ply::read(bytes, path, &mut warnings)?,
-        Format::Obj => (obj::read(bytes, path)?, Encoding::Ascii),
+        // An MNI surface is the one other `.obj` found in the wild; its first statement (`P`)
+        // is not Wavefront's, so the content decides unambiguously.
+        Format::Obj if mni::is_mni(bytes) => {
+            (mni::read(bytes, path, &mut warnings)?, Encoding::Ascii)
+        }
+        Format::Obj => (obj::read(bytes, path, &mut warnings)?, Encoding::Ascii),
         Format::Off => (off::read(bytes, path)?, Encoding::Ascii),
         Format::Stl => stl::read(bytes, path, opts.weld_stl)?,
         Format::Xyz => (xyz::read(bytes, path)?, Encoding::Ascii),
