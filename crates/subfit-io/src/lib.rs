@@ -12,6 +12,7 @@ pub mod error;
 mod mni;
 pub mod obj;
 pub mod off;
+mod off_binary;
 pub mod ply;
 pub mod stl;
 pub mod tags_json;
@@ -32,7 +33,7 @@ pub enum Format {
     Ply,
     /// Wavefront OBJ (`v`, `vn`, `f`).
     Obj,
-    /// Object File Format (OFF, COFF, NOFF, CNOFF).
+    /// Object File Format (OFF, COFF, NOFF, CNOFF…; text or binary).
     Off,
     /// Stereolithography (ascii or binary; triangles, vertices welded on reading).
     Stl,
@@ -48,7 +49,7 @@ pub enum Encoding {
     Ascii,
     /// Binary, little-endian.
     BinaryLittleEndian,
-    /// Binary, big-endian (PLY only).
+    /// Binary, big-endian (PLY; binary OFF on reading).
     BinaryBigEndian,
 }
 
@@ -236,7 +237,7 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
             (mni::read(bytes, path, &mut warnings)?, Encoding::Ascii)
         }
         Format::Obj => (obj::read(bytes, path, &mut warnings)?, Encoding::Ascii),
-        Format::Off => (off::read(bytes, path)?, Encoding::Ascii),
+        Format::Off => off::read(bytes, path, &mut warnings)?,
         Format::Stl => stl::read(bytes, path, opts.weld_stl)?,
         Format::Xyz => (xyz::read(bytes, path)?, Encoding::Ascii),
     };

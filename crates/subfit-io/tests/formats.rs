@@ -540,9 +540,11 @@ fn off_errors() {
         ("nOFF\n3\n", Location::Line(1), |k| {
             matches!(k, ErrorKind::Unsupported(_))
         }),
-        ("OFF BINARY\n", Location::Line(1), |k| {
-            matches!(k, ErrorKind::Unsupported(_))
-        }),
+        (
+            "OFF BINARY\n",
+            Location::Byte(11),
+            |k| matches!(k, ErrorKind::Truncated(s) if s.contains("binary OFF")),
+        ),
         (
             "OFX\n",
             Location::Line(1),

@@ -1,6 +1,7 @@
-//! Hand-written binary files in the variants real files come in: PLY big-endian with `uchar`,
-//! `int` and `uint` list types and extra vertex and face properties; PLY header lines no reader
-//! knows; NaN colours (read as 0) next to NaN positions (an error naming the vertex).
+//! Hand-written binary files in the variants real files come in: binary OFF in both byte
+//! orders, with and without per-face colour counts; PLY big-endian with `uchar`, `int` and
+//! `uint` list types and extra vertex and face properties; PLY header lines no reader knows;
+//! NaN colours (read as 0) next to NaN positions (an error naming the vertex).
 
 use std::path::Path;
 
@@ -32,12 +33,121 @@ const FACES: [&[u32]; 5] = [
     &[1, 4, 3, 2],
 ];
 
+/// Binary OFF bytes: `header` line, then counts, vertices (plus `extra` floats per vertex) and
+/// faces, in the given byte order, with or without a colour count (and `nc` components).
+fn binary_off(header: &str, big: bool, colour_counts: bool, extra: &[f32]) -> Vec<u8> {
+    let mut out = header.as_bytes().to_vec();
+    let int = |out: &mut Vec<u8>, v: i32| {
+        out.extend(if big {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        })
+    };
+    let float = |out: &mut Vec<u8>, v: f32| {
+        out.extend(if big {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        })
+    };
+    for c in [5, 5, 9] {
+        int(&mut out, c);
+    }
+    for p in POINTS {
+        p.iter().chain(extra).for_each(|&v| float(&mut out, v));
+    }
+    for (i, f) in FACES.iter().enumerate() {
+        int(&mut out, f.len() as i32);
+        f.iter().for_each(|&v| int(&mut out, v as i32));
+        if colour_counts {
+            // Faces carry 0, 3 or 4 colour components, as files mix them.
+            let nc = [0, 3, 4, 0, 3][i];
+            int(&mut out, nc);
+            (0..nc).for_each(|_| float(&mut out, 0.5));
+        }
+    }
+    out
+}
+
 fn expect_shape(m: &PolyMesh) {
     let want: Vec<[f64; 3]> = POINTS.iter().map(|p| p.map(f64::from)).collect();
     assert_eq!(m.positions, want);
     assert_eq!(
         faces(m),
         FACES.iter().map(|f| f.to_vec()).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn binary_off_in_every_byte_order_and_face_layout() {
+    for big in [true, false] {
+        for counts in [true, false] {
+            let bytes = binary_off("OFF BINARY\n", big, counts, &[]);
+            let (m, info) = read("t.off", &bytes).unwrap_or_else(|e| panic!("{e}"));
+            expect_shape(&m);
+            let enc = if big {
+                Encoding::BinaryBigEndian
+            } else {
+                Encoding::BinaryLittleEndian
+            };
+            assert_eq!(info.encoding, enc);
+            // The spec's layout reads silently; any other is said.
+            let spec = big && counts;
+            assert_eq!(info.warnings.is_empty(), spec, "{:?}", info.warnings);
+            if !spec {
+                assert!(info.warnings[0].contains(if big {
+                    "big-endian"
+                } else {
+                    "little-endian"
+                }));
+            }
+        }
+    }
+    // NOFF and COFF: per-vertex normals and RGBA colours (a NaN channel reads as 0).
+    let bytes = binary_off(
+        "# a comment line\nCNOFF BINARY\r\n",
+        true,
+        true,
+        &[0.0, 0.0, 1.0, 1.0, f32::NAN, 0.5, 1.0],
+    );
+    let (m, _) = read("t.off", &bytes).unwrap_or_else(|e| panic!("{e}"));
+    expect_shape(&m);
+    assert_eq!(m.normals.unwrap(), vec![[0.0, 0.0, 1.0]; 5]);
+    assert_eq!(m.colors.unwrap(), vec![[255, 0, 128]; 5]);
+}
+
+#[test]
+fn broken_binary_off_is_refused_with_its_byte() {
+    let good = binary_off("OFF BINARY\n", true, true, &[]);
+    // Cut inside the last face: no layout reads it; the error names a byte inside the data.
+    let e = read("t.off", &good[..good.len() - 2]).unwrap_err();
+    assert!(
+        matches!(e.location, Location::Byte(b) if b > 11 && b < good.len() as u64),
+        "{e}"
+    );
+    assert!(e.to_string().contains("binary OFF"), "{e}");
+    // An index out of range in every layout.
+    let mut bad = good.clone();
+    let at = 11 + 12 + 5 * 12 + 4;
+    bad[at..at + 4].copy_from_slice(&7i32.to_be_bytes());
+    let e = read("t.off", &bad).unwrap_err();
+    assert!(
+        matches!(e.kind, ErrorKind::IndexOutOfRange { index: 7, count: 5 }),
+        "{e}"
+    );
+    // Trailing garbage.
+    let mut long = good.clone();
+    long.extend_from_slice(b"xyz");
+    let e = read("t.off", &long).unwrap_err();
+    assert!(e.to_string().contains("after the last face"), "{e}");
+    // A NaN position.
+    let mut nan = good;
+    nan[11 + 12 + 4..11 + 12 + 8].copy_from_slice(&f32::NAN.to_be_bytes());
+    let e = read("t.off", &nan).unwrap_err();
+    assert!(
+        matches!(e.kind, ErrorKind::NonFinite(ref s) if s.contains("vertex 0")),
+        "{e}"
     );
 }
 

@@ -1,6 +1,7 @@
 //! Hand-written text files in the variants real files come in (see `wild_variants.rs` for the
-//! real ones): OBJ with empty corner slots, partial `vt`, non-UTF-8 names and per-corner
-//! normals, MNI surfaces. Each checks what is read and what the reader says about it.
+//! real ones): OFF with a glued keyword and faces over several lines, OBJ with empty corner
+//! slots, partial `vt`, non-UTF-8 names and per-corner normals, MNI surfaces. Each checks what
+//! is read and what the reader says about it.
 
 use std::path::Path;
 
@@ -30,6 +31,65 @@ fn faces(m: &PolyMesh) -> Vec<Vec<u32>> {
 
 fn warned(w: &[String], part: &str) -> bool {
     w.iter().any(|s| s.contains(part))
+}
+
+// ------------------------------------------------------------------------------------ OFF
+
+#[test]
+fn off_keyword_glued_to_the_counts_after_blanks() {
+    let text =
+        b"\t   OFF4 1 0 # a comment\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 1.0 0.0 0.0 0.75\n";
+    let (m, w) = ok("t.off", text);
+    assert_eq!(m.positions.len(), 4);
+    assert_eq!(faces(&m), vec![vec![0, 1, 2, 3]]);
+    assert!(w.is_empty(), "{w:?}");
+    // The same with the keyword announcing colours, glued as well.
+    let (m, _) = ok(
+        "t.off",
+        b"COFF3 1 0\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2\n",
+    );
+    assert_eq!(m.colors.unwrap()[2], [0, 0, 255]);
+    // Not a glued count: still an unknown keyword.
+    let e = err("t.off", b"OFFx 1 0\n");
+    assert!(
+        matches!(e.kind, ErrorKind::Syntax(ref s) if s.contains("OFFx")),
+        "{e}"
+    );
+}
+
+#[test]
+fn off_faces_spread_over_lines() {
+    let text = b"OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 2 2\n\
+                 4 0 1\n  2\n3 0.5 0.5 0.5\n\
+                 3 # the count alone\n4\n1 2\n";
+    let (m, _) = ok("t.off", text);
+    assert_eq!(faces(&m), vec![vec![0, 1, 2, 3], vec![4, 1, 2]]);
+    // A face whose indices never come: named at its first line.
+    let e = err("t.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0\n1\n");
+    assert_eq!(e.location, Location::Line(6));
+    assert!(
+        matches!(e.kind, ErrorKind::Syntax(ref s) if s.contains("lists 2")),
+        "{e}"
+    );
+    // An index out of range on a continuation line is named at that line.
+    let e = err("t.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0\n1 7\n");
+    assert_eq!(e.location, Location::Line(7));
+    assert!(matches!(
+        e.kind,
+        ErrorKind::IndexOutOfRange { index: 7, count: 3 }
+    ));
+}
+
+#[test]
+fn off_comments_may_hold_any_bytes() {
+    let (m, _) = ok(
+        "t.off",
+        b"OFF # caf\xe9\n3 1 0\n0 0 0\n1 0 0 # \xff\xfe\n0 1 0\n3 0 1 2\n",
+    );
+    assert_eq!(m.positions.len(), 3);
+    let e = err("t.off", b"OFF\n3 1 0\n0 0 0\n1 \xe9 0\n0 1 0\n3 0 1 2\n");
+    assert_eq!(e.location, Location::Line(4));
+    assert!(e.to_string().contains("not UTF-8"), "{e}");
 }
 
 // ------------------------------------------------------------------------------------ OBJ
