@@ -37,7 +37,8 @@ pub enum Format {
     Off,
     /// Stereolithography (ascii or binary; triangles, vertices welded on reading).
     Stl,
-    /// Point list: `x y z` or `x y z nx ny nz` per line (`.xyz`, `.pts`, `.txt`).
+    /// Point list: `x y z` per line with optional normal, colour or intensity columns, or
+    /// `p x y z` statements (`.xyz`, `.pts`, `.txt`; see [`xyz`]).
     Xyz,
 }
 
@@ -229,17 +230,16 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
         return Err(Error::file(path, ErrorKind::Empty));
     }
     let mut warnings = Vec::new();
+    let w = &mut warnings;
     let (mesh, encoding) = match format {
-        Format::Ply => ply::read(bytes, path, &mut warnings)?,
+        Format::Ply => ply::read(bytes, path, w)?,
         // An MNI surface is the one other `.obj` found in the wild; its first statement (`P`)
         // is not Wavefront's, so the content decides unambiguously.
-        Format::Obj if mni::is_mni(bytes) => {
-            (mni::read(bytes, path, &mut warnings)?, Encoding::Ascii)
-        }
-        Format::Obj => (obj::read(bytes, path, &mut warnings)?, Encoding::Ascii),
-        Format::Off => off::read(bytes, path, &mut warnings)?,
+        Format::Obj if mni::is_mni(bytes) => (mni::read(bytes, path, w)?, Encoding::Ascii),
+        Format::Obj => (obj::read(bytes, path, w)?, Encoding::Ascii),
+        Format::Off => off::read(bytes, path, w)?,
         Format::Stl => stl::read(bytes, path, opts.weld_stl)?,
-        Format::Xyz => (xyz::read(bytes, path)?, Encoding::Ascii),
+        Format::Xyz => (xyz::read(bytes, path, w)?, Encoding::Ascii),
     };
     Ok((
         mesh,

@@ -704,10 +704,11 @@ fn xyz_forms() {
     let m = ok(Format::Xyz, "1\n0 0 0 -1200 255 10 300\n");
     assert_eq!(m.colors.unwrap(), vec![[255, 10, 255]]);
     assert!(m.normals.is_none());
-    // 4 columns: intensity ignored; 9: normals, the rest ignored.
+    // 4 columns: intensity ignored; 9: normals, then colours (integers in 0..255).
     assert_eq!(ok(Format::Xyz, "0 0 0 7\n").positions.len(), 1);
     let m = ok(Format::Xyz, "0 0 0 1 0 0 9 9 9\n");
     assert_eq!(m.normals.unwrap(), vec![[1.0, 0.0, 0.0]]);
+    assert_eq!(m.colors.unwrap(), vec![[9, 9, 9]]);
 }
 
 #[test]
