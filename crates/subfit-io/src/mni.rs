@@ -163,6 +163,30 @@ pub(crate) fn read(bytes: &[u8], path: &Path, warnings: &mut Vec<String>) -> Res
     // A polygon takes an end index and three indices: at least 8 bytes.
     let n_items = r.count("the polygon count", room / 4)?;
     let colors = colours(&mut r, n_items, np)?;
+    let faces = polygons(&mut r, n_items, np, room)?;
+    if let Some((no, t)) = r.toks.next() {
+        return Err(syntax(
+            path,
+            no,
+            "data after the last polygon index of the MNI surface",
+            t,
+        ));
+    }
+    warnings.push(
+        "read as an MNI BIC polygon surface (an `.obj` of the MNI tools, not Wavefront)".into(),
+    );
+    Ok(PolyMesh {
+        positions,
+        normals: Some(normals),
+        colors,
+        faces,
+    })
+}
+
+/// The end indices and indices of `n_items` polygons over `np` points (`room`: the most
+/// tokens the file can hold).
+fn polygons(r: &mut Reader<'_, '_>, n_items: u64, np: u64, room: u64) -> Result<Polygons> {
+    let path = r.path;
     let mut ends = Vec::with_capacity(n_items as usize);
     let mut prev = 0u64;
     for i in 0..n_items {
@@ -209,23 +233,7 @@ pub(crate) fn read(bytes: &[u8], path: &Path, warnings: &mut Vec<String>) -> Res
         faces.push(&face);
         start = end;
     }
-    if let Some((no, t)) = r.toks.next() {
-        return Err(syntax(
-            path,
-            no,
-            "data after the last polygon index of the MNI surface",
-            t,
-        ));
-    }
-    warnings.push(
-        "read as an MNI BIC polygon surface (an `.obj` of the MNI tools, not Wavefront)".into(),
-    );
-    Ok(PolyMesh {
-        positions,
-        normals: Some(normals),
-        colors,
-        faces,
-    })
+    Ok(faces)
 }
 
 /// The colour flag and its colours; per-point colours are returned, the others skipped.
