@@ -2,3 +2,7 @@
 //! measures every result with an independent judge ([`judge`]), a code path of its own (parry's
 //! closest points on triangles, the limit surface evaluated exactly and sampled by area) that
 //! shares nothing with the fit's foot points or the report's distances.
+
+pub mod judge;
+
+pub use judge::{judge, Candidate, Direction, JudgeError, JudgeOptions, Judgement, Reference};
