@@ -1,7 +1,8 @@
 //! The local surface of a point reference: every point is a disc centred on it, normal to the
 //! principal axis of least variance of its [`NEIGHBOURS`] nearest points (PCA, as Hoppe et al.
 //! 1992 estimate tangent planes), with one radius for all: the median over the points of the
-//! distance to their [`NEIGHBOURS`]-th nearest neighbour. A point of the candidate is measured
+//! distance to their [`NEIGHBOURS`]-th nearest neighbour. A point whose neighbours span no
+//! plane (duplicates, a line) stays a point. A point of the candidate is measured
 //! to the nearest disc — to the disc, not its plane, so surface that overhangs the data's edge
 //! by more than the radius is measured as far as it overhangs.
 //!
@@ -19,6 +20,8 @@ use subfit::mesh::vec3::{dot, norm, sub};
 
 /// Neighbours of the normal estimate and of the radius.
 pub(super) const NEIGHBOURS: usize = 12;
+/// Extra neighbours fetched to find ties with the last of the [`NEIGHBOURS`].
+const TIES: usize = 4;
 /// Nearest points whose discs are tried first for a query; discs of farther points are tried
 /// only while they could still be nearer.
 const FIRST_TRIED: usize = 8;
@@ -38,7 +41,8 @@ impl<'a> Discs<'a> {
     pub fn new(points: &'a [[f64; 3]]) -> Result<Self, String> {
         use rayon::prelude::*;
         let tree = ImmutableKdTree::new_from_slice(points).map_err(|e| e.to_string())?;
-        let k = NonZeroUsize::new(NEIGHBOURS + 1).expect("positive");
+        // The point itself, its NEIGHBOURS nearest, and a few more to find ties with the last.
+        let k = NonZeroUsize::new(NEIGHBOURS + 1 + TIES).expect("positive");
         let (normals, reach): (Vec<[f64; 3]>, Vec<f64>) = points
             .par_iter()
             .map(|p| {
@@ -46,9 +50,16 @@ impl<'a> Discs<'a> {
                     .query(p)
                     .nearest_n::<SquaredEuclidean<f64>>(k)
                     .execute();
-                let idx: Vec<usize> = near.iter().map(|r| r.item as usize).collect();
-                let last = near.last().map_or(0.0, |r| r.distance.max(0.0).sqrt());
-                (pca_normal(points, &idx), last)
+                let last = near.get(NEIGHBOURS).map_or(0.0, |r| r.distance.max(0.0));
+                // Neighbours tied with the last (within 1e-9 relative, squared) join it, so the
+                // set does not hang on rounding (symmetric data, scaled copies).
+                let idx: Vec<usize> = near
+                    .iter()
+                    .enumerate()
+                    .take_while(|(i, r)| *i <= NEIGHBOURS || r.distance <= last * (1.0 + 2e-9))
+                    .map(|(_, r)| r.item as usize)
+                    .collect();
+                (pca_normal(points, &idx), last.sqrt())
             })
             .unzip();
         let mut reach = reach;
@@ -67,10 +78,13 @@ impl<'a> Discs<'a> {
         self.radius
     }
 
-    /// Distance from `q` to disc `i`.
+    /// Distance from `q` to disc `i` (to the point itself where its neighbours span no plane).
     fn disc_distance(&self, i: usize, q: [f64; 3]) -> f64 {
         let w = sub(q, self.points[i]);
         let n = self.normals[i];
+        if n == [0.0; 3] {
+            return norm(w);
+        }
         let h = dot(w, n);
         let rho = norm(std::array::from_fn(|k| w[k] - h * n[k]));
         if rho <= self.radius {
@@ -108,7 +122,8 @@ impl<'a> Discs<'a> {
 }
 
 /// The unit normal of the points `idx` of `points`: the eigenvector of their covariance with the
-/// smallest eigenvalue.
+/// smallest eigenvalue; zero when they span no plane (coincident or collinear: the middle
+/// eigenvalue below 1e-12 of the largest, relative to rounding).
 fn pca_normal(points: &[[f64; 3]], idx: &[usize]) -> [f64; 3] {
     let n = idx.len() as f64;
     let mut c = [0.0; 3];
@@ -127,14 +142,14 @@ fn pca_normal(points: &[[f64; 3]], idx: &[usize]) -> [f64; 3] {
         }
     }
     let e = m.symmetric_eigen();
-    let j = e.eigenvalues.imin();
-    let v = e.eigenvectors.column(j);
-    let l = v.norm();
-    if l > 0.0 {
-        [v[0] / l, v[1] / l, v[2] / l]
-    } else {
-        [0.0, 0.0, 1.0]
+    let mut order = [0, 1, 2];
+    order.sort_by(|&a, &b| e.eigenvalues[a].total_cmp(&e.eigenvalues[b]));
+    if e.eigenvalues[order[1]] <= 1e-12 * e.eigenvalues[order[2]] {
+        return [0.0; 3];
     }
+    let v = e.eigenvectors.column(order[0]);
+    let l = v.norm();
+    [v[0] / l, v[1] / l, v[2] / l]
 }
 
 #[cfg(test)]
@@ -159,5 +174,11 @@ mod tests {
         assert!((d.distance([2.5, 1.0, 0.0]) - 0.3).abs() < 1e-12);
         let far = d.distance([2.5, 1.0, 0.4]);
         assert!((far - (0.09f64 + 0.16).sqrt()).abs() < 1e-12, "{far}");
+        // Thirteen copies of one point and a line: no plane, so points.
+        let mut q = vec![[0.0; 3]; 13];
+        q.extend((0..13).map(|i| [1.0 + i as f64, 0.0, 0.0]));
+        let d = Discs::new(&q).unwrap();
+        assert!(d.normals.iter().all(|&n| n == [0.0; 3]));
+        assert!((d.distance([0.0, 0.5, 0.0]) - 0.5).abs() < 1e-15);
     }
 }

@@ -75,7 +75,9 @@ pub(super) fn level_for(faces: &Polygons, scheme: Scheme, target: usize) -> (usi
     let tris = |t: usize, q: usize| (t + 2 * q) as f64;
     let target = target.max(1) as f64;
     let mut level = 1;
-    while tris(t, q) * 2.0 < target {
+    // A face list with no face the scheme splits (quads under Loop) stays at level 1; the
+    // refinement then reports it.
+    while tris(t, q) * 2.0 < target && tris(t, q) > 0.0 {
         (t, q, level) = (4 * t, 4 * q, level + 1);
     }
     // Now tris ≥ target / 2; one level less if that is nearer in ratio.
