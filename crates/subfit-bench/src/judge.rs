@@ -11,7 +11,7 @@
 //! How a [`Candidate::Limit`] is measured (everything in the reference's units):
 //! 1. **Tessellation** (module `tessellate`). The cage refined uniformly `L` times, each
 //!    level-`L` vertex pushed to its exact limit point, the level-`L` faces as flat triangles;
-//!    `L` brings the count near [`JudgeOptions::tessellation_triangles`]. How far the flat
+//!    `L` brings the count near [`JudgeOptions::tessellation_triangles`] (at most 1.5 times it). How far the flat
 //!    triangles may lie from the exact surface is measured one level coarser, at edge midpoints
 //!    whose exact limit points the finer level holds ([`Judgement::tessellation_deviation`]).
 //! 2. **Surface → data.** Every limit point of the tessellation, standing for a third of the
@@ -311,11 +311,12 @@ fn judge_limit(
     })
 }
 
-/// Replaces the `count` largest tessellation distances in `d` (and any tied with the last) (data point `points[i]`, closest
-/// point `closest[i]` on `tess`) by the exact distance to the limit surface: Newton steps on the
-/// exact evaluator from the tessellation's foot point (module `polish`), the polished distance
-/// where it comes to rest inside its patch, the smaller of the two elsewhere. Returns how many
-/// were polished. Cost: the evaluator's construction and a few evaluations per point.
+/// Replaces the `count` largest tessellation distances in `d` (and any tied with the last; data
+/// point `points[i]`, closest point `closest[i]` on `tess`) by the exact distance to the limit
+/// surface: Newton steps on the exact evaluator from the tessellation's foot point (module
+/// `polish`), the polished distance where it comes to rest inside its patch, the smaller of the
+/// two elsewhere. Returns how many were polished. Cost: the evaluator's construction and a few
+/// evaluations per point.
 fn polish_worst(
     d: &mut [f64],
     closest: &[Closest],
@@ -343,23 +344,29 @@ fn polish_worst(
     }
     order.truncate(count + ties);
     let ev = Evaluator::new(&cage.faces, cage.positions.len(), tags, subdiv)?;
-    let exact = order
+    // An evaluation the evaluator refuses (a broken invariant it reports rather than panics
+    // on) leaves that point at its tessellation distance, and out of the polished count.
+    let exact: Vec<Option<f64>> = order
         .par_iter()
         .map(|&i| {
             let c = &closest[i as usize];
             let start = tess.levels.param(tess.face_of[c.triangle as usize], c.bary);
-            let foot = polish::polish(&ev, &cage.positions, points[i as usize], start)?;
-            Ok(if foot.interior_stationary {
+            let foot = polish::polish(&ev, &cage.positions, points[i as usize], start).ok()?;
+            Some(if foot.interior_stationary {
                 foot.distance
             } else {
                 foot.distance.min(c.distance)
             })
         })
-        .collect::<Result<Vec<f64>, EvalError>>()?;
+        .collect();
+    let mut polished = 0;
     for (&i, x) in order.iter().zip(exact) {
-        d[i as usize] = x;
+        if let Some(x) = x {
+            d[i as usize] = x;
+            polished += 1;
+        }
     }
-    Ok(order.len())
+    Ok(polished)
 }
 
 /// The area each vertex stands for: a third of each incident triangle's.

@@ -4,7 +4,7 @@
 //! ([`subfit::subdiv::limit_stencils`]). Those points lie exactly on the limit surface (the
 //! limit of a vertex is a point of the surface, at the dyadic parameter of the vertex); the
 //! level-`L` faces (quads cut along their first diagonal) are the flat triangles between them.
-//! `L ≥ 1` is the level whose triangle count is nearest (in ratio) to the requested one.
+//! `L ≥ 1` is the deepest level with at most 1.5 times the requested number of triangles.
 //!
 //! This is not the fit's sampling operator (the fused `C = L_l · M_l ⋯ M_1` of
 //! `subfit_subdiv::sample`) nor the report's tessellation; it is the plain refinement and limit
@@ -61,8 +61,9 @@ fn face_kinds(faces: &Polygons) -> (usize, usize, usize) {
     })
 }
 
-/// The refinement level whose tessellation has the number of triangles nearest (in ratio) to
-/// `target`, at least 1, and that count.
+/// The deepest refinement level whose tessellation has at most `1.5 · target` triangles (so
+/// between `0.375` and `1.5` times the target), at least 1, and that count. The cap bounds the
+/// memory: about 450 bytes per triangle at the peak (refinement, limit stencils, parry's BVH).
 pub(super) fn level_for(faces: &Polygons, scheme: Scheme, target: usize) -> (usize, usize) {
     let (t0, q0, o0) = face_kinds(faces);
     // Faces after one level: Loop and quad/triangle split triangles into 4 triangles, quads into
@@ -73,16 +74,12 @@ pub(super) fn level_for(faces: &Polygons, scheme: Scheme, target: usize) -> (usi
         Scheme::QuadTriangle => (4 * t0, 4 * q0 + o0),
     };
     let tris = |t: usize, q: usize| (t + 2 * q) as f64;
-    let target = target.max(1) as f64;
+    let cap = 1.5 * target.max(1) as f64;
     let mut level = 1;
     // A face list with no face the scheme splits (quads under Loop) stays at level 1; the
     // refinement then reports it.
-    while tris(t, q) * 2.0 < target && tris(t, q) > 0.0 {
+    while 4.0 * tris(t, q) <= cap && tris(t, q) > 0.0 {
         (t, q, level) = (4 * t, 4 * q, level + 1);
-    }
-    // Now tris ≥ target / 2; one level less if that is nearer in ratio.
-    if level > 1 && tris(t, q) / target > target / (tris(t, q) / 4.0) {
-        (t, q, level) = (t / 4, q / 4, level - 1);
     }
     (level, tris(t, q) as usize)
 }
@@ -222,13 +219,15 @@ mod tests {
         let (_, quads) = flat_grid(5);
         // 25 quads: level 1 has 100 quads = 200 triangles, each level ×4.
         assert_eq!(level_for(&quads, Scheme::CatmullClark, 1), (1, 200));
-        assert_eq!(level_for(&quads, Scheme::CatmullClark, 1_500), (2, 800));
-        assert_eq!(level_for(&quads, Scheme::CatmullClark, 2_000), (3, 3_200));
-        assert_eq!(level_for(&quads, Scheme::CatmullClark, 6_000), (3, 3_200));
+        assert_eq!(level_for(&quads, Scheme::CatmullClark, 2_000), (2, 800));
+        assert_eq!(level_for(&quads, Scheme::CatmullClark, 2_134), (3, 3_200));
+        assert_eq!(level_for(&quads, Scheme::CatmullClark, 8_000), (3, 3_200));
         let tri = Polygons::from_triangles(&[[0, 1, 2]]);
         assert_eq!(level_for(&tri, Scheme::Loop, 1_000_000), (10, 1 << 20));
         let penta = Polygons::from_raw(vec![0, 5], vec![0, 1, 2, 3, 4]).unwrap();
         assert_eq!(level_for(&penta, Scheme::QuadTriangle, 10), (1, 10));
+        let quad = Polygons::from_quads(&[[0, 1, 2, 3]]);
+        assert_eq!(level_for(&quad, Scheme::Loop, 1_000), (1, 0));
     }
 
     #[test]

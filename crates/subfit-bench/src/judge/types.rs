@@ -9,7 +9,8 @@ use subfit::subdiv::{BoundaryRule, EvalError, Scheme};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Reference {
     /// A triangle mesh. `positions` is `#V by 3`, `triangles` `#T by 3` (indices into
-    /// `positions`, any winding). Vertices no triangle uses are ignored.
+    /// `positions`, any winding). Vertices no triangle uses are not measured (but must be
+    /// finite).
     Mesh {
         /// Vertex positions, `#V by 3`.
         positions: Vec<[f64; 3]>,
@@ -104,9 +105,10 @@ pub struct JudgeOptions {
     /// Area-uniform samples of a mesh reference's triangles added to its vertices (data →
     /// surface). Default 100,000; 0 measures the vertices only. Unused for point references.
     pub data_samples: usize,
-    /// Triangles of the limit tessellation the judge builds: the uniform refinement level
-    /// whose triangle count is nearest (in ratio, so within a factor 2) is taken. Default
-    /// 1,000,000 (about half as many limit points; a few hundred MB at the peak); at least 1.
+    /// Triangles of the limit tessellation the judge builds: the deepest uniform refinement
+    /// level with at most 1.5 times this many is taken (so 0.375–1.5 times it). Default
+    /// 1,000,000 (about half as many limit points; about 450 bytes per triangle at the peak,
+    /// so under 700 MB); at least 1.
     pub tessellation_triangles: usize,
     /// Data points whose distance to a limit surface is polished exactly (Newton steps on the
     /// exact evaluator): the farthest ones by the tessellation's distance, which set the
