@@ -93,7 +93,7 @@ use tessellate::Tessellation;
 /// Cost: for the defaults, the refinement of the cage to about a million triangles (half as
 /// many limit points measured to the reference), a parry BVH over them, a closest point for
 /// each reference point, and a thousand exact polishes (the evaluator's construction and a few
-/// evaluations each); measured 1.8 s of CPU and 370 MB for a 100k-vertex scan and a 5,000-point
+/// evaluations each); measured 1.6 s of CPU and 370 MB for a 100k-vertex scan and a 5,000-point
 /// Loop cage (`examples/judge_cost.rs`).
 pub fn judge(
     reference: &Reference,
