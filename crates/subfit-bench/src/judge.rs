@@ -64,6 +64,7 @@
 //! ```
 
 mod closest;
+mod params;
 mod points;
 mod polish;
 mod sample;
@@ -72,6 +73,7 @@ mod tessellate;
 mod types;
 mod walk;
 
+pub use params::closest_params;
 pub use types::{Candidate, Direction, JudgeError, JudgeOptions, Judgement, Reference};
 
 use closest::{Closest, Triangles};
@@ -151,6 +153,7 @@ fn judge_here(
         tessellation_deviation: measured.deviation,
         tessellation_triangles: measured.triangles,
         polished_points: measured.polished,
+        isolated_points: data.isolated,
         point_spacing: match &data.surface {
             Surface::Discs(d) => Some(d.radius()),
             Surface::Triangles(_) => None,
@@ -188,6 +191,8 @@ impl Surface<'_> {
 /// The validated reference: its points measured to the candidate, its diagonal, its surface.
 struct Data<'a> {
     points: Vec<[f64; 3]>,
+    /// Points of a cloud left out as isolated returns.
+    isolated: usize,
     diagonal: f64,
     surface: Surface<'a>,
 }
@@ -229,6 +234,7 @@ impl<'a> Data<'a> {
                 }
                 Ok(Self {
                     points,
+                    isolated: 0,
                     diagonal,
                     surface: Surface::Triangles(Triangles::new(positions, triangles)),
                 })
@@ -243,10 +249,19 @@ impl<'a> Data<'a> {
                     });
                 }
                 let diagonal = diagonal(positions)?;
+                let discs = Discs::new(positions).map_err(JudgeError::KdTree)?;
+                // Isolated returns are not measured data → surface (see `points::ISOLATED`).
+                let points: Vec<[f64; 3]> = positions
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, _)| !discs.isolated(i))
+                    .map(|(_, &p)| p)
+                    .collect();
                 Ok(Self {
-                    points: positions.clone(),
+                    isolated: positions.len() - points.len(),
+                    points,
                     diagonal,
-                    surface: Surface::Discs(Discs::new(positions).map_err(JudgeError::KdTree)?),
+                    surface: Surface::Discs(discs),
                 })
             }
         }

@@ -392,13 +392,57 @@ fn a_surface_overhanging_a_cloud_is_seen() {
         }
     }
     let cage = Candidate::limit(PolyMesh::new(p, f), Tags::new(), Scheme::CatmullClark);
-    let j = judge(&Reference::Points { positions: points }, &cage, &small()).unwrap();
+    let j = judge(
+        &Reference::Points {
+            positions: points.clone(),
+        },
+        &cage,
+        &small(),
+    )
+    .unwrap();
     // The 12th neighbour of an interior grid point is two spacings away.
     assert!((j.point_spacing.unwrap() - 0.05).abs() < 1e-12);
     assert!(j.data_to_surface.max < 1e-12, "{:?}", j.data_to_surface);
     // Far from the data (corners of the limit, ~1.3 from the square): far, less the radius.
     assert!(j.surface_to_data.max > 1.0, "{:?}", j.surface_to_data);
     assert!(j.surface_to_data.mean > 0.3, "{:?}", j.surface_to_data);
+    assert_eq!(j.isolated_points, 0);
+
+    // Two clusters of three stray returns, 0.5 and 0.8 above the square (a range scan's), are
+    // left out of data → surface; a patch of 16 points floating as far is data and is measured.
+    let mut strays = points.clone();
+    for (i, h) in [
+        (0.0, 0.5),
+        (0.002, 0.5),
+        (0.004, 0.5),
+        (0.5, 0.8),
+        (0.502, 0.8),
+        (0.5, 0.802),
+    ] {
+        strays.push([0.3 + i, 0.3, h]);
+    }
+    let j = judge(
+        &Reference::Points {
+            positions: strays.clone(),
+        },
+        &cage,
+        &small(),
+    )
+    .unwrap();
+    assert_eq!(j.isolated_points, 6);
+    assert!(j.data_to_surface.max < 1e-12, "{:?}", j.data_to_surface);
+    for a in 0..4 {
+        for b in 0..4 {
+            strays.push([0.9 + 0.025 * a as f64, 0.9 + 0.025 * b as f64, 0.6]);
+        }
+    }
+    let j = judge(&Reference::Points { positions: strays }, &cage, &small()).unwrap();
+    assert_eq!(j.isolated_points, 6);
+    assert!(
+        (j.data_to_surface.max - 0.6).abs() < 1e-9,
+        "{:?}",
+        j.data_to_surface
+    );
 }
 
 #[test]

@@ -22,6 +22,13 @@ use subfit::mesh::vec3::{dot, norm, sub};
 pub(super) const NEIGHBOURS: usize = 12;
 /// Extra neighbours fetched to find ties with the last of the [`NEIGHBOURS`].
 const TIES: usize = 4;
+/// A point whose [`NEIGHBOURS`]-th neighbour is farther than this many disc radii (the median of
+/// that distance) is an isolated return: a stray point of a range scan with no surface around
+/// it (a handful of them, 40–60 radii from any other data, in the corpus's single views). It is
+/// not data → surface data: its distance would be the Hausdorff distance of every fit, however
+/// good. Ten radii is five times the spacing of a sparse patch (2 radii), far above the sampling
+/// variation of a real surface.
+pub(super) const ISOLATED: f64 = 10.0;
 /// Nearest points whose discs are tried first for a query; discs of farther points are tried
 /// only while they could still be nearer.
 const FIRST_TRIED: usize = 8;
@@ -32,6 +39,7 @@ pub(super) struct Discs<'a> {
     normals: Vec<[f64; 3]>,
     radius: f64,
     tree: ImmutableKdTree<f64, 3>,
+    isolated: Vec<bool>,
 }
 
 impl<'a> Discs<'a> {
@@ -62,15 +70,23 @@ impl<'a> Discs<'a> {
                 (pca_normal(points, &idx), last.sqrt())
             })
             .unzip();
-        let mut reach = reach;
-        let mid = reach.len() / 2;
-        let (_, radius, _) = reach.select_nth_unstable_by(mid, f64::total_cmp);
+        let mut sorted = reach.clone();
+        let mid = sorted.len() / 2;
+        let (_, radius, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
+        let radius = *radius;
+        let isolated = reach.iter().map(|&r| r > ISOLATED * radius).collect();
         Ok(Self {
             points,
             normals,
-            radius: *radius,
+            radius,
             tree,
+            isolated,
         })
+    }
+
+    /// Whether point `i` is isolated (see [`ISOLATED`]).
+    pub fn isolated(&self, i: usize) -> bool {
+        self.isolated[i]
     }
 
     /// The discs' radius, in the points' units.

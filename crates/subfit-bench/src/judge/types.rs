@@ -183,6 +183,10 @@ pub struct Judgement {
     /// For a point reference: the radius of the discs its local surface is made of (the median
     /// distance of a point to its 12th nearest neighbour); `None` for a mesh reference.
     pub point_spacing: Option<f64>,
+    /// Points of a cloud reference left out of data → surface as isolated returns (farther from
+    /// their 12th neighbour than ten times the median of that distance); 0 for a mesh.
+    #[serde(default)]
+    pub isolated_points: usize,
     /// Wall-clock seconds the judgement took (informative only).
     pub seconds: f64,
 }
