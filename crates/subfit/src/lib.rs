@@ -24,7 +24,8 @@
 //! - [`target`]: the shape being fitted (normals, curvature, foot points);
 //! - [`fit`]: the fitting engine (PDM/TDM/SDM, smoothing, LM and Armijo step control, stages);
 //! - [`init`]: initial control meshes with the target's topology (QEM simplification, contouring);
-//! - [`report`]: two-sided distances, error colours, the limit tessellation, plots.
+//! - [`measure`]: the one measurer: two-sided distances, data samples, the limit tessellation;
+//! - [`report`]: error colours, plots, the preview image, report.html.
 
 mod budget_starts;
 mod error;
@@ -58,6 +59,7 @@ pub use sequence::{
 pub use subfit_fit as fit;
 pub use subfit_init as init;
 pub use subfit_io as io;
+pub use subfit_measure as measure;
 pub use subfit_mesh as mesh;
 pub use subfit_report as report;
 pub use subfit_subdiv as subdiv;

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 use subfit_fit::{ErrorStats, IterationRow, StageReport};
-use subfit_report::{DistanceStats, TwoSided};
+use subfit_measure::{DistanceStats, TwoSided};
 
 /// Errors of one cage, surface → data, as the fitter measures them (Cheng 2007 §II-B step 7).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

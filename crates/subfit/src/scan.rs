@@ -28,7 +28,7 @@ use crate::tolerance::{
     edge_count, noise_floored, target_tolerances, with_sampling_margin, ToleranceKind,
     NOISE_FLOOR_FACTOR, SCAN_RMS,
 };
-use subfit_report::{
+use subfit_measure::{
     data_samples, limit_tessellation, vertex_areas, DistanceStats, MeshDistance, TwoSided,
 };
 
@@ -635,8 +635,8 @@ pub(crate) fn fit_scan_from(
         normalized_unit_in_original_units: unit,
         bbox_diagonal_unit_cube: diagonal,
         data_samples: match result.report.data_samples {
-            subfit_report::data_samples::SampleKind::Points => "points".into(),
-            subfit_report::data_samples::SampleKind::MeshArea => "mesh_area".into(),
+            subfit_measure::SampleKind::Points => "points".into(),
+            subfit_measure::SampleKind::MeshArea => "mesh_area".into(),
         },
         init,
         options: OptionsSummary {

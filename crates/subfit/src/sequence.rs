@@ -54,9 +54,9 @@ use std::time::Instant;
 
 use serde::Serialize;
 use subfit_fit::{AnyTerm, FitOptions, Fitter, Method, WeightedSurfaceTerm};
+use subfit_measure::data_samples;
 use subfit_mesh::vec3::{cross, dist2, dot, sub};
 use subfit_mesh::{Cancel, PolyMesh, Polygons, Tags};
-use subfit_report::data_samples;
 use subfit_subdiv::{sampling_operator, BoundaryRule, Scheme, StencilMatrix};
 use subfit_target::{Normalization, Target, TargetOptions};
 
