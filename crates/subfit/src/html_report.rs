@@ -19,7 +19,7 @@ use subfit_report::{error_color, preview_png, PreviewOptions, Wireframe};
 use subfit_subdiv::{sampling_operator, Scheme};
 
 use crate::error::Error;
-use crate::scan::Fitted;
+use crate::fitted::Fitted;
 
 /// Most triangles shown in the viewer.
 pub const VIEW_TRIANGLES: usize = 300_000;

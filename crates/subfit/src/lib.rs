@@ -27,34 +27,49 @@
 //! - [`measure`]: the one measurer: two-sided distances, data samples, the limit tessellation;
 //! - [`report`]: error colours, plots, the preview image, report.html.
 
-mod budget_starts;
+pub mod choose;
 mod error;
+mod fit_start;
+mod fitted;
 mod html_report;
-pub mod initial_cage;
+mod limit_stencils;
 mod markers;
+mod measure_fit;
+mod options;
 mod outputs;
 pub mod pipeline_report;
+pub mod prepare;
+mod progress;
 mod repair;
+mod report_build;
 mod scan;
 mod sequence;
 mod sequence_tracking;
+mod start;
+mod start_curvature_lines;
+mod start_given;
+mod start_qem;
+pub mod starts;
 pub mod tolerance;
 
-pub use budget_starts::BUDGET_STARTS;
+pub use choose::Measurement;
 pub use error::Error;
+pub use fitted::Fitted;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use markers::{parse_markers, read_markers};
+pub use options::{FitScanOptions, InitialCage, Input, EXACT_ERROR};
 pub use outputs::{log_csv, usd_scheme, OUTPUTS};
 pub use pipeline_report::Report;
+pub use prepare::Prepared;
+pub use progress::{Progress, Step};
 pub use repair::repair_mesh;
-pub use scan::{
-    fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
-};
+pub use scan::{fit_scan, read_cage};
 pub use sequence::{
     fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, MarkerObservation,
     Sequence, SequenceFrame, SequenceOptions, SequenceOptionsSummary, SequenceReport,
     SilhouetteOptions, TrackingOptions, TrackingReport, DEFAULT_SILHOUETTE_WEIGHT,
 };
+pub use starts::{Start, StartKind, BOTH_INITS_POINTS, BUDGET_STARTS};
 
 pub use subfit_fit as fit;
 pub use subfit_init as init;

@@ -178,7 +178,7 @@ pub struct CurvatureLineSummary {
     /// Whether it is the initial cage.
     pub used: bool,
     /// Why it is not (it cannot be built, or the QEM start gave the better fit, see
-    /// `crate::initial_cage`). `None` when used.
+    /// `crate::starts`). `None` when used.
     pub reason: Option<String>,
     /// Its control points (0 when it could not be built).
     pub control_points: usize,

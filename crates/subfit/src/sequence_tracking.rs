@@ -20,7 +20,7 @@ use subfit_fit::track::{
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::{Normalization, Target};
 
-use crate::sequence::LimitStencils;
+use crate::limit_stencils::LimitStencils;
 
 /// The embedded-deformation tracking step of a sequence ([`subfit_fit::track`]).
 #[derive(Clone, Debug, PartialEq)]

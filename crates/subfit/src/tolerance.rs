@@ -207,6 +207,18 @@ pub(crate) fn noise_floored(
     (options, Some(floor))
 }
 
+/// The tolerances one fit works to and is judged by.
+pub(crate) struct Tolerances {
+    /// The default set chosen for the target, when the target's defaults are asked.
+    pub(crate) kind: Option<ToleranceKind>,
+    /// The tolerances before the noise floor (the report's options).
+    pub(crate) judged: StageOptions,
+    /// The tolerances the cage is judged by (noise floor applied).
+    pub(crate) stages: StageOptions,
+    /// The raised RMS tolerance of a noisy scan, if it was raised.
+    pub(crate) noise_floor: Option<f64>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
