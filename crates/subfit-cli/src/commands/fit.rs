@@ -283,6 +283,7 @@ pub fn blender_hint(fitted: &Fitted) {
 pub fn write_outputs(fitted: &mut Fitted, dir: &std::path::Path) -> anyhow::Result<()> {
     let stage = crate::interrupt::Staging::new(dir)
         .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+    crate::progress::phase("writing the outputs");
     fitted.write_into(&stage.path(""))?;
     stage
         .commit(&OUTPUTS)
