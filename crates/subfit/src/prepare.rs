@@ -55,6 +55,16 @@ impl Prepared {
             .is_some_and(|t| t.genus == 0 && t.boundary_loops > 0)
     }
 
+    /// The number of faces fitted (0 for a point cloud or with `as_points`).
+    pub fn mesh_faces(&self) -> usize {
+        self.mesh.faces.len()
+    }
+
+    /// Seconds spent reading and analysing the input.
+    pub fn read_and_analyse_seconds(&self) -> f64 {
+        self.read_seconds + self.preprocess_seconds
+    }
+
     /// Whether the target is a mesh with boundary loops.
     pub fn is_open_mesh(&self) -> bool {
         self.topology.is_some_and(|t| t.boundary_loops > 0)
@@ -75,8 +85,9 @@ impl Prepared {
             .quad_dominant
             .unwrap_or(options.scheme.is_some_and(|s| s != Scheme::Loop));
         if let Some(t) = self.expected_topology {
-            init.expected_genus = Some(t.genus);
-            init.expected_boundary_loops = Some(t.boundary_loops);
+            // A genus the caller gave (`subfit init --genus`) wins over the dropped faces'.
+            init.expected_genus.get_or_insert(t.genus);
+            init.expected_boundary_loops.get_or_insert(t.boundary_loops);
         }
         init
     }

@@ -55,4 +55,9 @@ pub struct Start {
     pub warnings: Vec<String>,
     /// Seconds spent building it.
     pub seconds: f64,
+    /// What [`subfit_init::initial_control_mesh`] did, for a QEM start.
+    pub init_report: Option<subfit_init::InitReport>,
+    /// What [`subfit_init::curvature_lines::curvature_line_cage`] did, for a curvature-line
+    /// start.
+    pub curvature_report: Option<subfit_init::curvature_lines::CurvatureLineReport>,
 }

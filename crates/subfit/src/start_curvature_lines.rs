@@ -116,5 +116,7 @@ pub(crate) fn curvature_line_start(
         feature_segments: None,
         warnings: Vec::new(),
         seconds: 0.0,
+        init_report: None,
+        curvature_report: Some(r),
     })
 }

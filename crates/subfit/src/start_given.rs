@@ -101,6 +101,8 @@ pub(crate) fn given_start(
         feature_segments: None,
         warnings: Vec::new(),
         seconds: 0.0,
+        init_report: None,
+        curvature_report: None,
     })
 }
 

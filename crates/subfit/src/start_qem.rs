@@ -127,16 +127,19 @@ pub(crate) fn qem_start(
     };
     let feature_segments =
         (!r.feature_segments.is_empty()).then(|| Arc::new(std::mem::take(&mut r.feature_segments)));
+    let tags = std::mem::take(&mut r.tags);
     Ok(Start {
         kind: StartKind::Qem {
             budget_fraction: budget_start,
         },
         cage: m,
-        tags: r.tags,
+        tags,
         summary,
         feature_segments,
         warnings,
         seconds: 0.0,
+        init_report: Some(r),
+        curvature_report: None,
     })
 }
 

@@ -70,12 +70,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         init,
         control_points: a.control_points.map(|n| n as usize),
         as_points: a.as_points,
-        scheme: match a.scheme {
-            SchemeArg::Auto => None,
-            SchemeArg::Loop => Some(Scheme::Loop),
-            SchemeArg::CatmullClark => Some(Scheme::CatmullClark),
-            SchemeArg::QuadTri => Some(Scheme::QuadTriangle),
-        },
+        scheme: scheme_of(a.scheme),
         quad_dominant: quad_dominant_flag(a.quad_dominant, a.no_quad_dominant),
         fit: FitOptions {
             sample_level: a.sample_level as usize,
@@ -289,6 +284,16 @@ pub fn write_outputs(fitted: &mut Fitted, dir: &std::path::Path) -> anyhow::Resu
         .commit(&OUTPUTS)
         .with_context(|| format!("{}: cannot move the outputs into place", dir.display()))?;
     Ok(())
+}
+
+/// The scheme asked by `--scheme` (`None`: automatic).
+pub(crate) fn scheme_of(s: SchemeArg) -> Option<Scheme> {
+    match s {
+        SchemeArg::Auto => None,
+        SchemeArg::Loop => Some(Scheme::Loop),
+        SchemeArg::CatmullClark => Some(Scheme::CatmullClark),
+        SchemeArg::QuadTri => Some(Scheme::QuadTriangle),
+    }
 }
 
 pub(crate) fn method_of(m: MethodArg) -> Method {
