@@ -1,7 +1,8 @@
 //! `subfit.fit`: numpy arrays and keywords → [`subfit::FitScanOptions`] → [`subfit::fit_scan`]
 //! (the pipeline of `subfit fit`, nothing re-implemented) → a [`NativeFit`] holding the result.
 //!
-//! Keywords mirror the CLI's flags (`--max-control-points` → `max_control_points`, `--lambda`
+//! Keywords mirror the CLI's flags (every `--method`, `imls` with `imls_radius` and `arap`
+//! included) (`--max-control-points` → `max_control_points`, `--lambda`
 //! → `lambda_start`, `--no-refine` → `refine=False`, …) with the same defaults and ranges. The
 //! fit runs with the interpreter detached; once per iteration the progress hook re-attaches to
 //! check for Ctrl-C (`KeyboardInterrupt`), pass warnings to Python's `warnings`, and call the
@@ -66,7 +67,9 @@ fn options(
     local_rings: Option<i64>,
     local_field: (f64, f64),
     error_scale: Option<f64>,
+    imls: (Option<f64>, f64),
 ) -> PyResult<FitScanOptions> {
+    let (imls_radius, arap) = imls;
     let (local_field_peak, local_field_share) = local_field;
     if !(local_field_peak > 0.5 && local_field_peak <= 1.0) {
         return Err(value_error(format!(
@@ -87,9 +90,10 @@ fn options(
         "pdm" => Method::Pdm,
         "tdm" => Method::Tdm,
         "sdm" => Method::Sdm,
+        "imls" => Method::Imls,
         _ => {
             return Err(value_error(format!(
-                "method must be \"pdm\", \"tdm\" or \"sdm\", got {method:?}"
+                "method must be \"pdm\", \"tdm\", \"sdm\" or \"imls\", got {method:?}"
             )))
         }
     };
@@ -117,6 +121,8 @@ fn options(
             method,
             step,
             coverage,
+            imls_radius,
+            arap,
             ..FitOptions::default()
         },
         stages: StageOptions {
@@ -197,7 +203,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
     max_depth=5, local=false, local_rings=None, local_field_peak=0.8, local_field_share=0.5,
-    error_scale=None, name=None, progress=None
+    error_scale=None, imls_radius=None, arap=0.0, name=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
@@ -230,6 +236,8 @@ pub fn fit(
     local_field_peak: f64,
     local_field_share: f64,
     error_scale: Option<f64>,
+    imls_radius: Option<f64>,
+    arap: f64,
     name: Option<String>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeFit> {
@@ -256,6 +264,7 @@ pub fn fit(
         local_rings,
         (local_field_peak, local_field_share),
         error_scale,
+        (imls_radius, arap),
     )?;
     let positions = vec3s("points", &points, subfit::target::MIN_POINTS)?;
     let n = positions.len();
