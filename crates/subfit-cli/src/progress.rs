@@ -99,7 +99,8 @@ pub fn read_with_progress(path: &Path) -> Result<Vec<u8>, subfit::io::Error> {
     Ok(buf)
 }
 
-/// Reads and parses a mesh or point-cloud file, with progress for large files.
+/// Reads and parses a mesh or point-cloud file, with progress for large files; the reader's
+/// warnings are printed on stderr.
 pub fn load(
     path: &Path,
 ) -> Result<(subfit::mesh::PolyMesh, subfit::io::FileInfo), subfit::io::Error> {
@@ -109,5 +110,16 @@ pub fn load(
     if let Some(sp) = sp {
         sp.finish_and_clear();
     }
+    if let Ok((_, info)) = &out {
+        print_read_warnings(path, &info.warnings);
+    }
     out
+}
+
+/// Prints what a reader decided about a file it read ([`subfit::io::FileInfo::warnings`]) on
+/// stderr, one `subfit: warning: FILE: …` line each.
+pub fn print_read_warnings(path: &Path, warnings: &[String]) {
+    for w in warnings {
+        eprintln!("subfit: warning: {}: {w}", path.display());
+    }
 }
