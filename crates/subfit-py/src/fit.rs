@@ -14,7 +14,7 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyRuntimeWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use subfit::fit::{FitOptions, Method, StageOptions, StepControl};
+use subfit::fit::{FitOptions, StageOptions, StepControl};
 use subfit::mesh::{Cancel, PolyMesh, Tags};
 use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
 
@@ -86,17 +86,7 @@ fn options(
             "coverage must be a finite number >= 0, got {coverage}"
         )));
     }
-    let method = match method.to_ascii_lowercase().as_str() {
-        "pdm" => Method::Pdm,
-        "tdm" => Method::Tdm,
-        "sdm" => Method::Sdm,
-        "imls" => Method::Imls,
-        _ => {
-            return Err(value_error(format!(
-                "method must be \"pdm\", \"tdm\", \"sdm\" or \"imls\", got {method:?}"
-            )))
-        }
-    };
+    let method = subfit::method_named(method).map_err(|e| value_error(e.to_string()))?;
     let step = match step.to_ascii_lowercase().as_str() {
         "none" => StepControl::None,
         "lm" => StepControl::LevenbergMarquardt,
@@ -110,7 +100,7 @@ fn options(
     if local_rings.is_some() && !local {
         return Err(value_error("local_rings needs local=True"));
     }
-    Ok(FitScanOptions {
+    let mut o = FitScanOptions {
         control_points: control_points
             .map(|n| range("control_points", n, 4, 1_000_000))
             .transpose()?,
@@ -126,18 +116,8 @@ fn options(
             ..FitOptions::default()
         },
         stages: StageOptions {
-            lambda_start,
-            lambda_end: lambda_end.unwrap_or(lambda_start.min(1e-5)),
             iterations_per_stage: range("stage_iterations", stage_iterations, 1, 10_000)?,
             max_iterations: range("max_iterations", max_iterations, 1, 10_000)?,
-            tolerance_rms: tolerance.unwrap_or(StageOptions::default().tolerance_rms),
-            tolerance_max: max_error.unwrap_or(0.0),
-            max_control_points: match max_control_points {
-                Some(n) => range("max_control_points", n, 4, 10_000_000)?,
-                None => StageOptions::default().max_control_points,
-            },
-            refine,
-            edge_flips: refine && edge_flips,
             max_depth: range("max_depth", max_depth, 1, 12)? as u8,
             local,
             local_rings: range("local_rings", local_rings.unwrap_or(2), 0, 1_000)?,
@@ -147,11 +127,18 @@ fn options(
             ..StageOptions::default()
         },
         error_scale,
-        target_tolerances: tolerance.is_none()
-            && max_error.is_none()
-            && max_control_points.is_none(),
         ..FitScanOptions::default()
-    })
+    };
+    o.set_limits(
+        tolerance,
+        max_error,
+        max_control_points
+            .map(|n| range("max_control_points", n, 4, 10_000_000))
+            .transpose()?,
+    );
+    o.set_lambda(lambda_start, lambda_end);
+    o.set_refinement(refine, edge_flips);
+    Ok(o)
 }
 
 /// A progress event as a Python dict.

@@ -59,7 +59,7 @@ pub use fitted::Fitted;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use initialize::{initialize, Initialized};
 pub use markers::{parse_markers, read_markers};
-pub use options::{FitScanOptions, InitialCage, Input, EXACT_ERROR};
+pub use options::{method_named, FitScanOptions, InitialCage, Input, EXACT_ERROR};
 pub use outputs::{log_csv, usd_scheme, OUTPUTS};
 pub use pipeline_report::Report;
 pub use prepare::Prepared;

@@ -150,6 +150,58 @@ impl Default for FitScanOptions {
 /// of a CAD part keep only the vertices their shape needs (an open box: its corners).
 pub const EXACT_ERROR: f64 = 1e-6;
 
+impl FitScanOptions {
+    /// Sets the tolerances and the budget a user gives (`--tolerance`, `--max-error`,
+    /// `--max-control-points` of the CLI; the keywords of the same names in Python), in
+    /// unit-cube units, with the rules every front end shares: the RMS tolerance is 5e-4
+    /// (Cheng et al. 2007's Table IV) unless given, no maximum unless given, the budget 5,000
+    /// unless given; with none of the three given the tolerances are the target's
+    /// ([`Self::target_tolerances`], [`crate::tolerance`]). Validated by [`crate::fit_scan`].
+    pub fn set_limits(
+        &mut self,
+        tolerance: Option<f64>,
+        max_error: Option<f64>,
+        max_control_points: Option<usize>,
+    ) {
+        let defaults = StageOptions::default();
+        self.stages.tolerance_rms = tolerance.unwrap_or(defaults.tolerance_rms);
+        self.stages.tolerance_max = max_error.unwrap_or(0.0);
+        self.stages.max_control_points = max_control_points.unwrap_or(defaults.max_control_points);
+        self.target_tolerances =
+            tolerance.is_none() && max_error.is_none() && max_control_points.is_none();
+    }
+
+    /// Sets the smoothing schedule: `λ` from `start` down to `end` (dimensionless; default
+    /// `min(1e-5, start)`), as `--lambda` / `--lambda-end` and Python's `lambda_start` /
+    /// `lambda_end`.
+    pub fn set_lambda(&mut self, start: f64, end: Option<f64>) {
+        self.stages.lambda_start = start;
+        self.stages.lambda_end = end.unwrap_or(start.min(1e-5));
+    }
+
+    /// Sets the refinement between stages: local refinement on or off (`--no-refine`), and
+    /// edge flips (`--no-flips`), which need refinement.
+    pub fn set_refinement(&mut self, refine: bool, edge_flips: bool) {
+        self.stages.refine = refine;
+        self.stages.edge_flips = refine && edge_flips;
+    }
+}
+
+/// The error term named `name` (`pdm`, `tdm`, `sdm` or `imls`, any case), as `--method`
+/// spells them; an options error naming the choices otherwise.
+pub fn method_named(name: &str) -> Result<subfit_fit::Method, Error> {
+    use subfit_fit::Method;
+    match name.to_ascii_lowercase().as_str() {
+        "pdm" => Ok(Method::Pdm),
+        "tdm" => Ok(Method::Tdm),
+        "sdm" => Ok(Method::Sdm),
+        "imls" => Ok(Method::Imls),
+        _ => Err(Error::Options(format!(
+            "method must be \"pdm\", \"tdm\", \"sdm\" or \"imls\", got {name:?}"
+        ))),
+    }
+}
+
 /// Checks `o` before any work: each error names the flag and what is wrong.
 pub(crate) fn validate(o: &FitScanOptions) -> Result<(), Error> {
     let bad = |m: String| Err(Error::Options(m));
