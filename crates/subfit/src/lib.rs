@@ -5,7 +5,11 @@
 //! both ways, keep the best cage — returning a [`Fitted`] cage in the input's coordinates with
 //! a typed [`Report`] (`report.json` is its serialization) that can write every output
 //! ([`Fitted::write_into`], [`OUTPUTS`]). The command-line tool, its demo and benchmarks call
-//! it; none re-implements a step.
+//! it; none re-implements a step. Its steps (DESIGN.md §2, STYLE.md rules 11–12):
+//! [`prepare`] reads, repairs and analyses the input once ([`Prepared`]); [`starts`] lists the
+//! candidate initial cages ([`StartKind`]: the one place where a new kind is added);
+//! `fit_start` fits each from the shared [`Prepared`]; [`choose`] keeps the best by its typed
+//! [`Measurement`]. [`initialize`] builds the first start alone (`subfit init`).
 //!
 //! ```no_run
 //! use subfit::{fit_scan, FitScanOptions, Input};

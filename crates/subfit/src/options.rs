@@ -95,7 +95,7 @@ pub struct FitScanOptions {
     /// given. Default false: the tolerances of `stages` (unit cube).
     pub target_tolerances: bool,
     /// With [`Self::target_tolerances`], a mesh target whose initial cage makes it a CAD part
-    /// ([`ToleranceKind::CadPart`]) has its sharp features detected again from this dihedral
+    /// ([`crate::tolerance::ToleranceKind::CadPart`]) has its sharp features detected again from this dihedral
     /// angle (degrees) when the features' angle is larger, and its cage built again
     /// ([`crate::tolerance::CAD_FEATURE_ANGLE`] by default; `None`: never). `subfit fit` sets
     /// `None` when `--feature-angle` is given.

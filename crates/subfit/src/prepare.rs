@@ -1,7 +1,7 @@
 //! The prepared input (DESIGN.md §2 "Prepared input", STYLE.md rule 11): the scan read,
-//! repaired ([`crate::repair`]) and analysed ([`subfit_target::Target`]: normalization to the
+//! repaired (`repair.rs`, [`crate::repair_mesh`]) and analysed ([`subfit_target::Target`]: normalization to the
 //! unit cube, kd-tree, normals, curvature, noise level, features of a mesh, boundaries) once,
-//! and borrowed by every start ([`crate::starts`]) and every fit ([`crate::fit_start`]).
+//! and borrowed by every start ([`crate::starts`]) and every fit (`fit_start.rs`).
 //!
 //! What the input is — a point cloud or a mesh, open or closed, of which genus, how noisy — is
 //! read off [`Prepared`] by the starts and the tolerance policy ([`crate::tolerance`]), never
@@ -20,7 +20,7 @@ use crate::options::{FitScanOptions, Input};
 use crate::pipeline_report::{Reorientation, Topology};
 use crate::progress::{Notify, Step};
 
-/// The input read, repaired and analysed once (see the module docs). Cost of [`prepare`]:
+/// The input read, repaired and analysed once (see the module docs). Cost of `prepare`:
 /// reading, the repairs (about linear in the mesh) and [`Target::build`] (kd-tree, normals,
 /// curvature by local quadrics: O(#points · k log #points)).
 pub struct Prepared {

@@ -38,7 +38,7 @@ impl StartKind {
     }
 }
 
-/// An initial cage built from the prepared input, ready for [`crate::fit_start`].
+/// An initial cage built from the prepared input, ready to be fitted (`fit_start.rs`).
 #[derive(Clone, Debug)]
 pub struct Start {
     /// Which kind of start built it.

@@ -3,7 +3,7 @@
 //! of start (a CAD cage, a thin-part-aware octree, cross-field quads from `subfit_init`) is
 //! added here: a variant of [`StartKind`], its builder in a `start_*.rs` file called from
 //! [`build_start`], and the condition under which [`starts`] lists it. [`crate::fit_scan`]
-//! fits every start listed from the one [`crate::Prepared`] input ([`crate::fit_start`]) and
+//! fits every start listed from the one [`crate::Prepared`] input (`fit_start.rs`) and
 //! keeps the best by [`crate::choose::Measurement`]; a later start of another kind is capped
 //! to one control point fewer than a kept fit that met the tolerances (it can only win by
 //! being more compact), so it stops early when it cannot win.
