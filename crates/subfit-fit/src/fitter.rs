@@ -280,11 +280,11 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         control: &[[f64; 3]],
         data: &[[f64; 3]],
     ) -> (
-        subfit_report::TwoSided,
+        subfit_measure::TwoSided,
         Vec<f64>,
-        Vec<subfit_report::PointToLimit>,
+        Vec<subfit_measure::PointToLimit>,
     ) {
-        use subfit_report::{vertex_areas, DistanceStats, MeshDistance, TwoSided};
+        use subfit_measure::{vertex_areas, DistanceStats, MeshDistance, TwoSided};
         let samples = self.op.position.apply(control);
         let err2 = self.squared_errors(&samples);
         let to_surface = MeshDistance::new(&samples, &self.op.faces).distances(data);

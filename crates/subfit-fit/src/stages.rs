@@ -10,7 +10,7 @@
 //!
 //! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
 //! surface against the data (Cheng's measure) and the data against the limit surface (the
-//! tessellation of the fitter's samples, [`subfit_report::MeshDistance`]). Tolerances hold only when both do; faces
+//! tessellation of the fitter's samples, [`subfit_measure::MeshDistance`]). Tolerances hold only when both do; faces
 //! that miss in either direction are refined; the best cage measured is the one returned.
 //!
 //! Every scheme is refined; flips change pairs of triangles only (a quad's edge is never
@@ -18,9 +18,9 @@
 
 use std::time::{Duration, Instant};
 
+use subfit_measure::data_samples::{DataSamples, SampleKind};
+use subfit_measure::{data_samples, TwoSided};
 use subfit_mesh::{PolyMesh, Polygons, Tags};
-use subfit_report::data_samples::{DataSamples, SampleKind};
-use subfit_report::{data_samples, TwoSided};
 use subfit_subdiv::{sampling_operator, Scheme};
 use subfit_target::Target;
 
@@ -103,7 +103,7 @@ pub struct StageOptions {
     /// measured and reported either way.
     pub two_sided: bool,
     /// Data → surface samples of a mesh target, uniform by area (0 = as many as it has
-    /// points, at least [`subfit_report::data_samples::MIN_AREA_SAMPLES`]; a point cloud
+    /// points, at least [`subfit_measure::data_samples::MIN_AREA_SAMPLES`]; a point cloud
     /// always uses its points). Default 0.
     pub data_samples: usize,
     /// The error power of the last step, a polish of the best cage towards a lower maximum
@@ -575,7 +575,7 @@ pub(crate) struct Best {
 /// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
 /// After each stage's fit the cage is measured both ways (surface → data with fresh
-/// projections; data → surface from the target's data samples, [`subfit_report::data_samples()`],
+/// projections; data → surface from the target's data samples, [`subfit_measure::data_samples()`],
 /// to the tessellation of the limit samples); the tolerances are judged on both
 /// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
 /// direction, so data the surface leaves uncovered gets control points. The cage returned is
