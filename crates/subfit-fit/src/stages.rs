@@ -582,8 +582,10 @@ pub(crate) struct Best {
 /// optimized: no refinement or flip is made when no iteration or stage is left to fit it.
 ///
 /// Errors: those of [`Fitter::new`] and [`Fitter::run`]; invalid stage options. Cost: per topology one [`Fitter`] setup (sampling
-/// operator, symbolic analysis); per stage its iterations and one measurement (one projection
-/// of the samples, a BVH over their tessellation and one query per data sample); flips cost one more sampling operator and projection.
+/// operator, symbolic analysis); per stage its iterations and one measurement (the last
+/// iteration's projections reused, a BVH over the samples' tessellation and one query per data
+/// sample); flips cost one more sampling operator and a projection of the samples of the faces
+/// they change.
 pub fn fit_stages(
     target: &Target,
     mesh: &PolyMesh,
