@@ -13,6 +13,7 @@
 pub mod cage_stats;
 pub mod child;
 pub mod drift;
+pub mod inputs;
 pub mod judge;
 pub mod manifest;
 pub mod markdown;

@@ -7,9 +7,10 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use crate::inputs::scheme_named;
 use crate::judge::JudgeOptions;
 use crate::row::{Judged, Row};
-use crate::score::{judge_peer, scheme_named};
+use crate::score::judge_peer;
 
 /// One result of `peers.json`.
 #[derive(Clone, Debug, Deserialize)]

@@ -8,7 +8,8 @@ use subfit::mesh::{PolyMesh, Tags};
 use subfit::subdiv::Scheme;
 
 use crate::cage_stats::{cage_stats, topology, Topology};
-use crate::judge::{judge, Candidate, JudgeOptions, Reference};
+use crate::inputs::{disagreement, fans, read_cage, read_model, reference_of, scheme_named};
+use crate::judge::{judge, Candidate, JudgeOptions};
 use crate::manifest::{Entry, Job};
 use crate::row::{criteria, passes, Judged, ReadCheck, ReportFigures, Row};
 use crate::Settings;
@@ -26,60 +27,6 @@ pub fn score(entry: &Entry, settings: &Settings) -> Row {
     row
 }
 
-/// Reads a model file. Errors: the reader's message.
-pub fn read_model(path: &Path) -> Result<PolyMesh, String> {
-    subfit::io::read_file(path, &subfit::io::ReadOptions::default())
-        .map(|(m, _)| m)
-        .map_err(|e| e.to_string())
-}
-
-/// The judge's reference for a model: its triangles (polygons split into fans), or its points.
-pub fn reference_of(mesh: &PolyMesh) -> Reference {
-    if mesh.faces.is_empty() {
-        return Reference::Points {
-            positions: mesh.positions.clone(),
-        };
-    }
-    Reference::Mesh {
-        positions: mesh.positions.clone(),
-        triangles: fans(mesh),
-    }
-}
-
-/// Polygons split into triangle fans.
-pub fn fans(mesh: &PolyMesh) -> Vec<[u32; 3]> {
-    let mut t = Vec::with_capacity(mesh.faces.len() * 2);
-    for f in mesh.faces.iter() {
-        for i in 1..f.len().saturating_sub(1) {
-            t.push([f[0], f[i], f[i + 1]]);
-        }
-    }
-    t
-}
-
-/// A cage as written by `subfit fit` (control.obj with its OpenSubdiv `t` lines, or its
-/// tags file) with its scheme.
-pub fn read_cage(path: &Path, scheme: Scheme) -> Result<Candidate, String> {
-    let cage = read_model(path)?;
-    let tags = subfit::io::read_tags_file(path, cage.num_vertices()).map_err(|e| e.to_string())?;
-    Ok(Candidate::limit(cage, tags, scheme))
-}
-
-/// The scheme named in a report (`Loop`, `CatmullClark`, `QuadTriangle` or the CLI's names).
-pub fn scheme_named(name: &str) -> Option<Scheme> {
-    let n: String = name
-        .chars()
-        .filter(|c| c.is_ascii_alphanumeric())
-        .collect::<String>()
-        .to_ascii_lowercase();
-    match n.as_str() {
-        "loop" => Some(Scheme::Loop),
-        "catmullclark" | "catmark" => Some(Scheme::CatmullClark),
-        "quadtriangle" | "quadtri" => Some(Scheme::QuadTriangle),
-        _ => None,
-    }
-}
-
 fn report_json(dir: &Path) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(dir.join("report.json")).ok()?;
     serde_json::from_str(&text).ok()
@@ -93,12 +40,6 @@ fn report_figures(r: &serde_json::Value) -> Option<ReportFigures> {
         hausdorff_fraction: t["e_max_fraction_of_diagonal"].as_f64()?,
         tolerance_reached: r["tolerance_reached"].as_bool().unwrap_or(false),
     })
-}
-
-/// The larger relative difference of the report's figures from the judge's.
-pub fn disagreement(judge_rms: f64, judge_max: f64, r: &ReportFigures) -> f64 {
-    let rel = |j: f64, r: f64| (j - r).abs() / j.max(f64::MIN_POSITIVE);
-    rel(judge_rms, r.rms_fraction).max(rel(judge_max, r.hausdorff_fraction))
 }
 
 fn judge_options(settings: &Settings) -> JudgeOptions {

@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 
 use crate::cage_stats::cage_stats;
 use crate::drift::{locate, measure, same_connectivity};
+use crate::inputs::{disagreement, read_cage, read_model, reference_of, scheme_named};
 use crate::judge::{judge, Candidate};
 use crate::manifest::Entry;
 use crate::row::{FrameRow, ReportFigures, Row};
-use crate::score::{disagreement, read_cage, read_model, reference_of, scheme_named};
 use crate::Settings;
 
 /// Tracked points per sequence for the drift (evenly strided over frame 0's vertices).
