@@ -1,13 +1,14 @@
 //! The final measurement of a fitted cage (DESIGN.md decision 11): both ways, on the limit
 //! tessellation written with it (chordal error a tenth of the fitting error, reported), with
 //! the one measurer ([`subfit_measure`]): surface → data by the fitter's foot points, data →
-//! surface from the target's data samples and every one of its vertices to the tessellation. What a user measures on
+//! surface from the target's data samples to the tessellation, its maximum over every input
+//! vertex too. What a user measures on
 //! limit.ply. A quad/triangle cage also gets the distance to the surface USD declares for it.
 
 use subfit_fit::{DataTerm, FitOptions, FootPointTerm, StagesResult};
 use subfit_measure::{
-    data_samples_with_vertices, limit_tessellation, vertex_areas, DistanceStats, LimitTessellation,
-    MeshDistance, TwoSided,
+    data_samples, limit_tessellation, mesh_vertices, vertex_areas, DistanceStats,
+    LimitTessellation, MeshDistance, TwoSided,
 };
 use subfit_mesh::{PolyMesh, Tags};
 use subfit_subdiv::Scheme;
@@ -63,19 +64,27 @@ pub(crate) fn measure_final(
         .into_iter()
         .map(f64::sqrt)
         .collect();
-    let data = data_samples_with_vertices(target, samples);
-    let to_surface: Vec<f64> =
-        MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces)
-            .distances(&data.points)
-            .iter()
-            .map(|p| p.distance)
-            .collect();
+    let data = data_samples(target, samples);
+    let surface = MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces);
+    let to_surface: Vec<f64> = surface
+        .distances(&data.points)
+        .iter()
+        .map(|p| p.distance)
+        .collect();
+    // The RMS is the area samples'; the largest distance is also taken over the vertices.
+    let mut data_to_surface = DistanceStats::of(&to_surface);
+    let from_vertices = surface
+        .distances(mesh_vertices(target))
+        .iter()
+        .map(|p| p.distance)
+        .fold(0.0, f64::max);
+    data_to_surface.max = data_to_surface.max.max(from_vertices);
     let two_sided = TwoSided {
         surface_to_data: DistanceStats::of_weighted(
             &local,
             &vertex_areas(&tessellation.mesh.positions, &tessellation.mesh.faces),
         ),
-        data_to_surface: DistanceStats::of(&to_surface),
+        data_to_surface,
     };
     Ok(FinalMeasure {
         tessellation,
