@@ -5,6 +5,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+pub use crate::cli_output::OutputArgs;
+
 /// Fit compact subdivision surfaces to dense 3D scans.
 #[derive(Parser, Debug)]
 #[command(name = "subfit", version, about, long_about = None, propagate_version = true)]
@@ -450,6 +452,9 @@ pub struct FitArgs {
     /// log.csv, preview.png, report.html, report.json).
     #[arg(short, long, default_value = "subfit-fit")]
     pub output: PathBuf,
+    /// What is printed, and the limit tessellation's faces.
+    #[command(flatten)]
+    pub report: OutputArgs,
 }
 
 /// Sharp features of mesh targets, for `fit` and `init`.
