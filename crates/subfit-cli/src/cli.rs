@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-pub use crate::cli_output::OutputArgs;
+pub use crate::cli_output::{CompletionsArgs, OutputArgs};
 
 /// Fit compact subdivision surfaces to dense 3D scans.
 #[derive(Parser, Debug)]
@@ -45,6 +45,11 @@ pub enum Command {
     /// Benchmarks and studies that print figures.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Print a shell completion script (e.g. `subfit completions bash > ~/.local/share/bash-completion/completions/subfit`).
+    Completions(CompletionsArgs),
+    /// Print this command-line reference as Markdown (docs/cli.md is its output).
+    #[command(hide = true)]
+    HelpMarkdown,
 }
 
 /// `subfit init`.

@@ -1,5 +1,5 @@
 //! Flags on what `subfit fit` prints and how it writes the limit tessellation: `--quiet`,
-//! `--json` (a machine-readable closing summary) and `--limit-quads`.
+//! `--json` (a machine-readable closing summary) and `--limit-quads`; `subfit completions`.
 
 /// How `subfit fit` reports and writes.
 #[derive(clap::Args, Debug, Clone, Copy, Default)]
@@ -18,4 +18,12 @@ pub struct OutputArgs {
     /// readers (trimesh) refuse a PLY whose faces differ in size.
     #[arg(long)]
     pub limit_quads: bool,
+}
+
+/// `subfit completions`.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct CompletionsArgs {
+    /// The shell to complete in.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
 }
