@@ -21,6 +21,7 @@ macro_rules! out {
 mod cli;
 mod cli_output;
 mod commands;
+mod hints;
 mod interrupt;
 mod progress;
 

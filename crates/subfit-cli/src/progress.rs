@@ -97,7 +97,13 @@ pub fn read_with_progress(path: &Path) -> Result<Vec<u8>, subfit::io::Error> {
         return Err(Error::file(path, ErrorKind::IsDirectory));
     }
     let io = |e| Error::file(path, ErrorKind::Io(e));
-    let file = std::fs::File::open(path).map_err(io)?;
+    let file = std::fs::File::open(path).map_err(|e| match crate::hints::did_you_mean(path) {
+        Some(near) if e.kind() == std::io::ErrorKind::NotFound => io(std::io::Error::new(
+            e.kind(),
+            format!("no such file; did you mean {}?", near.display()),
+        )),
+        _ => io(e),
+    })?;
     let len = file.metadata().map_err(io)?.len();
     if len < BAR_THRESHOLD {
         return subfit::io::read_all(path);
