@@ -5,6 +5,8 @@ use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
+pub use crate::cli_output::{CompletionsArgs, OutputArgs};
+
 /// Fit compact subdivision surfaces to dense 3D scans.
 #[derive(Parser, Debug)]
 #[command(name = "subfit", version, about, long_about = None, propagate_version = true)]
@@ -43,6 +45,11 @@ pub enum Command {
     /// Benchmarks and studies that print figures.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Print a shell completion script (e.g. `subfit completions bash > ~/.local/share/bash-completion/completions/subfit`).
+    Completions(CompletionsArgs),
+    /// Print this command-line reference as Markdown (docs/cli.md is its output).
+    #[command(hide = true)]
+    HelpMarkdown,
 }
 
 /// `subfit init`.
@@ -455,6 +462,9 @@ pub struct FitArgs {
     /// log.csv, preview.png, report.html, report.json).
     #[arg(short, long, default_value = "subfit-fit")]
     pub output: PathBuf,
+    /// What is printed, and the limit tessellation's faces.
+    #[command(flatten)]
+    pub report: OutputArgs,
 }
 
 /// Sharp features of mesh targets, for `fit` and `init`.

@@ -19,7 +19,9 @@ macro_rules! out {
 }
 
 mod cli;
+mod cli_output;
 mod commands;
+mod hints;
 mod interrupt;
 mod progress;
 

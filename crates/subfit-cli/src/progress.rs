@@ -47,10 +47,28 @@ pub fn phase(name: &str) {
     }
 }
 
+/// Set by `--quiet`: spinners and bars are drawn nowhere.
+static HIDDEN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Hides every later spinner and bar (`--quiet`); phases are still announced ([`phase`]).
+pub fn set_hidden() {
+    HIDDEN.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Where spinners and bars are drawn: stderr (indicatif hides them when it is not a
+/// terminal), or nowhere after [`set_hidden`].
+fn target() -> ProgressDrawTarget {
+    if HIDDEN.load(std::sync::atomic::Ordering::Relaxed) {
+        ProgressDrawTarget::hidden()
+    } else {
+        ProgressDrawTarget::stderr()
+    }
+}
+
 /// A spinner with a message, on stderr.
 pub fn spinner(msg: &str) -> ProgressBar {
     phase(msg);
-    let pb = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    let pb = ProgressBar::with_draw_target(None, target());
     pb.set_style(
         ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("valid template"),
     );
@@ -62,7 +80,7 @@ pub fn spinner(msg: &str) -> ProgressBar {
 /// A bar counting `len` items, on stderr.
 pub fn bar(len: u64, msg: &str) -> ProgressBar {
     phase(msg);
-    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    let pb = ProgressBar::with_draw_target(Some(len), target());
     pb.set_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} [{elapsed}<{eta}]")
             .expect("valid template")
@@ -79,12 +97,18 @@ pub fn read_with_progress(path: &Path) -> Result<Vec<u8>, subfit::io::Error> {
         return Err(Error::file(path, ErrorKind::IsDirectory));
     }
     let io = |e| Error::file(path, ErrorKind::Io(e));
-    let file = std::fs::File::open(path).map_err(io)?;
+    let file = std::fs::File::open(path).map_err(|e| match crate::hints::did_you_mean(path) {
+        Some(near) if e.kind() == std::io::ErrorKind::NotFound => io(std::io::Error::new(
+            e.kind(),
+            format!("no such file; did you mean {}?", near.display()),
+        )),
+        _ => io(e),
+    })?;
     let len = file.metadata().map_err(io)?.len();
     if len < BAR_THRESHOLD {
         return subfit::io::read_all(path);
     }
-    let pb = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    let pb = ProgressBar::with_draw_target(Some(len), target());
     pb.set_style(
         ProgressStyle::with_template(
             "reading {msg} [{bar:40}] {bytes}/{total_bytes} ({bytes_per_sec})",

@@ -53,4 +53,23 @@ impl Error {
             message: message.to_string(),
         }
     }
+
+    /// The target named `name` cannot be analysed: [`Self::Interrupted`] when the run was
+    /// cancelled, else [`Self::Input`] with the reason and, for too few points, a hint at the
+    /// usual mistake (a scan needs thousands of points: a file of tens is a cage, a set of
+    /// landmarks or the wrong file).
+    pub(crate) fn target(name: &str, e: subfit_target::TargetError) -> Self {
+        use subfit_target::TargetError as T;
+        match e {
+            T::Interrupted => Self::Interrupted,
+            T::TooFewPoints { .. } | T::TooFewDistinctPoints { .. } => Self::input(
+                name,
+                format!(
+                    "{e}; hint: a scan to fit has thousands of points — is this a control \
+                     mesh or a set of landmarks? (a cage to start from goes to --init)"
+                ),
+            ),
+            e => Self::input(name, e),
+        }
+    }
 }

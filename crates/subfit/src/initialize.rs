@@ -27,6 +27,22 @@ pub struct Initialized {
 /// `options` (the QEM start under `--init auto`, the curvature lines or a given cage when
 /// asked), within `options.stages.max_control_points`. Errors: as [`crate::fit_scan`]'s
 /// before its fit.
+///
+/// ```
+/// use subfit::mesh::shapes::Shape;
+/// use subfit::{initialize, FitScanOptions, Input};
+///
+/// let mesh = Shape::PAPER_ELLIPSOID.sample(2_000, 0.0, 1);
+/// let options = FitScanOptions {
+///     control_points: Some(50),
+///     ..FitScanOptions::default()
+/// };
+/// let init = initialize(Input::Mesh { mesh, name: "ellipsoid".into() }, &options, None)?;
+/// assert!(init.cage.num_vertices() <= 50); // the start `subfit fit` would fit
+/// assert!(!init.prepared.is_open_mesh()); // a point cloud: no mesh faces
+/// assert_eq!(init.prepared.mesh_faces(), 0);
+/// # Ok::<(), subfit::Error>(())
+/// ```
 pub fn initialize(
     input: Input,
     options: &FitScanOptions,

@@ -32,6 +32,7 @@
 //! - [`report`]: error colours, plots, the preview image, report.html.
 
 pub mod choose;
+mod closing;
 mod error;
 mod fit_start;
 mod fitted;
@@ -58,13 +59,14 @@ pub mod starts;
 pub mod tolerance;
 
 pub use choose::Measurement;
+pub use closing::{ClosingSummary, ErrorFigure};
 pub use error::Error;
 pub use fitted::Fitted;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use initialize::{initialize, Initialized};
 pub use markers::{parse_markers, read_markers};
 pub use options::{method_named, FitScanOptions, InitialCage, Input, EXACT_ERROR};
-pub use outputs::{log_csv, usd_scheme, OUTPUTS};
+pub use outputs::{log_csv, usd_scheme, OutputOptions, OUTPUTS};
 pub use pipeline_report::Report;
 pub use prepare::Prepared;
 pub use progress::{Progress, Step};

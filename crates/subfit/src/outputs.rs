@@ -4,6 +4,11 @@
 //! [`subfit_io::tags_json`]) and as a UsdGeom Mesh with its scheme and tags, the limit tessellation with normals, the same coloured by the distance to
 //! the target (Cheng 2007 §IV-D colours), the per-iteration log, the page a person looks at
 //! (`report.html`, [`crate::html_report`]) and the report.
+//!
+//! The limit tessellation is written as triangles by default ([`OutputOptions`]): its quads,
+//! when the scheme makes them, are split along the diagonal the measurer splits them along
+//! (`Polygons::triangulate_fan`), so the file is the surface the final errors were measured on,
+//! and readers that expect one face size per file (trimesh's PLY reader) open it.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -33,7 +38,26 @@ pub const OUTPUTS: [&str; 9] = [
     "report.json",
 ];
 
+/// How [`Fitted::write_into_with`] writes the outputs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OutputOptions {
+    /// Keep the limit tessellation's quads in `limit.ply` and `error.ply` (a Catmull-Clark or
+    /// quad/triangle cage's refinement) instead of splitting each into two triangles. Off by
+    /// default: a file mixing quads and triangles is valid PLY, but several readers (trimesh)
+    /// refuse one whose faces differ in size.
+    pub limit_quads: bool,
+}
+
 impl Fitted {
+    /// Writes every file of [`OUTPUTS`] into `dir` with the default [`OutputOptions`]
+    /// (see [`Self::write_into_with`]).
+    ///
+    /// Errors: a file that cannot be written; [`Error::Interrupted`] when the run's token is
+    /// cancelled (checked before each file).
+    pub fn write_into(&mut self, dir: &Path) -> Result<(), Error> {
+        self.write_into_with(dir, &OutputOptions::default())
+    }
+
     /// Writes every file of [`OUTPUTS`] into `dir` (which must exist; each file atomically,
     /// the report last) and completes the report with the colour scale and the output time.
     /// A front end that wants all or none in place writes into a staging directory and
@@ -41,7 +65,7 @@ impl Fitted {
     ///
     /// Errors: a file that cannot be written; [`Error::Interrupted`] when the run's token is
     /// cancelled (checked before each file).
-    pub fn write_into(&mut self, dir: &Path) -> Result<(), Error> {
+    pub fn write_into_with(&mut self, dir: &Path, options: &OutputOptions) -> Result<(), Error> {
         let t = Instant::now();
         let check = || self.cancel.check().map_err(|_| Error::Interrupted);
         check()?;
@@ -69,12 +93,18 @@ impl Fitted {
             .report
             .error_color_scale_or(last.e_max)
             .max(f64::MIN_POSITIVE);
+        let faces = if options.limit_quads || limit.faces.is_triangles() {
+            limit.faces
+        } else {
+            Polygons::from_triangles(&limit.faces.triangulate_fan())
+        };
         let limit = PolyMesh {
             positions: limit
                 .positions
                 .iter()
                 .map(|&p| self.target.to_original(p))
                 .collect(),
+            faces,
             ..limit
         };
         let binary = WriteOptions {

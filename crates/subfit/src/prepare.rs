@@ -129,10 +129,8 @@ pub(crate) fn prepare(
         cancel: options.cancel.clone(),
         ..options.target.clone()
     };
-    let target = Target::build(&mesh, &target_options, None).map_err(|e| match e {
-        subfit_target::TargetError::Interrupted => Error::Interrupted,
-        e => Error::input(&name, e),
-    })?;
+    let target =
+        Target::build(&mesh, &target_options, None).map_err(|e| Error::target(&name, e))?;
     let preprocess_seconds = target.stats().timings.total.as_secs_f64();
     let outliers = target.stats().outliers_removed;
     if outliers > 0 {

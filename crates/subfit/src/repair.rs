@@ -29,6 +29,19 @@ use crate::pipeline_report::Reorientation;
 /// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
 /// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
 /// an error (a non-orientable component) the other repairs are kept and no face is turned.
+///
+/// ```
+/// use subfit::mesh::{PolyMesh, Polygons};
+///
+/// // A tetrahedron with one face written twice and a vertex no face uses.
+/// let positions = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [5.0; 3]];
+/// let faces = Polygons::from_triangles(&[[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2], [0, 3, 2]]);
+/// let mut mesh = PolyMesh::new(positions, faces);
+/// let mut warnings = Vec::new();
+/// subfit::repair_mesh(&mut mesh, "tetra.obj", &mut |w| warnings.push(w)).unwrap();
+/// assert_eq!((mesh.num_vertices(), mesh.num_faces()), (4, 4));
+/// assert_eq!(warnings.len(), 2, "{warnings:?}"); // one per repair
+/// ```
 pub fn repair_mesh(
     mesh: &mut PolyMesh,
     name: &str,

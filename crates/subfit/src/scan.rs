@@ -38,6 +38,34 @@ use crate::starts::{build_start, same_kind, starts, StartKind};
 /// A quad scheme whose default start exceeds the budget (`--max-control-points` below the
 /// target's default size) is fitted from each of [`crate::BUDGET_STARTS`] and the better cage
 /// kept; see [`crate::starts`] for every start.
+///
+/// ```
+/// use subfit::mesh::shapes::Shape;
+/// use subfit::{fit_scan, FitScanOptions, Input, OutputOptions};
+///
+/// // 2,000 points on the papers' ellipsoid (semi-axes 0.25, 0.5, 1), a small budget.
+/// let mesh = Shape::PAPER_ELLIPSOID.sample(2_000, 0.0, 1);
+/// let mut options = FitScanOptions {
+///     control_points: Some(40),
+///     ..FitScanOptions::default()
+/// };
+/// options.stages.max_iterations = 5;
+/// options.fit.sample_level = 2;
+/// let input = Input::Mesh { mesh, name: "ellipsoid".into() };
+/// let mut fitted = fit_scan(input, &options, None)?;
+/// let two = &fitted.report.r#final.two_sided; // errors both ways
+/// assert!(two.e_rms_fraction_of_diagonal < 0.01);
+/// assert!(fitted.cage.num_vertices() >= 4);
+///
+/// let dir = std::env::temp_dir().join(format!("subfit-doc-{}", std::process::id()));
+/// std::fs::create_dir_all(&dir)?;
+/// fitted.write_into_with(&dir, &OutputOptions::default())?; // limit.ply as triangles
+/// let summary = fitted.closing_summary(&dir); // what `subfit fit` prints last
+/// assert_eq!(summary.control_points, fitted.cage.num_vertices());
+/// assert!(summary.files.iter().all(|f| f.is_file()));
+/// # std::fs::remove_dir_all(&dir)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn fit_scan(
     input: Input,
     options: &FitScanOptions,
@@ -207,6 +235,18 @@ fn reached(r: bool) -> &'static str {
 }
 
 /// Reads `path` as a cage for [`InitialCage::Given`].
+///
+/// ```
+/// use subfit::mesh::shapes::octahedron_mesh;
+/// use subfit::{read_cage, InitialCage};
+///
+/// let path = std::env::temp_dir().join(format!("subfit-doc-cage-{}.obj", std::process::id()));
+/// subfit::io::write_file(&path, &octahedron_mesh(1.0, 1.0, 1.0), &Default::default())?;
+/// let InitialCage::Given { mesh, .. } = read_cage(&path)? else { unreachable!() };
+/// assert_eq!((mesh.num_vertices(), mesh.num_faces()), (6, 8));
+/// # std::fs::remove_file(&path)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn read_cage(path: &Path) -> Result<InitialCage, Error> {
     let (mesh, _) = subfit_io::read_file(path, &subfit_io::ReadOptions::default())?;
     if mesh.faces.is_empty() {

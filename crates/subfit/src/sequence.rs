@@ -645,10 +645,8 @@ fn fit_frame(
         cancel: options.cancel.clone(),
         ..TargetOptions::default()
     };
-    let target = Target::build(&mesh, &target_options, None).map_err(|e| match e {
-        subfit_target::TargetError::Interrupted => Error::Interrupted,
-        e => Error::input(&name, e),
-    })?;
+    let target =
+        Target::build(&mesh, &target_options, None).map_err(|e| Error::target(&name, e))?;
     let analyse = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let silhouette = silhouette_term(&target, &options.silhouette);

@@ -312,7 +312,7 @@ pub fn run(a: BenchFitArgs) -> anyhow::Result<ExitCode> {
             options.stages.max_iterations as u64,
         )
         .with_context(|| format!("fitting {}", m.name))?;
-        crate::commands::fit::write_outputs(&mut fitted, &dir)?;
+        crate::commands::fit::write_outputs(&mut fitted, &dir, &Default::default())?;
         let r = &fitted.report;
         let t = &r.timings_s;
         let two = &r.r#final.two_sided;

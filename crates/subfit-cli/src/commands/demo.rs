@@ -61,7 +61,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<ExitCode> {
             options.stages.max_iterations as u64,
         )
         .with_context(|| format!("fitting the {name}"))?;
-        crate::commands::fit::write_outputs(&mut fitted, &dir)?;
+        crate::commands::fit::write_outputs(&mut fitted, &dir, &Default::default())?;
         all_reached &= fitted.reached();
         reports.push(dir.join("report.html"));
         let r = &fitted.report;

@@ -9,33 +9,46 @@ use anyhow::Context;
 use subfit::fit::{FitOptions, Method, Optimizer, StageOptions, StepControl};
 use subfit::init::InitOptions;
 use subfit::subdiv::Scheme;
-use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, OUTPUTS};
+use subfit::{
+    fit_scan, FitScanOptions, Fitted, InitialCage, Input, OutputOptions, Progress, Step, OUTPUTS,
+};
 
 use crate::cli::{quad_dominant_flag, FitArgs, MethodArg, OptimizerArg, SchemeArg, StepArg};
 
 pub fn run(a: FitArgs) -> anyhow::Result<ExitCode> {
-    let fitted = execute(&a)?;
-    eprintln!("subfit: {}", init_line(&fitted.report.init));
-    if let Some(kind) = fitted.report.tolerance_kind {
-        eprintln!(
-            "subfit: {} (--tolerance / --max-error set others, in unit-cube units)",
-            kind.describe()
-        );
+    let quiet = a.report.quiet;
+    if quiet {
+        crate::progress::set_hidden();
     }
-    out!(
-        "{}; wrote {} (look at {})",
-        fitted.summary(),
-        a.output.display(),
-        a.output.join("report.html").display()
-    );
-    blender_hint(&fitted);
+    let fitted = execute(&a)?;
+    let closing = fitted.closing_summary(&a.output);
+    if a.report.json {
+        let json = serde_json::to_string_pretty(&closing)?;
+        out!("{json}");
+    } else if !quiet {
+        eprintln!("subfit: {}", init_line(&fitted.report.init));
+        if let Some(kind) = fitted.report.tolerance_kind {
+            eprintln!(
+                "subfit: {} (--tolerance / --max-error set others, in unit-cube units)",
+                kind.describe()
+            );
+        }
+        out!("{}", fitted.summary());
+        out!("{closing}");
+        out!("look at {}", a.output.join("report.html").display());
+    }
+    if !quiet {
+        blender_hint(&fitted);
+    }
     Ok(if fitted.reached() {
         ExitCode::SUCCESS
     } else {
-        eprintln!(
-            "subfit: the requested tolerance was not reached {}(outputs written)",
-            if a.one_sided { "" } else { "both ways " }
-        );
+        if !quiet {
+            eprintln!(
+                "subfit: the requested tolerance was not reached {}(outputs written)",
+                if a.one_sided { "" } else { "both ways " }
+            );
+        }
         ExitCode::from(1)
     })
 }
@@ -144,7 +157,10 @@ pub fn execute(a: &FitArgs) -> anyhow::Result<Fitted> {
         name: a.target.display().to_string(),
     };
     let mut fitted = run_with_progress(input, &options, a.max_iterations as u64)?;
-    write_outputs(&mut fitted, &a.output)?;
+    let output = OutputOptions {
+        limit_quads: a.report.limit_quads,
+    };
+    write_outputs(&mut fitted, &a.output, &output)?;
     Ok(fitted)
 }
 
@@ -271,11 +287,15 @@ pub fn blender_hint(fitted: &Fitted) {
 
 /// Writes the outputs into a staging directory inside `dir` and moves them into place
 /// together.
-pub fn write_outputs(fitted: &mut Fitted, dir: &std::path::Path) -> anyhow::Result<()> {
+pub fn write_outputs(
+    fitted: &mut Fitted,
+    dir: &std::path::Path,
+    options: &OutputOptions,
+) -> anyhow::Result<()> {
     let stage = crate::interrupt::Staging::new(dir)
         .with_context(|| format!("{}: cannot create directory", dir.display()))?;
     crate::progress::phase("writing the outputs");
-    fitted.write_into(&stage.path(""))?;
+    fitted.write_into_with(&stage.path(""), options)?;
     stage
         .commit(&OUTPUTS)
         .with_context(|| format!("{}: cannot move the outputs into place", dir.display()))?;
