@@ -153,9 +153,21 @@ pub struct BenchSequenceArgs {
     /// Silhouette views of the run with the term (the other run has none).
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub silhouette_views: u32,
-    /// Which motion: the moderate default, the large tangential one, or both.
+    /// Which motion: the tube's moderate default, its large tangential one, both, or the
+    /// dancing articulated figure (material moves with its limbs, as on a real body).
     #[arg(long, value_enum, default_value_t = MotionArg::Both)]
     pub motion: MotionArg,
+    /// Capture frames between two frames of the dance (1: a smooth capture; 5: the same dance
+    /// at a fifth of the frame rate, fast motion between frames).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub stride: u32,
+    /// Give each frame of the dance as this many fresh random surface points without normals
+    /// (like a capture) instead of a mesh; 0: meshes.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10_000_000))]
+    pub points: u32,
+    /// Only the run with the silhouette term, or only the one without (`0`); both by default.
+    #[arg(long)]
+    pub only_views: Option<u32>,
     /// Seed of the frames' tessellations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -202,6 +214,8 @@ pub enum MotionArg {
     Large,
     /// Both.
     Both,
+    /// The dancing articulated figure (subfit_mesh::deforming::DancingFigure).
+    Dance,
 }
 
 /// `subfit bench fit`.
