@@ -28,10 +28,12 @@
 //! vertices is O(#V) (a few milliseconds, `benches/deforming.rs`); a lookup is one BVH query
 //! (O(log #T)) after an O(#T log #T) build.
 
+mod corresponded;
 mod figure;
 mod marching;
 mod tessellate;
 
+pub use corresponded::{NotCorresponded, SameConnectivity};
 pub use figure::{DanceParams, DancingFigure};
 
 use std::f64::consts::TAU;

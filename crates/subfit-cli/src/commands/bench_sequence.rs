@@ -14,7 +14,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use subfit::mesh::deforming::{
     drift, DanceParams, DancingFigure, DeformingParams, DeformingSequence, Frame, MaterialLookup,
-    MaterialMotion,
+    MaterialMotion, SameConnectivity,
 };
 use subfit::{fit_sequence, FitScanOptions, Input, SequenceOptions, SilhouetteOptions};
 
@@ -37,6 +37,8 @@ struct Row {
 enum Generated {
     Tube(DeformingSequence),
     Dance(DancingFigure),
+    /// Frames read from files, their ground truth by shared connectivity.
+    Files(SameConnectivity, Vec<std::path::PathBuf>),
 }
 
 impl Generated {
@@ -44,6 +46,7 @@ impl Generated {
         match self {
             Self::Tube(s) => s.len(),
             Self::Dance(d) => d.len(),
+            Self::Files(s, _) => s.len(),
         }
     }
 
@@ -51,6 +54,7 @@ impl Generated {
         match self {
             Self::Tube(s) => s,
             Self::Dance(d) => d,
+            Self::Files(s, _) => s,
         }
     }
 
@@ -60,6 +64,18 @@ impl Generated {
             Self::Tube(s) => s.frame(i, vertices, seed),
             Self::Dance(d) if points > 0 => d.points(i, points, seed),
             Self::Dance(d) => d.frame(i, vertices, seed),
+            Self::Files(s, _) => s.first_frame(),
+        }
+    }
+
+    /// Frame `i` as the sequence's input.
+    fn input(&self, i: usize, vertices: usize, points: usize, seed: u64, name: &str) -> Input {
+        match self {
+            Self::Files(_, paths) => Input::File(paths[i].clone()),
+            _ => Input::Mesh {
+                mesh: self.frame(i, vertices, points, seed).mesh,
+                name: format!("{name} frame {i}"),
+            },
         }
     }
 }
@@ -83,26 +99,30 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
             DeformingSequence::new(params).context("sequence parameters")?,
         ))
     };
-    let motions: Vec<(&'static str, Generated)> = match a.motion {
-        MotionArg::Moderate => vec![("moderate", tube(DeformingParams::default())?)],
-        MotionArg::Large => vec![("large", tube(DeformingParams::large_tangential_motion())?)],
-        MotionArg::Both => vec![
-            ("moderate", tube(DeformingParams::default())?),
-            ("large", tube(DeformingParams::large_tangential_motion())?),
-        ],
-        MotionArg::Dance => vec![(
-            "dance",
-            Generated::Dance(
-                DancingFigure::new(DanceParams {
-                    frames: a.frames as usize,
-                    stride: a.stride as usize,
-                    ..DanceParams::default()
-                })
-                .context("dance parameters")?,
-            ),
-        )],
+    let motions: Vec<(&'static str, Generated)> = if !a.meshes.is_empty() {
+        vec![("files", read_meshes(&a.meshes)?)]
+    } else {
+        match a.motion {
+            MotionArg::Moderate => vec![("moderate", tube(DeformingParams::default())?)],
+            MotionArg::Large => vec![("large", tube(DeformingParams::large_tangential_motion())?)],
+            MotionArg::Both => vec![
+                ("moderate", tube(DeformingParams::default())?),
+                ("large", tube(DeformingParams::large_tangential_motion())?),
+            ],
+            MotionArg::Dance => vec![(
+                "dance",
+                Generated::Dance(
+                    DancingFigure::new(DanceParams {
+                        frames: a.frames as usize,
+                        stride: a.stride as usize,
+                        ..DanceParams::default()
+                    })
+                    .context("dance parameters")?,
+                ),
+            )],
+        }
     };
-    if a.points > 0 && a.motion != MotionArg::Dance {
+    if a.points > 0 && (a.motion != MotionArg::Dance || !a.meshes.is_empty()) {
         anyhow::bail!("--points: point frames are generated for --motion dance only");
     }
     let frames_as = if a.points > 0 {
@@ -114,7 +134,8 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
         "subfit bench sequence: {} frames of {frames_as}, stride {}, {} control points, {} markers",
         a.frames,
         a.stride,
-        a.control_points,
+        a.control_points
+            .map_or("default".to_string(), |n| n.to_string()),
         a.markers
     );
     let views: Vec<usize> = match a.only_views {
@@ -160,6 +181,25 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The frames of `paths`, which must share one connectivity (checked).
+fn read_meshes(paths: &[std::path::PathBuf]) -> anyhow::Result<Generated> {
+    let meshes = paths
+        .iter()
+        .map(|p| {
+            subfit::io::read_file(p, &subfit::io::ReadOptions::default())
+                .map(|(m, _)| m)
+                .with_context(|| format!("{}", p.display()))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let truth = SameConnectivity::new(&meshes).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: the frames cannot give the drift: {e}",
+            paths[e.frame].display()
+        )
+    })?;
+    Ok(Generated::Files(truth, paths.to_vec()))
+}
+
 /// `count` markers spread over `frame0`, at their true places in every frame of `seq`.
 fn markers(seq: &Generated, frame0: &Frame, count: usize) -> Vec<subfit::MarkerObservation> {
     let mut out = Vec::new();
@@ -192,12 +232,17 @@ fn run_one(
     } else {
         MaterialLookup::new(&frame0)
     };
-    let n = a.control_points as usize;
+    let n = match seq {
+        Generated::Files(..) => a.control_points.map(|n| n as usize),
+        _ => Some(a.control_points.unwrap_or(1000) as usize),
+    };
     let mut template_fit = FitScanOptions {
-        control_points: Some(n),
+        control_points: n,
         ..FitScanOptions::default()
     };
-    template_fit.stages.max_control_points = n;
+    if let Some(n) = n {
+        template_fit.stages.max_control_points = n;
+    }
     let d = SequenceOptions::default();
     let options = SequenceOptions {
         template_fit,
@@ -220,20 +265,19 @@ fn run_one(
         ..d
     };
     let frames = (0..seq.len()).map(|i| {
-        let mesh = if i == 0 {
-            frame0.mesh.clone()
+        if i == 0 && !matches!(seq, Generated::Files(..)) {
+            Input::Mesh {
+                mesh: frame0.mesh.clone(),
+                name: format!("{motion} frame 0"),
+            }
         } else {
-            seq.frame(
+            seq.input(
                 i,
                 a.vertices as usize,
                 points,
                 a.seed.wrapping_add(i as u64),
+                motion,
             )
-            .mesh
-        };
-        Input::Mesh {
-            mesh,
-            name: format!("{motion} frame {i}"),
         }
     });
     let bar = crate::progress::bar(seq.len() as u64, &format!("{motion}, {views} views"));
