@@ -11,7 +11,8 @@ use super::{v, DeformationGraph, Marker, NodeMotion, Skin, TrackOptions};
 /// Unknowns per node: `A` row-major (9), then `t` (3).
 pub(super) const PER: usize = 12;
 
-/// A dense symmetric normal system `H x = b` over `12 m` unknowns.
+/// A dense symmetric normal system `H x = b` over `12 m` unknowns; only the upper triangle
+/// of `H` (row ≤ column) is accumulated.
 pub(super) struct Normal {
     n: usize,
     h: Vec<f64>,
@@ -34,7 +35,7 @@ impl Normal {
         let nn = self.n;
         let trace: f64 = (0..nn).map(|i| self.h[i * nn + i]).sum::<f64>() / nn as f64;
         let h = Mat::<f64>::from_fn(nn, nn, |a, c| {
-            self.h[a * nn + c] + if a == c { 1e-6 * trace.max(1e-30) } else { 0.0 }
+            self.h[a.min(c) * nn + a.max(c)] + if a == c { 1e-6 * trace.max(1e-30) } else { 0.0 }
         });
         let rhs = Mat::<f64>::from_fn(nn, 1, |a, _| self.b[a]);
         let Ok(llt) = h.llt(Side::Lower) else {
@@ -57,15 +58,25 @@ impl Normal {
         true
     }
 
-    /// Adds `w (jᵀj, −jᵀr)` for one residual row `r` with sparse gradient `j`.
+    /// Adds `w (jᵀj, −jᵀr)` for one residual row `r` with sparse gradient `j` (the upper
+    /// triangle of `jᵀj`).
     pub(super) fn row(&mut self, j: &[(usize, f64)], r: f64, w: f64) {
         for &(a, va) in j {
             self.b[a] -= w * va * r;
             let base = a * self.n;
+            let wa = w * va;
             for &(c, vc) in j {
-                self.h[base + c] += w * va * vc;
+                if c >= a {
+                    self.h[base + c] += wa * vc;
+                }
             }
         }
+    }
+
+    /// Adds `other` (a system over as many unknowns) into this one.
+    fn absorb(&mut self, other: &Self) {
+        self.h.iter_mut().zip(&other.h).for_each(|(x, y)| *x += y);
+        self.b.iter_mut().zip(&other.b).for_each(|(x, y)| *x += y);
     }
 }
 
@@ -92,20 +103,33 @@ impl FitRows<'_> {
         if matches.is_empty() || weight == 0.0 {
             return;
         }
+        use rayon::prelude::*;
         let wf = weight / matches.len() as f64;
-        let mut j: Vec<(usize, f64)> = Vec::with_capacity(PER * self.skin.per);
-        for &(i, y, n) in matches {
-            let r = sub(self.moved[i], y);
-            self.skin.jacobian(&mut j, i, self.samples[i], self.g, n);
-            sys.row(&j, dot3(n, r), wf);
-            if beta > 0.0 {
-                for a in 0..3 {
-                    let mut e = [0.0; 3];
-                    e[a] = 1.0;
-                    self.skin.jacobian(&mut j, i, self.samples[i], self.g, e);
-                    sys.row(&j, r[a], wf * beta);
+        // One partial system per thread (each 8·(12m)² bytes), summed.
+        let chunk = matches.len().div_ceil(rayon::current_num_threads().max(1));
+        let parts: Vec<Normal> = matches
+            .par_chunks(chunk.max(1))
+            .map(|part| {
+                let mut local = Normal::new(sys.n);
+                let mut j: Vec<(usize, f64)> = Vec::with_capacity(PER * self.skin.per);
+                for &(i, y, n) in part {
+                    let r = sub(self.moved[i], y);
+                    self.skin.jacobian(&mut j, i, self.samples[i], self.g, n);
+                    local.row(&j, dot3(n, r), wf);
+                    if beta > 0.0 {
+                        for a in 0..3 {
+                            let mut e = [0.0; 3];
+                            e[a] = 1.0;
+                            self.skin.jacobian(&mut j, i, self.samples[i], self.g, e);
+                            local.row(&j, r[a], wf * beta);
+                        }
+                    }
                 }
-            }
+                local
+            })
+            .collect();
+        for p in &parts {
+            sys.absorb(p);
         }
     }
 }
