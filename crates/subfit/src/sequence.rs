@@ -14,27 +14,29 @@
 //!
 //! **Tracking.** Before each frame's fit, the template is carried onto the frame by an
 //! embedded deformation ([`subfit_fit::track`], [`TrackingOptions`]: 60 nodes inside the body,
-//! halfway to its medial points; 20 Gauss-Newton steps, started from the two previous frames'
-//! motions extrapolated). Closest points only move the cage along the surface's normal; the
-//! step follows the part of the motion along the surface that the frame's shape reveals (a
-//! spin of an elliptic section, a bend seen from its inner and outer sides), and the field's
-//! smoothness decides the rest. Mapping from the template rather than from the previous frame
-//! keeps one frame's error from being carried into the next. A step stops as soon as the
-//! frame's residual is within [`TrackingOptions::discrepancy`] of what the previous cage left
-//! on its own frame (Morozov's discrepancy principle): a body that holds still is then not
-//! tracked into a slide (largest drift over 30 still frames 0.025 %, as without tracking).
-//! The fit's ARAP term then keeps the template's local shape *as the tracking carried it*: the
-//! template itself would pull the cage back from the frame's true strains (a bend of this
-//! body stretches one side by a quarter), and so along the surface.
+//! halfway to its medial points, laid out over the surface — neighbours and skinning by
+//! distance over it; at most 20 Gauss-Newton steps annealed from stiff to supple, pulling the
+//! model's samples to the frame and the frame's points to the model, started from the two
+//! previous frames' motions extrapolated). Closest points only move the cage along the
+//! surface's normal; the step follows large motion between frames (a limb that moved farther
+//! than its width) and the part of the motion along the surface that the frame's shape
+//! reveals (limbs, joints, a head turning), and the field's smoothness decides the rest.
+//! Mapping from the template rather than from the previous frame (re-anchoring every frame to
+//! the first) keeps one frame's error from being carried into the next. A step stops as soon
+//! as the frame's residual is within [`TrackingOptions::discrepancy`] of what the previous cage
+//! left on its own frame (Morozov's discrepancy principle): a body that holds still is then not
+//! tracked into a slide. The fit's ARAP term then keeps the template's local shape *as the
+//! tracking carried it*: the template itself would pull the cage back from the frame's true
+//! strains, and so along the surface.
 //!
-//! Measured with `subfit bench sequence` (30 frames of ~25k vertices, 1,000 control points;
-//! largest drift over the frames, fraction of the diagonal, without / with the 8-view
-//! silhouette): default motion **2.40 % / 2.40 %** (RMS 1.18 %), large tangential motion
-//! **3.70 % / 3.70 %** (RMS 1.83 %); 0.8–1.1 s per frame. Before (surface nodes, frame to
-//! frame, ARAP towards the template itself): 6.8 % and 14.4 %; without tracking 16.6 % and
-//! 39.8 %. The goal (1 %) is not met: the largest drifts are on the rounded ends, where the
-//! generated bend goes on to the tip and nothing on the surface tells a bent end from a turned
-//! one (see [`subfit_fit::track`]).
+//! Measured with `subfit bench sequence --motion dance --stride 5 --points 40000` (an
+//! articulated figure dancing, seen at a fifth of a smooth capture's frame rate, 30 frames of
+//! 40k fresh random points without normals, 1,000 control points; fractions of the diagonal,
+//! worst frame): two-sided RMS 0.036 %, tracked points' drift RMS 0.78 % and 95th percentile
+//! 1.67 %, with the silhouette term or without; 1.84 CPU seconds per frame without it. A body
+//! whose bulges travel over its material (`--motion moderate|large`, the generated tube) leaves
+//! the slide along its surface free: its drift stays a few per cent, the priors' choice (see
+//! [`subfit_fit::track`]); markers pin it ([`TrackingOptions::markers`]).
 //!
 //! All frames share one normalization, the first frame's (the unit cube of frame 0), so that
 //! the cage moves in one set of units; every figure is reported in the frame's own units and
@@ -75,8 +77,10 @@ pub struct SilhouetteOptions {
     /// Image resolution (pixels per side). Default 128.
     pub resolution: usize,
     /// Refinement level of the limit tessellation that is rendered (its triangles are what the
-    /// rasterizer pays for, per view). Default 1: on 1,000 control points about 8,000 triangles,
-    /// a few pixels each at 128².
+    /// rasterizer pays for, per view). Default 0, the control vertices' limit points: on 1,000
+    /// control points about 2,000 triangles of a few pixels each at 128², whose chords stray
+    /// from the limit surface by less than a pixel even on the thin limbs of the dancing
+    /// figure (level 1 rendered four times the triangles, a fifth of a frame's time).
     pub level: usize,
     /// Weight of the loss (mean squared pixel difference) in the objective, against the data
     /// term's mean squared distance (normalized units²). Default [`DEFAULT_SILHOUETTE_WEIGHT`].
@@ -91,7 +95,7 @@ impl Default for SilhouetteOptions {
         Self {
             views: 8,
             resolution: 128,
-            level: 1,
+            level: 0,
             weight: DEFAULT_SILHOUETTE_WEIGHT,
         }
     }

@@ -51,7 +51,7 @@ fn cpu_seconds() -> Option<f64> {
 /// A generated sequence: the tube or the dancing figure.
 enum Generated {
     Tube(DeformingSequence),
-    Dance(DancingFigure),
+    Dance(Box<DancingFigure>),
     /// Frames read from files, their ground truth by shared connectivity.
     Files(SameConnectivity, Vec<std::path::PathBuf>),
 }
@@ -68,7 +68,7 @@ impl Generated {
     fn motion(&self) -> &dyn MaterialMotion {
         match self {
             Self::Tube(s) => s,
-            Self::Dance(d) => d,
+            Self::Dance(d) => d.as_ref(),
             Self::Files(s, _) => s,
         }
     }
@@ -126,28 +126,30 @@ pub fn run(a: BenchSequenceArgs) -> anyhow::Result<ExitCode> {
             ],
             MotionArg::Dance => vec![(
                 "dance",
-                Generated::Dance(
+                Generated::Dance(Box::new(
                     DancingFigure::new(DanceParams {
                         frames: a.frames as usize,
                         stride: a.stride as usize,
                         ..DanceParams::default()
                     })
                     .context("dance parameters")?,
-                ),
+                )),
             )],
         }
     };
     if a.points > 0 && (a.motion != MotionArg::Dance || !a.meshes.is_empty()) {
         anyhow::bail!("--points: point frames are generated for --motion dance only");
     }
-    let frames_as = if a.points > 0 {
+    let frames_as = if !a.meshes.is_empty() {
+        "files".to_string()
+    } else if a.points > 0 {
         format!("{} points without normals", a.points)
     } else {
         format!("~{} vertices", a.vertices)
     };
     out!(
         "subfit bench sequence: {} frames of {frames_as}, stride {}, {} control points, {} markers",
-        a.frames,
+        motions.first().map_or(0, |m| m.1.len()),
         a.stride,
         a.control_points
             .map_or("default".to_string(), |n| n.to_string()),

@@ -78,7 +78,7 @@ pub(super) struct Level {
     pub stiffness: f64,
     /// Correspondence radius (normalized units).
     pub reach: f64,
-    /// Whether this is the last level (the discrepancy rule applies only there).
+    /// Whether this is the last level (where a stalled step ends the iterations).
     pub last: bool,
 }
 

@@ -261,13 +261,16 @@ impl Default for DanceParams {
     }
 }
 
+/// Vertices and triangles.
+type TriangleMesh = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// A dancing articulated figure (see the module docs).
 #[derive(Debug)]
 pub struct DancingFigure {
     params: DanceParams,
     bones: [Bone; BONES],
     /// A fine rest mesh, built on first use, that point frames sample.
-    fine: OnceLock<(Vec<[f64; 3]>, Vec<[u32; 3]>)>,
+    fine: OnceLock<TriangleMesh>,
 }
 
 /// The coarsest grid cell (length units): below the thinnest part's radius (the hands',
@@ -399,7 +402,7 @@ impl DancingFigure {
     /// The rest surface meshed with about `approx_vertices` vertices (±15 %, two passes of
     /// marching tetrahedra at most; at least about 13k, [`MAX_CELL`]), the grid's offset drawn
     /// from `rng`.
-    fn rest_mesh(&self, approx_vertices: f64, rng: &mut StdRng) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    fn rest_mesh(&self, approx_vertices: f64, rng: &mut StdRng) -> TriangleMesh {
         let (lo, hi) = self.bounds();
         let f = |p: [f64; 3]| body(&self.bones, p);
         let offset: [f64; 3] = std::array::from_fn(|_| rng.random_range(0.0..1.0));
