@@ -16,13 +16,34 @@ const BAR_THRESHOLD: u64 = 8 << 20;
 /// run is (e.g. to interrupt it in a given phase).
 pub const PHASE_LOG_ENV: &str = "SUBFIT_PHASE_LOG";
 
-/// Announces the start of a phase (see [`PHASE_LOG_ENV`]); spinners and bars call it.
+/// Environment variable for tests of the interruption: `SUBFIT_INTERRUPT_AT=PHASE[:SIGNAL]`
+/// makes the run send itself `SIGNAL` (`INT`, the default, `TERM` or `HUP`) when the phase
+/// named `PHASE` starts (the names [`PHASE_LOG_ENV`] prints), and go on once the signal handler
+/// has cancelled the run ([`crate::interrupt::raise`]): the whole signal path, from the
+/// handler to the exit code and the clean-up, at a known step and with no timing.
+pub const INTERRUPT_AT_ENV: &str = "SUBFIT_INTERRUPT_AT";
+
+/// Announces the start of a phase (see [`PHASE_LOG_ENV`], [`INTERRUPT_AT_ENV`]); spinners and
+/// bars call it.
 pub fn phase(name: &str) {
     static ON: OnceLock<bool> = OnceLock::new();
+    static AT: OnceLock<Option<(String, String)>> = OnceLock::new();
     let on = *ON
         .get_or_init(|| std::env::var_os(PHASE_LOG_ENV).is_some_and(|v| !v.is_empty() && v != "0"));
     if on {
         eprintln!("subfit: phase: {name}");
+    }
+    let at = AT.get_or_init(|| {
+        let v = std::env::var(INTERRUPT_AT_ENV)
+            .ok()
+            .filter(|v| !v.is_empty())?;
+        let (phase, signal) = v.rsplit_once(':').unwrap_or((&v, "INT"));
+        Some((phase.to_string(), signal.to_string()))
+    });
+    if let Some((phase, signal)) = at {
+        if phase == name {
+            crate::interrupt::raise(signal);
+        }
     }
 }
 

@@ -23,8 +23,8 @@ use subfit_mesh::{
 };
 
 use crate::error::Error;
+use crate::options::Input;
 use crate::pipeline_report::Reorientation;
-use crate::scan::Input;
 
 /// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
 /// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
