@@ -32,7 +32,7 @@ from worker import PEERS, clear
 HERE = pathlib.Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 ENTRY_NAME = re.compile(r"^[A-Za-z0-9_.-]+(/[A-Za-z0-9_.-]+)*$")
-ROW_KEYS = ("entry", "input", "category", "kind", "control_points")
+ROW_KEYS = ("entry", "input", "category", "kind")
 DIED = "the worker died"
 """How the error of a peer whose process crashed or timed out starts: such a peer is redone by
 the next run, where a peer's own failure (e.g. a remesh subfit refuses) is kept."""
@@ -241,7 +241,8 @@ def read_ours(path, only):
         missing = [k for k in ROW_KEYS if k not in row]
         if missing:
             fail(f"{where}: missing {', '.join(missing)}")
-        entry, cp = row["entry"], row["control_points"]
+        # `subfit bench corpus` leaves the cage's fields out of a row without a cage.
+        entry, cp = row["entry"], row.get("control_points")
         if not isinstance(entry, str) or not ENTRY_NAME.match(entry) or ".." in entry.split("/"):
             fail(f"{where}: entry {entry!r} is not a usable folder name")
         if entry in seen:
@@ -252,7 +253,7 @@ def read_ours(path, only):
         if only and entry not in only:
             continue
         if cp is None:
-            print(f"{entry:36} skipped: our fit failed (control_points null)", flush=True)
+            print(f"{entry:36} skipped: no cage of ours (control_points absent or null)", flush=True)
             continue
         rows.append(row)
     unknown = set(only or ()) - seen

@@ -182,6 +182,11 @@ pub struct BenchCorpusArgs {
     /// same way and set beside ours.
     #[arg(long)]
     pub peers: Option<PathBuf>,
+    /// Take the rows of an earlier scoreboard (its JSON) instead of fitting again: to add
+    /// `--peers` or compare with another baseline without re-running the fits. The entry
+    /// filters apply to its rows.
+    #[arg(long, value_name = "FILE.json")]
+    pub rows: Option<PathBuf>,
     /// Seconds one run may take before it is stopped (a row `timeout`).
     #[arg(long, default_value_t = 900)]
     pub timeout: u64,

@@ -74,6 +74,35 @@ pub fn data_samples(target: &Target, count: usize) -> DataSamples {
     }
 }
 
+/// [`data_samples`] and, for a mesh, every vertex of it too (before the boundary vertices,
+/// which stay last): the final measurement, what a user measures from the input's own points.
+/// A spike, a thin tip or a lone vertex is where the largest data → surface distance is, and
+/// area samples land on it with probability zero. A point cloud's samples are its points
+/// already. Cost: [`data_samples`] plus O(#vertices).
+pub fn data_samples_with_vertices(target: &Target, count: usize) -> DataSamples {
+    let mut s = data_samples(target, count);
+    let Some(bvh) = target.mesh() else {
+        return s;
+    };
+    if s.kind != SampleKind::MeshArea {
+        return s;
+    }
+    let rim = s.points.split_off(s.points.len() - s.boundary);
+    let mut on_rim = vec![false; bvh.vertices().len()];
+    for v in boundary_vertices(bvh.triangles()) {
+        on_rim[v as usize] = true;
+    }
+    s.points.extend(
+        bvh.vertices()
+            .iter()
+            .zip(&on_rim)
+            .filter(|(_, &r)| !r)
+            .map(|(p, _)| *p),
+    );
+    s.points.extend(rim);
+    s
+}
+
 /// `n` points uniformly by area on the triangles `tris` over `p` (seeded SplitMix64; inverse
 /// CDF over the cumulative areas, then uniform barycentric coordinates). Empty when the total
 /// area is zero or not finite. Cost O(T + n log T).
@@ -139,6 +168,13 @@ mod tests {
             assert!(bvh.closest(*p).unwrap().distance < 1e-12);
         }
         assert_eq!(s, data_samples(&target, 5_000), "deterministic");
+        let all = data_samples_with_vertices(&target, 5_000);
+        let n = target.mesh().unwrap().vertices().len();
+        assert_eq!(all.points.len(), s.points.len() + n - s.boundary);
+        assert_eq!(all.boundary, s.boundary);
+        assert_eq!(&all.points[..5_000], &s.points[..5_000]);
+        let rim = |d: &DataSamples| d.points[d.points.len() - d.boundary..].to_vec();
+        assert_eq!(rim(&all), rim(&s), "the boundary vertices stay last");
         let cloud = subfit_mesh::PolyMesh::point_cloud(mesh.positions.clone(), None);
         let t = Target::from_mesh(&cloud, &TargetOptions::default()).unwrap();
         let s = data_samples(&t, 5_000);

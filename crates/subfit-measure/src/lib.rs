@@ -24,7 +24,7 @@ pub mod limit_distance;
 pub mod mesh_distance;
 pub mod tessellate;
 
-pub use data_samples::{data_samples, DataSamples, SampleKind};
+pub use data_samples::{data_samples, data_samples_with_vertices, DataSamples, SampleKind};
 pub use distance::{vertex_areas, DistanceStats, TwoSided};
 pub use limit_distance::{LimitDistance, LimitDistanceError, PointToLimit};
 pub use mesh_distance::MeshDistance;

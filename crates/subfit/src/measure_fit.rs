@@ -1,13 +1,13 @@
 //! The final measurement of a fitted cage (DESIGN.md decision 11): both ways, on the limit
 //! tessellation written with it (chordal error a tenth of the fitting error, reported), with
 //! the one measurer ([`subfit_measure`]): surface → data by the fitter's foot points, data →
-//! surface from the target's data samples to the tessellation. What a user measures on
+//! surface from the target's data samples and every one of its vertices to the tessellation. What a user measures on
 //! limit.ply. A quad/triangle cage also gets the distance to the surface USD declares for it.
 
 use subfit_fit::{DataTerm, FitOptions, FootPointTerm, StagesResult};
 use subfit_measure::{
-    data_samples, limit_tessellation, vertex_areas, DistanceStats, LimitTessellation, MeshDistance,
-    TwoSided,
+    data_samples_with_vertices, limit_tessellation, vertex_areas, DistanceStats, LimitTessellation,
+    MeshDistance, TwoSided,
 };
 use subfit_mesh::{PolyMesh, Tags};
 use subfit_subdiv::Scheme;
@@ -63,7 +63,7 @@ pub(crate) fn measure_final(
         .into_iter()
         .map(f64::sqrt)
         .collect();
-    let data = data_samples(target, samples);
+    let data = data_samples_with_vertices(target, samples);
     let to_surface: Vec<f64> =
         MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces)
             .distances(&data.points)

@@ -68,9 +68,15 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
         settings.work.display()
     );
     let t0 = Instant::now();
-    let mut rows = subfit_bench::score_all(&entries, &settings, &|row, n, total| {
-        eprintln!("[{n}/{total}] {}", line(row));
-    });
+    let (mut rows, earlier_seconds) = match &a.rows {
+        Some(p) => earlier_rows(p, &entries)?,
+        None => {
+            let rows = subfit_bench::score_all(&entries, &settings, &|row, n, total| {
+                eprintln!("[{n}/{total}] {}", line(row));
+            });
+            (rows, None)
+        }
+    };
     if let Some(p) = &a.peers {
         let peers = subfit_bench::peers::read_peers(p).map_err(anyhow::Error::msg)?;
         subfit_bench::peers::add_peers(&mut rows, &peers, p, &settings.judge);
@@ -81,7 +87,7 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
         jobs,
         threads_per_run: threads,
         cores,
-        seconds: t0.elapsed().as_secs_f64(),
+        seconds: earlier_seconds.unwrap_or_else(|| t0.elapsed().as_secs_f64()),
         judge_surface_samples: a.surface_samples,
         rows,
         ..Scoreboard::default()
@@ -118,6 +124,30 @@ fn runs_dir(out: &Path) -> PathBuf {
         .file_stem()
         .map_or("corpus".into(), |s| s.to_string_lossy().to_string());
     out.with_file_name(format!("{stem}-runs"))
+}
+
+/// The rows of an earlier scoreboard for `entries`, in their order, without its peers (those
+/// are judged again from `--peers`), and the seconds that scoreboard took. Errors: an
+/// unreadable file, or an entry it does not hold.
+fn earlier_rows(
+    path: &Path,
+    entries: &[subfit_bench::Entry],
+) -> anyhow::Result<(Vec<Row>, Option<f64>)> {
+    let earlier = Scoreboard::read(path).map_err(anyhow::Error::msg)?;
+    let rows = entries
+        .iter()
+        .map(|e| {
+            let mut row = earlier
+                .rows
+                .iter()
+                .find(|r| r.entry == e.name)
+                .cloned()
+                .with_context(|| format!("{}: no row for entry `{}`", path.display(), e.name))?;
+            row.peers.clear();
+            Ok(row)
+        })
+        .collect::<anyhow::Result<Vec<Row>>>()?;
+    Ok((rows, Some(earlier.seconds)))
 }
 
 fn baseline(a: &BenchCorpusArgs) -> anyhow::Result<Option<Scoreboard>> {
