@@ -32,8 +32,10 @@
 //! Measured with `subfit bench sequence --motion dance --stride 5 --points 40000` (an
 //! articulated figure dancing, seen at a fifth of a smooth capture's frame rate, 30 frames of
 //! 40k fresh random points without normals, 1,000 control points; fractions of the diagonal,
-//! worst frame): two-sided RMS 0.036 %, tracked points' drift RMS 0.78 % and 95th percentile
-//! 1.67 %, with the silhouette term or without; 1.84 CPU seconds per frame without it. A body
+//! worst frame): two-sided RMS 0.038 %, tracked points' drift RMS 0.73 % and 95th percentile
+//! 1.56 % (largest 3.1 %), with the silhouette term or without; 1.98 CPU seconds per frame with
+//! the 8-view silhouette, 1.44 without (all threads; the wall clock on a machine loaded twenty
+//! times over its two cores was 6.3 and 4.7 s). A body
 //! whose bulges travel over its material (`--motion moderate|large`, the generated tube) leaves
 //! the slide along its surface free: its drift stays a few per cent, the priors' choice (see
 //! [`subfit_fit::track`]); markers pin it ([`TrackingOptions::markers`]).

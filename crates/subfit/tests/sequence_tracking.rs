@@ -11,8 +11,6 @@ use subfit::{
     TrackingOptions,
 };
 
-/// Frames fitted.
-
 /// The drift of a generated sequence's tracked limit points, frame by frame (fractions of
 /// the diagonal), fitted with 200 control points, with or without tracking, with `markers`
 /// markers at their true places in every frame.
