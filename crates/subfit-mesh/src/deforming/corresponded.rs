@@ -8,7 +8,7 @@
 use crate::bvh::TriangleBvh;
 use crate::polygons::PolyMesh;
 
-use super::{Frame, MaterialMotion};
+use super::motion::{Frame, MaterialMotion};
 
 /// Frames of one connectivity (see the module docs).
 #[derive(Clone, Debug)]

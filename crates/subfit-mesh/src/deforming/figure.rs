@@ -37,7 +37,7 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 use super::marching::marching_tetrahedra;
-use super::{splitmix, Frame, InvalidParams, MaterialMotion};
+use super::motion::{splitmix, Frame, InvalidParams, MaterialMotion};
 use crate::polygons::{PolyMesh, Polygons};
 use crate::vec3::{cross, dot, norm, sub};
 
