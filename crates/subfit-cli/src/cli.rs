@@ -215,15 +215,34 @@ pub struct BenchSequenceArgs {
     /// Vertices per frame (each frame's resolution varies ±30% around it).
     #[arg(long, default_value_t = 25_000, value_parser = clap::value_parser!(u32).range(500..=5_000_000))]
     pub vertices: u32,
-    /// Control points of the template.
-    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(20..=100_000))]
-    pub control_points: u32,
+    /// Control points of the template [default: 1000; with --meshes, `subfit sequence`'s].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(20..=100_000))]
+    pub control_points: Option<u32>,
     /// Silhouette views of the run with the term (the other run has none).
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub silhouette_views: u32,
-    /// Which motion: the moderate default, the large tangential one, or both.
+    /// Which motion: the tube's moderate default, its large tangential one, both, or the
+    /// dancing articulated figure (material moves with its limbs, as on a real body).
     #[arg(long, value_enum, default_value_t = MotionArg::Both)]
     pub motion: MotionArg,
+    /// Capture frames between two frames of the dance (1: a smooth capture; 5: the same dance
+    /// at a fifth of the frame rate, fast motion between frames).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub stride: u32,
+    /// Give each frame of the dance as this many fresh random surface points without normals
+    /// (like a capture) instead of a mesh; 0: meshes.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=10_000_000))]
+    pub points: u32,
+    /// Only the run with the silhouette term, or only the one without (`0`); both by default.
+    #[arg(long)]
+    pub only_views: Option<u32>,
+    /// Instead of a generated sequence, fit these frames (files, in order) as `subfit
+    /// sequence` does with its defaults (the template's control points by `subfit fit`'s
+    /// rule unless --control-points is given), and measure the drift by the frames' own
+    /// correspondence: they must share one connectivity (vertex i is the same material point
+    /// in every frame), as the corpus's seq-* frames do.
+    #[arg(long, num_args = 2.., value_name = "FRAME")]
+    pub meshes: Vec<PathBuf>,
     /// Seed of the frames' tessellations.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -270,6 +289,8 @@ pub enum MotionArg {
     Large,
     /// Both.
     Both,
+    /// The dancing articulated figure (subfit_mesh::deforming::DancingFigure).
+    Dance,
 }
 
 /// `subfit bench fit`.

@@ -11,6 +11,18 @@
 //! coupled through space, and what the frame does not show is decided by that field's
 //! smoothness.
 //!
+//! **Large motion between frames** (a capture at a low frame rate, fast limbs): the graph is
+//! laid over the surface ([`DeformationGraph::on_surface`], [`geodesic`]: node neighbours and
+//! skinning by distance over the surface, so an arm beside the body or two legs side by side
+//! are not tied together), each frame's points also pull the model (data → model
+//! correspondences), and the step anneals from stiff with a long correspondence radius to
+//! its own weights ([`backward`]; [`TrackOptions::stiffness_start`]). On the dancing figure of
+//! `subfit bench sequence --motion dance --stride 5 --points 40000` (30 frames of 40k points
+//! without normals, the hands moving up to about 15 % of the diagonal between frames) the
+//! tracking through space lost the figure at frame 1 (two-sided RMS 0.7–1.4 % of the
+//! diagonal, drift 3–6 % RMS); laid over the surface with both directions and the annealing
+//! every frame is within 0.036 % two-sided, drift RMS ≤ 0.80 % and 95th percentile ≤ 1.65 %.
+//!
 //! **Model.** `m` nodes with rest positions `g_k` ([`DeformationGraph`]), each with an affine
 //! map `A_k` and a translation `t_k`; a point `x` of the rest shape moves to
 //! `x' = Σ_k w_k(x) (A_k (x − g_k) + g_k + t_k)` over its `s` nearest nodes,
@@ -81,8 +93,6 @@
 //! **Cost** per step: `iterations × (S foot points + S·(12s)² + (12m)³/3 flops)`, plus once
 //! per graph O(S log S) for the medial points and O(m·K³) for the projectors.
 
-use faer::linalg::solvers::Solve;
-use faer::{Mat, Side};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use subfit_mesh::vec3::{dist2, dot as dot3, sub};
@@ -93,7 +103,10 @@ use subfit_target::Target;
 pub struct TrackOptions {
     /// Gauss-Newton iterations. Default 20.
     pub iterations: usize,
-    /// Nodes each sample is skinned to (`s`). Default 12.
+    /// Nodes each sample is skinned to (`s`). Default 6 (with a graph laid over the surface,
+    /// [`DeformationGraph::on_surface`]; 12 with one through space smoothed a limb's motion
+    /// into the body it hangs beside; 4, Sumner et al.'s, left a hand 1.4 % of the diagonal off
+    /// in one frame of the dance).
     pub skin: usize,
     /// Weight `γ` of the regularity term. Default 1e-4 (see the module docs).
     pub regularity: f64,
@@ -114,13 +127,36 @@ pub struct TrackOptions {
     /// (normalized units; Morozov's discrepancy principle): what the data's own noise explains
     /// is not fitted with motion. Default 0 (never).
     pub stop_rms: f64,
+    /// Weight of the data → model correspondences, all together against the model → data
+    /// ones (1 weighs both sides alike; 0 turns them off): each of up to
+    /// [`Self::backward_points`] frame points pulls the nearest moved sample whose normal
+    /// agrees along the frame's normal. Where a limb moved farther than its own width, the
+    /// model's samples find nothing of it nearby, but its points still find the model's limb
+    /// (symmetric ICP; see [`backward`]). Used in the stiff levels of the annealing only
+    /// ([`Self::stiffness_start`]). Default 1.
+    pub backward_weight: f64,
+    /// Frame points used by the data → model correspondences at most (an even subsample).
+    /// Default 3000.
+    pub backward_points: usize,
+    /// Stiffness annealing (Amberg, Romdhani & Vetter, "Optimal step nonrigid ICP
+    /// algorithms for surface registration", CVPR 2007, §3.2): the step starts with the
+    /// regularity and rigidity weights times this and divides them by 10 every
+    /// [`Self::level_iterations`] iterations down to ×1, the correspondence radius going from
+    /// [`Self::reach_start`] down to [`Self::max_distance`] alike: the graph first moves piece
+    /// by piece nearly rigidly onto the far-moved frame, then bends into its details. 1 turns
+    /// the annealing off. Default 100.
+    pub stiffness_start: f64,
+    /// Iterations per stiffness level before the last (which gets the rest). Default 4.
+    pub level_iterations: usize,
+    /// Correspondence radius at the stiffest level (normalized units). Default 0.3.
+    pub reach_start: f64,
 }
 
 impl Default for TrackOptions {
     fn default() -> Self {
         Self {
             iterations: 20,
-            skin: 12,
+            skin: 6,
             regularity: 1e-4,
             rigidity: 1e-6,
             second_order: 1e-6,
@@ -128,6 +164,11 @@ impl Default for TrackOptions {
             marker_weight: 1.0,
             max_distance: 0.1,
             stop_rms: 0.0,
+            backward_weight: 1.0,
+            backward_points: 3000,
+            stiffness_start: 100.0,
+            level_iterations: 4,
+            reach_start: 0.3,
         }
     }
 }
@@ -141,28 +182,26 @@ pub struct DeformationGraph {
     /// Per node, the projector `I − Π` (row-major, `q × q` over the node and its neighbours)
     /// that removes a field's best linear trend in position (the second-order term).
     detrend: Vec<Vec<f64>>,
+    /// The skinning of the surface samples the graph was laid over, by surface distance
+    /// ([`Self::on_surface`]); `None` for a graph through space.
+    surface: Option<SurfaceSkin>,
+}
+
+/// The samples a graph was laid over, their skinning rows and an index to find the nearest.
+#[derive(Clone, Debug)]
+struct SurfaceSkin {
+    rest: Vec<[f64; 3]>,
+    skin: Skin,
 }
 
 impl DeformationGraph {
     /// Picks `count` nodes among `points` by farthest-point sampling (from point 0) and links
     /// each to its `neighbors` nearest nodes. Cost: O(n · count + count²).
     pub fn new(points: &[[f64; 3]], count: usize, neighbors: usize) -> Self {
-        let n = points.len();
-        let count = count.min(n).max(1.min(n));
-        let mut positions = Vec::with_capacity(count);
-        let mut d2 = vec![f64::INFINITY; n];
-        let mut next = 0usize;
-        while positions.len() < count {
-            let g = points[next];
-            positions.push(g);
-            d2.par_iter_mut()
-                .zip(points.par_iter())
-                .for_each(|(d, &p)| *d = d.min(dist2(p, g)));
-            next = (0..n).max_by(|&a, &b| d2[a].total_cmp(&d2[b])).unwrap_or(0);
-            if d2[next] == 0.0 {
-                break;
-            }
-        }
+        let positions: Vec<[f64; 3]> = farthest_points(points, count)
+            .into_iter()
+            .map(|i| points[i])
+            .collect();
         let k = neighbors.min(positions.len().saturating_sub(1));
         let neighbors: Vec<Vec<u32>> = positions
             .par_iter()
@@ -178,6 +217,14 @@ impl DeformationGraph {
                 by.into_iter().map(|(_, j)| j).collect()
             })
             .collect();
+        Self::with_links(positions, neighbors, None)
+    }
+
+    fn with_links(
+        positions: Vec<[f64; 3]>,
+        neighbors: Vec<Vec<u32>>,
+        surface: Option<SurfaceSkin>,
+    ) -> Self {
         let detrend = neighbors
             .iter()
             .enumerate()
@@ -187,6 +234,66 @@ impl DeformationGraph {
             positions,
             neighbors,
             detrend,
+            surface,
+        }
+    }
+
+    /// Nodes inside a closed body laid out along its surface ([`geodesic`]): as
+    /// [`Self::interior`] (`depth` of the way to the medial points, `count` nodes by
+    /// farthest-point sampling), but each node's `neighbors` and each sample's `skin` nearest
+    /// nodes are found by distance over the surface mesh `faces` (over the samples, e.g. the
+    /// limit mesh they are the vertices of) from the sample each node was placed from (a
+    /// variant that took the nearest in space among the nodes not much farther round than
+    /// through — a cross-section as one piece — tracked the dance worse: drift RMS 1.10 %
+    /// against 0.78 %, and the generated tube's spin no better). Points
+    /// other than the samples ([`deform`], markers) take the skinning of their nearest sample.
+    /// Cost: [`Self::interior`] plus one Dijkstra per node over the samples.
+    ///
+    /// # Panics
+    /// If `samples` and `normals` differ in length.
+    #[track_caller]
+    pub fn on_surface(
+        samples: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        faces: &subfit_mesh::Polygons,
+        depth: f64,
+        (count, neighbors, skin): (usize, usize, usize),
+    ) -> Self {
+        assert_eq!(samples.len(), normals.len(), "one normal per sample");
+        let inner = inner_points(samples, normals, depth);
+        let anchors = farthest_points(&inner, count);
+        let positions: Vec<[f64; 3]> = anchors.iter().map(|&i| inner[i]).collect();
+        let dist = geodesic::distances_from(samples, faces, &anchors);
+        let links = geodesic::neighbours(&dist, &anchors, neighbors);
+        let (nodes, weights) = geodesic::skin_rows(&dist, samples, &positions, skin);
+        let per = skin.min(positions.len()).max(1);
+        let surface = SurfaceSkin {
+            rest: samples.to_vec(),
+            skin: Skin {
+                nodes,
+                weights,
+                per,
+            },
+        };
+        Self::with_links(positions, links, Some(surface))
+    }
+
+    /// The skinning of `points` (rest positions) over `s` nodes: the surface samples' own
+    /// rows when `points` are those samples, the nearest sample's rows for other points of a
+    /// graph laid over a surface, the nearest nodes in space otherwise.
+    fn skin_of(&self, points: &[[f64; 3]], s: usize) -> Skin {
+        match &self.surface {
+            Some(sf) if sf.rest.as_slice() == points => sf.skin.clone(),
+            Some(sf) => match subfit_target::neighbors::PointIndex::new(&sf.rest) {
+                Some(index) => sf.skin.gather(
+                    &points
+                        .iter()
+                        .map(|p| index.nearest(p).index as usize)
+                        .collect::<Vec<_>>(),
+                ),
+                None => Skin::new(points, &self.positions, s),
+            },
+            None => Skin::new(points, &self.positions, s),
         }
     }
 
@@ -206,12 +313,7 @@ impl DeformationGraph {
         neighbors: usize,
     ) -> Self {
         assert_eq!(samples.len(), normals.len(), "one normal per sample");
-        let inner: Vec<[f64; 3]> = medial_points(samples, normals)
-            .iter()
-            .zip(samples)
-            .map(|(c, p)| std::array::from_fn(|a| p[a] + depth * (c[a] - p[a])))
-            .collect();
-        Self::new(&inner, count, neighbors)
+        Self::new(&inner_points(samples, normals, depth), count, neighbors)
     }
 
     /// Number of nodes.
@@ -279,6 +381,37 @@ fn detrend(g: &[[f64; 3]], k: usize, nb: &[u32]) -> Vec<f64> {
             f64::from(u8::from(r == c)) - pi
         })
         .collect()
+}
+
+/// The points `depth` of the way from each sample to its medial point.
+fn inner_points(samples: &[[f64; 3]], normals: &[[f64; 3]], depth: f64) -> Vec<[f64; 3]> {
+    medial_points(samples, normals)
+        .iter()
+        .zip(samples)
+        .map(|(c, p)| std::array::from_fn(|a| p[a] + depth * (c[a] - p[a])))
+        .collect()
+}
+
+/// `count` indices of `points` by farthest-point sampling from point 0 (fewer when points
+/// coincide). Cost: O(n · count).
+fn farthest_points(points: &[[f64; 3]], count: usize) -> Vec<usize> {
+    let n = points.len();
+    let count = count.min(n);
+    let mut picks = Vec::with_capacity(count);
+    let mut d2 = vec![f64::INFINITY; n];
+    let mut next = 0usize;
+    while picks.len() < count {
+        let g = points[next];
+        picks.push(next);
+        d2.par_iter_mut()
+            .zip(points.par_iter())
+            .for_each(|(d, &p)| *d = d.min(dist2(p, g)));
+        next = (0..n).max_by(|&a, &b| d2[a].total_cmp(&d2[b])).unwrap_or(0);
+        if d2[next] == 0.0 {
+            break;
+        }
+    }
+    picks
 }
 
 /// Shrinking-ball medial points (Ma, Bae & Mukherjee, "3D medial axis point approximation
@@ -393,6 +526,7 @@ pub struct TrackStats {
     pub marker_rms: f64,
 }
 
+#[derive(Clone, Debug)]
 struct Skin {
     nodes: Vec<u32>,
     weights: Vec<f64>,
@@ -444,6 +578,22 @@ impl Skin {
             nodes,
             weights,
             per,
+        }
+    }
+
+    /// The rows `rows` of this skin, in that order.
+    fn gather(&self, rows: &[usize]) -> Self {
+        let mut nodes = Vec::with_capacity(rows.len() * self.per);
+        let mut weights = Vec::with_capacity(rows.len() * self.per);
+        for &r in rows {
+            let (n, w) = self.row(r);
+            nodes.extend_from_slice(n);
+            weights.extend_from_slice(w);
+        }
+        Self {
+            nodes,
+            weights,
+            per: self.per,
         }
     }
 
@@ -513,66 +663,9 @@ impl Skin {
     }
 }
 
-/// Unknowns per node: `A` row-major (9), then `t` (3).
-const PER: usize = 12;
-
-/// A dense symmetric normal system `H x = b` over `12 m` unknowns.
-struct Normal {
-    n: usize,
-    h: Vec<f64>,
-    b: Vec<f64>,
-}
-
-impl Normal {
-    fn new(n: usize) -> Self {
-        Self {
-            n,
-            h: vec![0.0; n * n],
-            b: vec![0.0; n],
-        }
-    }
-
-    /// Solves the system with a little Levenberg damping (1e-6 of the mean diagonal, which
-    /// keeps unobserved nodes put) and adds the step to `motion`; false when the factorization
-    /// fails.
-    fn solve_into(&self, motion: &mut NodeMotion) -> bool {
-        let nn = self.n;
-        let trace: f64 = (0..nn).map(|i| self.h[i * nn + i]).sum::<f64>() / nn as f64;
-        let h = Mat::<f64>::from_fn(nn, nn, |a, c| {
-            self.h[a * nn + c] + if a == c { 1e-6 * trace.max(1e-30) } else { 0.0 }
-        });
-        let rhs = Mat::<f64>::from_fn(nn, 1, |a, _| self.b[a]);
-        let Ok(llt) = h.llt(Side::Lower) else {
-            return false;
-        };
-        let x = llt.solve(&rhs);
-        for (k, (lin, t)) in motion
-            .linear
-            .iter_mut()
-            .zip(&mut motion.translations)
-            .enumerate()
-        {
-            for a in 0..3 {
-                for c in 0..3 {
-                    lin[(a, c)] += x[(PER * k + 3 * a + c, 0)];
-                }
-                t[a] += x[(PER * k + 9 + a, 0)];
-            }
-        }
-        true
-    }
-
-    /// Adds `w (jᵀj, −jᵀr)` for one residual row `r` with sparse gradient `j`.
-    fn row(&mut self, j: &[(usize, f64)], r: f64, w: f64) {
-        for &(a, va) in j {
-            self.b[a] -= w * va * r;
-            let base = a * self.n;
-            for &(c, vc) in j {
-                self.h[base + c] += w * va * vc;
-            }
-        }
-    }
-}
+/// A step of the last stiffness level that lowers the point-to-plane RMS by less than this
+/// fraction ends the step (it has converged; the fit that follows refines the rest).
+const STALL: f64 = 0.01;
 
 /// Points of the rest surface that [`track`] brings onto the frame, with their unit normals.
 #[derive(Clone, Copy, Debug)]
@@ -630,11 +723,14 @@ pub fn track(
     if m == 0 || samples.is_empty() {
         return (cage.to_vec(), motion, stats);
     }
-    let skin = Skin::new(samples, g, options.skin);
+    let skin = graph.skin_of(samples, options.skin);
     let marker_rest: Vec<[f64; 3]> = markers.iter().map(|k| k.rest).collect();
-    let marker_skin = Skin::new(&marker_rest, g, options.skin);
-    let pairs: usize = graph.neighbors.iter().map(Vec::len).sum();
+    let marker_skin = graph.skin_of(&marker_rest, options.skin);
+    let data = backward::subsample(target, options.backward_points);
+    let schedule = backward::Schedule::new(options);
+    let mut previous = None;
     for it in 0..options.iterations {
+        let level = schedule.level(it);
         let moved: Vec<[f64; 3]> = (0..samples.len())
             .into_par_iter()
             .map(|i| skin.apply(i, samples[i], g, &motion))
@@ -643,115 +739,49 @@ pub fn track(
             .into_par_iter()
             .map(|i| skin.normal(i, normals[i], &motion))
             .collect();
-        let matches = matches(&moved, &moved_normals, target, options.max_distance);
-        let rms = plane_rms(&moved, &matches);
+        let forward = matches(&moved, &moved_normals, target, level.reach);
+        let rms = plane_rms(&moved, &forward);
         if it == 0 {
             stats.rms_before = rms;
         }
-        stats.matched = matches.len();
+        stats.matched = forward.len();
         stats.rms_after = rms;
         stats.marker_rms = marker_rms(&marker_skin, markers, g, &motion);
-        if matches.is_empty() || (rms <= options.stop_rms && stats.marker_rms <= options.stop_rms) {
+        // Explained as well as the previous frame was (at any level: a still body is not moved).
+        let settled = rms <= options.stop_rms && stats.marker_rms <= options.stop_rms;
+        // Stalled: the last level's previous step gained less than STALL of the distance.
+        let stalled = level.last && previous.is_some_and(|p: f64| rms > (1.0 - STALL) * p);
+        if forward.is_empty() || settled || stalled {
             break;
         }
+        previous = level.last.then_some(rms);
+        // Data → model pairs catch what moved far (the stiff levels); the last level refines
+        // with the model's own samples alone: nearest-sample pairs from the frame's side see a
+        // slide along the surface as no motion, and held the generated tube's spin back
+        // (drift 3.2 % instead of 0.5 % of the diagonal on its first frame).
+        let backward = if options.backward_weight > 0.0 && !level.last {
+            backward::matches(&moved, &moved_normals, &data, level.reach)
+        } else {
+            Vec::new()
+        };
         let mut sys = Normal::new(PER * m);
-        let wf = 1.0 / matches.len() as f64;
-        let beta = options.point_weight;
-        let mut j: Vec<(usize, f64)> = Vec::with_capacity(PER * options.skin);
-        // Fit rows: δx'_i = Σ_k w_k (Σ_c d_c δA_k[i][c] + δt_k[i]), d = x − g_k.
-        for &(i, y, n) in &matches {
-            let r = sub(moved[i], y);
-            skin.jacobian(&mut j, i, samples[i], g, n);
-            sys.row(&j, dot3(n, r), wf);
-            if beta > 0.0 {
-                for a in 0..3 {
-                    let mut e = [0.0; 3];
-                    e[a] = 1.0;
-                    skin.jacobian(&mut j, i, samples[i], g, e);
-                    sys.row(&j, r[a], wf * beta);
-                }
-            }
-        }
-        // Marker rows: x'_m − p_m, point to point.
-        let wm = options.marker_weight / markers.len().max(1) as f64;
-        for (i, mk) in markers.iter().enumerate() {
-            let r = sub(marker_skin.apply(i, mk.rest, g, &motion), mk.position);
-            for a in 0..3 {
-                let mut e = [0.0; 3];
-                e[a] = 1.0;
-                marker_skin.jacobian(&mut j, i, mk.rest, g, e);
-                sys.row(&j, r[a], wm);
-            }
-        }
-        // Regularity rows: e = A_k (g_l − g_k) + g_k + t_k − g_l − t_l.
-        let wr = options.regularity / pairs.max(1) as f64;
-        for (k, nb) in graph.neighbors.iter().enumerate() {
-            for &l in nb {
-                let l = l as usize;
-                let dl = v(sub(g[l], g[k]));
-                let e = motion.linear[k] * dl + v(motion.translations[k])
-                    - dl
-                    - v(motion.translations[l]);
-                for a in 0..3 {
-                    j.clear();
-                    for c in 0..3 {
-                        j.push((PER * k + 3 * a + c, dl[c]));
-                    }
-                    j.push((PER * k + 9 + a, 1.0));
-                    j.push((PER * l + 9 + a, -1.0));
-                    sys.row(&j, e[a], wr);
-                }
-            }
-        }
-        // Rigidity rows (Sumner eq. 5): the columns c_0..c_2 of A_k orthonormal,
-        // c_a·c_b = 0 (a < b) and c_a·c_a = 1. Linearized exactly, a turn costs nothing.
-        let wrot = options.rigidity / m as f64;
-        for k in 0..m {
-            let a = motion.linear[k];
-            let col = |c: usize| [a[(0, c)], a[(1, c)], a[(2, c)]];
-            for p in 0..3 {
-                for q in p..3 {
-                    let (cp, cq) = (col(p), col(q));
-                    let r = dot3(cp, cq) - if p == q { 1.0 } else { 0.0 };
-                    j.clear();
-                    for x in 0..3 {
-                        if p == q {
-                            j.push((PER * k + 3 * x + p, 2.0 * cp[x]));
-                        } else {
-                            j.push((PER * k + 3 * x + p, cq[x]));
-                            j.push((PER * k + 3 * x + q, cp[x]));
-                        }
-                    }
-                    sys.row(&j, r, wrot);
-                }
-            }
-        }
-        // Second-order rows: each entry of the linear parts over a node's neighbourhood, less
-        // its best linear trend in position. A bend that goes on at the same rate costs
-        // nothing, a bend that stops does.
-        let w2 = options.second_order / m as f64;
-        if w2 > 0.0 {
-            for (k, p) in graph.detrend.iter().enumerate() {
-                if p.is_empty() {
-                    continue;
-                }
-                let ids = graph.neighbourhood(k);
-                let q = ids.len();
-                for e in 0..9 {
-                    let (a, c) = (e / 3, e % 3);
-                    for r in 0..q {
-                        j.clear();
-                        let mut res = 0.0;
-                        for (s, &l) in ids.iter().enumerate() {
-                            let coef = p[r * q + s];
-                            res += coef * motion.linear[l][(a, c)];
-                            j.push((PER * l + e, coef));
-                        }
-                        sys.row(&j, res, w2);
-                    }
-                }
-            }
-        }
+        let rows = FitRows {
+            skin: &skin,
+            samples,
+            g,
+            moved: &moved,
+        };
+        rows.add(&mut sys, &forward, 1.0, options.point_weight);
+        rows.add(&mut sys, &backward, options.backward_weight, 0.0);
+        add_markers(
+            &mut sys,
+            &marker_skin,
+            markers,
+            g,
+            &motion,
+            options.marker_weight,
+        );
+        add_priors(&mut sys, graph, &motion, options, level.stiffness);
         if !sys.solve_into(&mut motion) {
             break;
         }
@@ -771,7 +801,7 @@ pub fn deform(
     if graph.is_empty() || motion.linear.len() != graph.len() {
         return points.to_vec();
     }
-    let sk = Skin::new(points, &graph.positions, skin);
+    let sk = graph.skin_of(points, skin);
     (0..points.len())
         .into_par_iter()
         .map(|i| sk.apply(i, points[i], &graph.positions, motion))
@@ -885,6 +915,12 @@ fn plane_rms(samples: &[[f64; 3]], matches: &[(usize, [f64; 3], [f64; 3])]) -> f
 fn v(a: [f64; 3]) -> Vector3<f64> {
     Vector3::new(a[0], a[1], a[2])
 }
+
+mod backward;
+mod geodesic;
+mod system;
+
+use system::{add_markers, add_priors, FitRows, Normal, PER};
 
 #[cfg(test)]
 mod tests;

@@ -28,7 +28,16 @@
 //! vertices is O(#V) (a few milliseconds, `benches/deforming.rs`); a lookup is one BVH query
 //! (O(log #T)) after an O(#T log #T) build.
 
+mod corresponded;
+mod figure;
+mod marching;
+mod motion;
 mod tessellate;
+
+pub use corresponded::{NotCorresponded, SameConnectivity};
+pub use figure::{DanceParams, DancingFigure};
+use motion::splitmix;
+pub use motion::{Frame, InvalidParams, MaterialMotion};
 
 use std::f64::consts::TAU;
 
@@ -104,32 +113,11 @@ impl DeformingParams {
     }
 }
 
-/// Parameters rejected by [`DeformingSequence::new`]: the field and what is wrong.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("invalid deforming-sequence parameter `{field}`: {reason}")]
-pub struct InvalidParams {
-    /// The field of [`DeformingParams`].
-    pub field: &'static str,
-    /// What is wrong with it.
-    pub reason: &'static str,
-}
-
 /// A deforming sequence: the rest shape and the motion `Φ_t` of [`DeformingParams`]
 /// (`Default`: the default motion).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct DeformingSequence {
     params: DeformingParams,
-}
-
-/// One frame: a closed triangle mesh of the deformed body and the material point of each
-/// vertex.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Frame {
-    /// Positions `Φ_t(material)` (`#V by 3`) and triangles (counter-clockwise seen from
-    /// outside); a closed genus-0 2-manifold.
-    pub mesh: PolyMesh,
-    /// Material coordinates of the vertices (`#V by 3`): their positions on the rest shape.
-    pub material: Vec<[f64; 3]>,
 }
 
 impl Frame {
@@ -296,68 +284,85 @@ impl DeformingSequence {
         }
     }
 
-    /// Drift of tracked points over the sequence: `tracked[t][i]` is the position of point `i`
-    /// in frame `t` (every frame listing the same points in the same order). Point `i`'s
-    /// material `m_i` is found by locating `tracked[0][i]` on frame 0 with `lookup` (built
-    /// from frame 0, so `tracked[0]` must lie on or near frame 0's surface); its drift in frame
-    /// `t` is `|tracked[t][i] − Φ_t(m_i)|`. Frames past `N − 1` use the continued motion.
-    ///
-    /// Each frame's error is also given relative to the bounding-box diagonal of the deformed
-    /// body, taken over `lookup`'s vertices moved by `Φ_t`. Cost: O(#P log #T) for the lookups
-    /// plus O((#P + #V₀) · #frames).
+    /// Drift of tracked points over the sequence: see [`drift`]. Frames past `N − 1` use the
+    /// continued motion.
     ///
     /// # Panics
     /// If a frame lists a different number of points than `tracked[0]`.
     #[track_caller]
     pub fn drift(&self, tracked: &[Vec<[f64; 3]>], lookup: &MaterialLookup) -> DriftStats {
-        let Some(first) = tracked.first() else {
-            return DriftStats { frames: Vec::new() };
-        };
-        let material: Vec<[f64; 3]> = first.iter().map(|&q| lookup.material(q)).collect();
-        let frames = tracked
-            .iter()
-            .enumerate()
-            .map(|(t, points)| {
-                assert_eq!(
-                    points.len(),
-                    material.len(),
-                    "frame {t} tracks {} points, frame 0 tracks {}",
-                    points.len(),
-                    material.len()
-                );
-                let motion = self.motion(t);
-                let (mut max2, mut sum2) = (0.0f64, 0.0);
-                for (&q, &m) in points.iter().zip(&material) {
-                    let d2 = dist2(q, motion.apply(m));
-                    max2 = max2.max(d2);
-                    sum2 += d2;
-                }
-                let moved: Vec<[f64; 3]> = lookup
-                    .vertex_material()
-                    .iter()
-                    .map(|&m| motion.apply(m))
-                    .collect();
-                let diagonal = bounding_box(&moved).map_or(0.0, |(lo, hi)| norm(sub(hi, lo)));
-                let rms = (sum2 / material.len().max(1) as f64).sqrt();
-                FrameDrift {
-                    max: max2.sqrt(),
-                    rms,
-                    diagonal,
-                    max_relative: max2.sqrt() / diagonal,
-                    rms_relative: rms / diagonal,
-                }
-            })
-            .collect();
-        DriftStats { frames }
+        drift(self, tracked, lookup)
     }
 }
 
-/// SplitMix64 finaliser (Steele, Lea & Flood, OOPSLA 2014): decorrelates nearby seeds.
-fn splitmix(x: u64) -> u64 {
-    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+impl MaterialMotion for DeformingSequence {
+    fn deform_all(&self, index: usize, material: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        DeformingSequence::deform_all(self, index, material)
+    }
+}
+
+/// Drift of tracked points over a sequence of `motion`: `tracked[t][i]` is the position of
+/// point `i` in frame `t` (every frame listing the same points in the same order). Point `i`'s
+/// material `m_i` is found by locating `tracked[0][i]` on frame 0 with `lookup` (built from
+/// frame 0, so `tracked[0]` must lie on or near frame 0's surface); its drift in frame `t` is
+/// `|tracked[t][i] − Φ_t(m_i)|`, summarized per frame by its RMS, 95th percentile and largest
+/// value.
+///
+/// Each frame's error is also given relative to the bounding-box diagonal of the deformed
+/// body, taken over `lookup`'s vertices moved by `Φ_t`. Cost: O(#P log #T) for the lookups
+/// plus O((#P log #P + #V₀) · #frames).
+///
+/// # Panics
+/// If a frame lists a different number of points than `tracked[0]`.
+#[track_caller]
+pub fn drift(
+    motion: &dyn MaterialMotion,
+    tracked: &[Vec<[f64; 3]>],
+    lookup: &MaterialLookup,
+) -> DriftStats {
+    let Some(first) = tracked.first() else {
+        return DriftStats { frames: Vec::new() };
+    };
+    let material: Vec<[f64; 3]> = first.iter().map(|&q| lookup.material(q)).collect();
+    let frames = tracked
+        .iter()
+        .enumerate()
+        .map(|(t, points)| {
+            assert_eq!(
+                points.len(),
+                material.len(),
+                "frame {t} tracks {} points, frame 0 tracks {}",
+                points.len(),
+                material.len()
+            );
+            let truth = motion.deform_all(t, &material);
+            let mut d2: Vec<f64> = points
+                .iter()
+                .zip(&truth)
+                .map(|(&q, &m)| dist2(q, m))
+                .collect();
+            d2.sort_unstable_by(f64::total_cmp);
+            let max2 = d2.last().copied().unwrap_or(0.0);
+            let sum2: f64 = d2.iter().sum();
+            let p95 = d2
+                .get((0.95 * d2.len() as f64).ceil() as usize)
+                .or(d2.last())
+                .map_or(0.0, |v| v.sqrt());
+            let moved = motion.deform_all(t, lookup.vertex_material());
+            let diagonal = bounding_box(&moved).map_or(0.0, |(lo, hi)| norm(sub(hi, lo)));
+            let rms = (sum2 / material.len().max(1) as f64).sqrt();
+            FrameDrift {
+                max: max2.sqrt(),
+                rms,
+                p95,
+                diagonal,
+                max_relative: max2.sqrt() / diagonal,
+                rms_relative: rms / diagonal,
+                p95_relative: p95 / diagonal,
+            }
+        })
+        .collect();
+    DriftStats { frames }
 }
 
 /// Maps points near one frame's surface to material coordinates: the closest point on the
@@ -425,12 +430,16 @@ pub struct FrameDrift {
     pub max: f64,
     /// Root mean square of those distances.
     pub rms: f64,
+    /// Their 95th percentile.
+    pub p95: f64,
     /// Bounding-box diagonal of the deformed body in this frame.
     pub diagonal: f64,
     /// `max / diagonal`.
     pub max_relative: f64,
     /// `rms / diagonal`.
     pub rms_relative: f64,
+    /// `p95 / diagonal`.
+    pub p95_relative: f64,
 }
 
 /// Drift of tracked points over a sequence, one entry per frame.
@@ -446,6 +455,22 @@ impl DriftStats {
         self.frames
             .iter()
             .map(|f| f.max_relative)
+            .fold(0.0, f64::max)
+    }
+
+    /// The largest relative RMS drift over all frames (0 without frames).
+    pub fn max_rms_relative(&self) -> f64 {
+        self.frames
+            .iter()
+            .map(|f| f.rms_relative)
+            .fold(0.0, f64::max)
+    }
+
+    /// The largest relative 95th-percentile drift over all frames (0 without frames).
+    pub fn max_p95_relative(&self) -> f64 {
+        self.frames
+            .iter()
+            .map(|f| f.p95_relative)
             .fold(0.0, f64::max)
     }
 }

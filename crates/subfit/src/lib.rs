@@ -50,6 +50,7 @@ mod repair;
 mod report_build;
 mod scan;
 mod sequence;
+mod sequence_output;
 mod sequence_tracking;
 mod start;
 mod start_curvature_lines;

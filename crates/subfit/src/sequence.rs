@@ -14,27 +14,31 @@
 //!
 //! **Tracking.** Before each frame's fit, the template is carried onto the frame by an
 //! embedded deformation ([`subfit_fit::track`], [`TrackingOptions`]: 60 nodes inside the body,
-//! halfway to its medial points; 20 Gauss-Newton steps, started from the two previous frames'
-//! motions extrapolated). Closest points only move the cage along the surface's normal; the
-//! step follows the part of the motion along the surface that the frame's shape reveals (a
-//! spin of an elliptic section, a bend seen from its inner and outer sides), and the field's
-//! smoothness decides the rest. Mapping from the template rather than from the previous frame
-//! keeps one frame's error from being carried into the next. A step stops as soon as the
-//! frame's residual is within [`TrackingOptions::discrepancy`] of what the previous cage left
-//! on its own frame (Morozov's discrepancy principle): a body that holds still is then not
-//! tracked into a slide (largest drift over 30 still frames 0.025 %, as without tracking).
-//! The fit's ARAP term then keeps the template's local shape *as the tracking carried it*: the
-//! template itself would pull the cage back from the frame's true strains (a bend of this
-//! body stretches one side by a quarter), and so along the surface.
+//! halfway to its medial points, laid out over the surface — neighbours and skinning by
+//! distance over it; at most 20 Gauss-Newton steps annealed from stiff to supple, pulling the
+//! model's samples to the frame and the frame's points to the model, started from the two
+//! previous frames' motions extrapolated). Closest points only move the cage along the
+//! surface's normal; the step follows large motion between frames (a limb that moved farther
+//! than its width) and the part of the motion along the surface that the frame's shape
+//! reveals (limbs, joints, a head turning), and the field's smoothness decides the rest.
+//! Mapping from the template rather than from the previous frame (re-anchoring every frame to
+//! the first) keeps one frame's error from being carried into the next. A step stops as soon
+//! as the frame's residual is within [`TrackingOptions::discrepancy`] of what the previous cage
+//! left on its own frame (Morozov's discrepancy principle): a body that holds still is then not
+//! tracked into a slide. The fit's ARAP term then keeps the template's local shape *as the
+//! tracking carried it*: the template itself would pull the cage back from the frame's true
+//! strains, and so along the surface.
 //!
-//! Measured with `subfit bench sequence` (30 frames of ~25k vertices, 1,000 control points;
-//! largest drift over the frames, fraction of the diagonal, without / with the 8-view
-//! silhouette): default motion **2.40 % / 2.40 %** (RMS 1.18 %), large tangential motion
-//! **3.70 % / 3.70 %** (RMS 1.83 %); 0.8–1.1 s per frame. Before (surface nodes, frame to
-//! frame, ARAP towards the template itself): 6.8 % and 14.4 %; without tracking 16.6 % and
-//! 39.8 %. The goal (1 %) is not met: the largest drifts are on the rounded ends, where the
-//! generated bend goes on to the tip and nothing on the surface tells a bent end from a turned
-//! one (see [`subfit_fit::track`]).
+//! Measured with `subfit bench sequence --motion dance --stride 5 --points 40000` (an
+//! articulated figure dancing, seen at a fifth of a smooth capture's frame rate, 30 frames of
+//! 40k fresh random points without normals, 1,000 control points; fractions of the diagonal,
+//! worst frame): two-sided RMS 0.038 %, tracked points' drift RMS 0.73 % and 95th percentile
+//! 1.56 % (largest 3.1 %), with the silhouette term or without; 1.98 CPU seconds per frame with
+//! the 8-view silhouette, 1.44 without (all threads; the wall clock on a machine loaded twenty
+//! times over its two cores was 6.3 and 4.7 s). A body
+//! whose bulges travel over its material (`--motion moderate|large`, the generated tube) leaves
+//! the slide along its surface free: its drift stays a few per cent, the priors' choice (see
+//! [`subfit_fit::track`]); markers pin it ([`TrackingOptions::markers`]).
 //!
 //! All frames share one normalization, the first frame's (the unit cube of frame 0), so that
 //! the cage moves in one set of units; every figure is reported in the frame's own units and
@@ -52,18 +56,21 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use serde::Serialize;
 use subfit_fit::{AnyTerm, FitOptions, Fitter, Method, WeightedSurfaceTerm};
 use subfit_measure::data_samples;
 use subfit_mesh::vec3::{cross, dist2, dot, sub};
 use subfit_mesh::{Cancel, PolyMesh, Polygons, Tags};
-use subfit_subdiv::{sampling_operator, BoundaryRule, Scheme};
+use subfit_subdiv::{sampling_operator, Scheme};
 use subfit_target::{Normalization, Target, TargetOptions};
 
 use crate::error::Error;
 use crate::limit_stencils::LimitStencils;
 use crate::pipeline_report::{Reorientation, TwoSidedErrors};
 use crate::repair::read_input;
+pub use crate::sequence_output::{
+    frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, Sequence, SequenceFrame,
+    SequenceOptionsSummary, SequenceReport,
+};
 use crate::sequence_tracking::Tracking;
 pub use crate::sequence_tracking::{MarkerObservation, TrackingOptions, TrackingReport};
 use crate::{fit_scan, FitScanOptions, InitialCage, Input};
@@ -76,8 +83,10 @@ pub struct SilhouetteOptions {
     /// Image resolution (pixels per side). Default 128.
     pub resolution: usize,
     /// Refinement level of the limit tessellation that is rendered (its triangles are what the
-    /// rasterizer pays for, per view). Default 1: on 1,000 control points about 8,000 triangles,
-    /// a few pixels each at 128².
+    /// rasterizer pays for, per view). Default 0, the control vertices' limit points: on 1,000
+    /// control points about 2,000 triangles of a few pixels each at 128², whose chords stray
+    /// from the limit surface by less than a pixel even on the thin limbs of the dancing
+    /// figure (level 1 rendered four times the triangles, a fifth of a frame's time).
     pub level: usize,
     /// Weight of the loss (mean squared pixel difference) in the objective, against the data
     /// term's mean squared distance (normalized units²). Default [`DEFAULT_SILHOUETTE_WEIGHT`].
@@ -92,7 +101,7 @@ impl Default for SilhouetteOptions {
         Self {
             views: 8,
             resolution: 128,
-            level: 1,
+            level: 0,
             weight: DEFAULT_SILHOUETTE_WEIGHT,
         }
     }
@@ -164,150 +173,6 @@ impl Default for SequenceOptions {
             cancel: Cancel::default(),
         }
     }
-}
-
-/// One frame's figures (`report.json` → `frames[i]`).
-#[derive(Clone, Debug, Serialize)]
-pub struct FrameReport {
-    /// 0-based frame index.
-    pub index: usize,
-    /// The frame's name (its file).
-    pub name: String,
-    /// Points of the frame after duplicates and outliers.
-    pub points: usize,
-    /// Whether the frame had faces (a mesh) or was a point cloud.
-    pub mesh: bool,
-    /// Faces re-oriented on reading, if any.
-    pub reoriented: Option<Reorientation>,
-    /// The frame's bounding-box diagonal (its own units).
-    pub bbox_diagonal: f64,
-    /// Both-way errors of the frame's cage against the frame.
-    pub two_sided: TwoSidedErrors,
-    /// Whether both directions' RMS are within the tolerance.
-    pub tolerance_reached: bool,
-    /// LM iterations (solves) spent on the frame (the template fit's for an automatic template).
-    pub iterations: usize,
-    /// The silhouette loss at the end (mean squared pixel difference), when the term is on.
-    pub silhouette_loss: Option<f64>,
-    /// Drift diagnostics of the tracked limit points (see the module docs).
-    pub drift: DriftDiagnostics,
-    /// The tracking step before the fit, when it ran.
-    pub tracking: Option<TrackingReport>,
-    /// Seconds per phase.
-    pub timings_s: FrameTimings,
-}
-
-/// How the tracked limit points moved and the cage deformed (fractions of the frame's
-/// bounding-box diagonal; zero for the first frame).
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct DriftDiagnostics {
-    /// RMS motion of the control vertices' limit points since the previous frame.
-    pub motion_rms: f64,
-    /// Its part along the limit normal (RMS).
-    pub normal_motion_rms: f64,
-    /// Its tangential part (RMS): sliding over the surface.
-    pub tangential_motion_rms: f64,
-    /// RMS relative change of the cage's edge lengths against the template.
-    pub edge_strain_rms: f64,
-}
-
-/// Seconds per phase of one frame.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
-pub struct FrameTimings {
-    /// Reading the file.
-    pub read: f64,
-    /// Target analysis.
-    pub analyse: f64,
-    /// Target images of the silhouette term.
-    pub silhouette: f64,
-    /// The tracking step.
-    pub track: f64,
-    /// Fitting (with the measurement at its end).
-    pub fit: f64,
-    /// The whole frame.
-    pub total: f64,
-}
-
-/// The sequence's report (`report.json`).
-#[derive(Clone, Debug, Serialize)]
-pub struct SequenceReport {
-    /// Frames fitted.
-    pub frames_fitted: usize,
-    /// Control points of the cage (every frame).
-    pub control_points: usize,
-    /// Control faces.
-    pub control_faces: usize,
-    /// The subdivision scheme.
-    pub scheme: String,
-    /// Where the template came from: `"fit"` (the first frame fitted with `fit_scan`) or the
-    /// file given.
-    pub template: String,
-    /// The template fit's own report when it was fitted here.
-    pub template_report: Option<Box<crate::Report>>,
-    /// Per-frame options in effect.
-    pub options: SequenceOptionsSummary,
-    /// Worst frame's two-sided RMS (fraction of its diagonal).
-    pub worst_rms_fraction_of_diagonal: f64,
-    /// Worst frame's two-sided maximum (fraction of its diagonal).
-    pub worst_max_fraction_of_diagonal: f64,
-    /// Mean seconds per frame (after the first).
-    pub mean_seconds_per_frame: f64,
-    /// Per frame.
-    pub frames: Vec<FrameReport>,
-    /// Warnings, in order.
-    pub warnings: Vec<String>,
-}
-
-/// The options a sequence ran with (`report.json` → `options`).
-#[derive(Clone, Debug, Serialize)]
-pub struct SequenceOptionsSummary {
-    /// Data term.
-    pub method: String,
-    /// `λ`.
-    pub lambda: f64,
-    /// ARAP `α` towards the template.
-    pub arap: f64,
-    /// LM iterations per frame at most.
-    pub iterations: usize,
-    /// Per-frame tolerance (normalized units).
-    pub tolerance_rms: f64,
-    /// Silhouette views (0: off).
-    pub silhouette_views: usize,
-    /// Silhouette image resolution.
-    pub silhouette_resolution: usize,
-    /// Silhouette weight.
-    pub silhouette_weight: f64,
-    /// Sample level.
-    pub sample_level: usize,
-}
-
-/// One fitted frame, as given to the callback of [`fit_sequence`].
-pub struct SequenceFrame<'a> {
-    /// The cage in the frame's (the input's) coordinates; same faces every frame.
-    pub cage: &'a PolyMesh,
-    /// Its tags (the template's).
-    pub tags: &'a Tags,
-    /// The scheme.
-    pub scheme: Scheme,
-    /// The frame's report.
-    pub report: &'a FrameReport,
-}
-
-/// What [`fit_sequence`] returns: the cage's connectivity, every frame's positions (input
-/// coordinates) and the report.
-pub struct Sequence {
-    /// Faces of the cage (every frame).
-    pub faces: Polygons,
-    /// Tags of the cage.
-    pub tags: Tags,
-    /// The scheme.
-    pub scheme: Scheme,
-    /// The boundary rule (the per-frame fit's, [`FitOptions::boundary`]).
-    pub boundary: BoundaryRule,
-    /// Positions per frame.
-    pub positions: Vec<Vec<[f64; 3]>>,
-    /// The report.
-    pub report: SequenceReport,
 }
 
 /// What carries over from frame to frame.
@@ -878,85 +743,4 @@ fn edges(faces: &Polygons) -> Vec<(u32, u32)> {
     e.sort_unstable();
     e.dedup();
     e
-}
-
-impl Sequence {
-    /// The limit points of the cage refined `level` times (`level = 0`: the control vertices'
-    /// limit points), every frame, input coordinates: the same surface point has the same
-    /// index in every frame — what a user tracks (e.g. to measure drift).
-    ///
-    /// Errors: a topology the subdivision refuses (not after a successful fit).
-    pub fn limit_points(&self, level: usize) -> Result<Vec<Vec<[f64; 3]>>, Error> {
-        let n = self.positions.first().map_or(0, Vec::len);
-        let opts = subfit_subdiv::Options::default()
-            .with_scheme(self.scheme)
-            .with_boundary(self.boundary);
-        let op = sampling_operator(&self.faces, n, &self.tags, &opts, level)
-            .map_err(|e| Error::Output(e.to_string()))?;
-        Ok(self
-            .positions
-            .iter()
-            .map(|p| op.position.apply(p))
-            .collect())
-    }
-
-    /// The names of the files [`Self::write_into`] writes, in order.
-    pub fn output_names(&self) -> Vec<String> {
-        let mut v: Vec<String> = (0..self.positions.len()).map(frame_file_name).collect();
-        v.push("sequence.usda".into());
-        v.push("report.json".into());
-        v
-    }
-
-    /// Writes every frame's cage (`frame_0000.obj` …, ASCII OBJ in the input's coordinates),
-    /// `sequence.usda` (at `fps` frames per second) and `report.json` into `dir`, which must
-    /// exist.
-    pub fn write_into(&self, dir: &std::path::Path, fps: f64) -> Result<(), Error> {
-        let ascii = subfit_io::WriteOptions {
-            format: None,
-            encoding: subfit_io::Encoding::Ascii,
-            single_precision: false,
-        };
-        for (i, p) in self.positions.iter().enumerate() {
-            let cage = PolyMesh::new(p.clone(), self.faces.clone());
-            subfit_io::write_file(&dir.join(frame_file_name(i)), &cage, &ascii)?;
-        }
-        let write = |name: &str, bytes: &[u8]| {
-            std::fs::write(dir.join(name), bytes)
-                .map_err(|e| Error::Output(format!("{}: {e}", dir.join(name).display())))
-        };
-        subfit_io::write_usda_animated_file(
-            &dir.join("sequence.usda"),
-            &self.faces,
-            &self.positions,
-            &self.tags,
-            crate::outputs::usd_scheme(self.scheme, &self.faces),
-            crate::outputs::usd_boundary(self.boundary),
-            fps,
-        )?;
-        let json = serde_json::to_vec_pretty(&self.report)
-            .map_err(|e| Error::Output(format!("report.json: {e}")))?;
-        write("report.json", &json)
-    }
-
-    /// `sequence.usda`: one mesh with the cage's topology, scheme and tags and time-sampled
-    /// points (time codes 0 … frames − 1 at `fps` frames per second, `fps` > 0).
-    pub fn usda(&self, fps: f64) -> Vec<u8> {
-        let mut out = Vec::new();
-        subfit_io::usda::write_animated(
-            &self.faces,
-            &self.positions,
-            &self.tags,
-            crate::outputs::usd_scheme(self.scheme, &self.faces),
-            crate::outputs::usd_boundary(self.boundary),
-            fps,
-            &mut out,
-        );
-        out
-    }
-}
-
-/// `frame_0000.obj` for frame 0.
-pub fn frame_file_name(index: usize) -> String {
-    format!("frame_{index:04}.obj")
 }

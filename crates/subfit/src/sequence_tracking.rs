@@ -177,14 +177,22 @@ impl Tracking {
                 });
             }
         }
+        let faces = op.faces;
         let samples = LimitStencils {
             position: op.position,
             tangent1: op.tangent1,
             tangent2: op.tangent2,
         };
         let rest = samples_of(&samples, &template);
+        let graph = DeformationGraph::on_surface(
+            &rest.0,
+            &rest.1,
+            &faces,
+            o.depth,
+            (o.nodes, o.neighbors, o.step.skin),
+        );
         Self {
-            graph: DeformationGraph::interior(&rest.0, &rest.1, o.depth, o.nodes, o.neighbors),
+            graph,
             samples,
             template,
             rest,
