@@ -6,20 +6,27 @@
 //!    mesh exported with its vertices split along texture seams is one surface, not one patch
 //!    per chart with a boundary along every seam;
 //! 2. faces that collapse onto a repeated vertex are shortened or dropped, and faces written
-//!    twice are written once ([`subfit_mesh::clean_faces`]);
-//! 3. edges with more than two faces are cut into pairs of faces that continue each other
-//!    ([`subfit_mesh::cut_nonmanifold_edges`]): a stray triangle hanging from the surface comes
-//!    off as a piece of its own;
-//! 4. non-manifold vertices are split into one per fan of faces
+//!    twice in the same turn are written once ([`subfit_mesh::clean_faces`]); a face written
+//!    again turned is kept: the two sides of a sheet of no thickness (a thin part of a scan that
+//!    the reconstruction collapsed);
+//! 3. edges with more than two faces are cut into pairs of faces that continue each other with
+//!    consistent orientations, by their order around the edge
+//!    ([`subfit_mesh::cut_nonmanifold_edges`], [`subfit_mesh::edge_pairs`]): a stray triangle
+//!    hanging from the surface comes off as a piece of its own, and each side of a sheet of no
+//!    thickness continues the side of the surface it faces;
+//! 4. what the cut leaves of a part written twice, once inside out, goes
+//!    ([`subfit_mesh::drop_twin_sides`]): a sheet written on both sides keeps one, a part that
+//!    repeats another is dropped;
+//! 5. non-manifold vertices are split into one per fan of faces
 //!    ([`subfit_mesh::split_bowties`]): holes that touch at a vertex;
-//! 5. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
+//! 6. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
 //!    a messy scan.
 //!
 //! Only what cannot be repaired is refused: a non-orientable part (a Möbius strip).
 
 use subfit_mesh::{
-    clean_faces, cut_nonmanifold_edges, reorient_faces, split_bowties, weld_coincident, PolyMesh,
-    ReorientError,
+    clean_faces, cut_nonmanifold_edges, drop_twin_sides, reorient_faces, split_bowties,
+    weld_coincident, PolyMesh, ReorientError,
 };
 
 use crate::error::Error;
@@ -90,8 +97,29 @@ pub fn repair_mesh(
             "cut {} edges of {name} shared by more than two faces (e.g. {a}-{b}) into pairs of faces that continue each other{}{}{}",
             e.edges_cut,
             clause(", ", e.vertices_added, "vertices copied"),
-            clause(", ", e.flap_faces_dropped, "faces of flaps that came off dropped"),
-            clause(", ", e.faces_dropped, "faces the cut could not separate dropped")
+            clause(", ", e.edges_split, "edges the surface passes twice split at their middle"),
+            clause(", ", e.flap_faces_dropped, "faces of flaps that came off dropped")
+        ));
+    }
+    let t = drop_twin_sides(mesh);
+    if t.faces_dropped > 0 {
+        let what = [
+            clause(
+                "",
+                t.pillows_halved,
+                "sheets written on both sides keep one side",
+            ),
+            clause(
+                ", ",
+                t.copies_dropped,
+                "parts that repeat another are dropped",
+            ),
+        ]
+        .concat();
+        warn(format!(
+            "dropped {} faces of {name} written a second time inside out: {}",
+            t.faces_dropped,
+            what.trim_start_matches(", ")
         ));
     }
     let b = split_bowties(mesh);
