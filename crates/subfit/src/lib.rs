@@ -45,7 +45,7 @@ pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use markers::{parse_markers, read_markers};
 pub use outputs::{log_csv, usd_scheme, OUTPUTS};
 pub use pipeline_report::Report;
-pub use repair::repair_mesh;
+pub use repair::{repair_mesh, repair_or_points};
 pub use scan::{
     fit_scan, read_cage, FitScanOptions, Fitted, InitialCage, Input, Progress, Step, EXACT_ERROR,
 };
