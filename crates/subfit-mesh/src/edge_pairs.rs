@@ -36,6 +36,10 @@ use crate::vec3::{add, any_orthogonal, cross, dot, scale, sub, unit};
 /// Pairings of one edge's faces enumerated at most; larger edges are paired greedily.
 pub const MAX_PAIRINGS: usize = 720;
 
+/// Angles (radians) closer than this are the same for [`crosses`]: coincident faces (the two
+/// sides of a sheet of no thickness) get the same angle up to rounding, about `1e-16` rad.
+const SAME_ANGLE: f64 = 1e-12;
+
 /// A half-edge around the edge being paired: its id, its direction along the edge (`true`:
 /// from the smaller vertex to the larger) and the angle of its face about the edge (`None`
 /// for a face with no extent off the edge).
@@ -122,7 +126,8 @@ fn departure(fwd: Side, bwd: Side) -> f64 {
 }
 
 /// Whether the wedges of two consistent pairs cross: exactly one face of the second lies
-/// strictly inside the first's wedge.
+/// strictly inside the first's wedge. A face at the same angle as an end of the wedge (up to
+/// [`SAME_ANGLE`]: the two sides of a sheet of no thickness) is not inside it.
 fn crosses(p: (Side, Side), q: (Side, Side)) -> bool {
     let Some((s, w)) = wedge(p.0, p.1) else {
         return false;
@@ -130,7 +135,7 @@ fn crosses(p: (Side, Side), q: (Side, Side)) -> bool {
     let inside = |t: Option<f64>| {
         t.is_some_and(|t| {
             let r = (t - s).rem_euclid(TAU);
-            r > 1e-12 && r < w - 1e-12
+            r > SAME_ANGLE && r < w - SAME_ANGLE
         })
     };
     inside(q.0.theta) != inside(q.1.theta)
