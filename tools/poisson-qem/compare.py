@@ -31,6 +31,10 @@ import numpy as np
 import pymeshlab
 from scipy.spatial import cKDTree
 
+# The decimation to a vertex count is the scoreboard peers' (tools/peers/poisson_qem.py).
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "peers"))
+from poisson_qem import decimate  # noqa: E402
+
 
 def compare(subfit, a, clean, scheme=None):
     cmd = [subfit, "compare", str(a), str(clean), "--json"]
@@ -70,17 +74,7 @@ def poisson_qem(noisy, vertices, depth, oracle, out):
     ms.meshing_remove_connected_component_by_diameter(
         mincomponentdiag=pymeshlab.PercentageValue(20)
     )
-    # Closed surfaces have about twice as many faces as vertices; aim there, then correct
-    # by the measured ratio.
-    target = 2 * vertices
-    for _ in range(3):
-        ms.meshing_decimation_quadric_edge_collapse(
-            targetfacenum=target, preservenormal=True, planarquadric=True, qualitythr=0.3
-        )
-        v = ms.current_mesh().vertex_number()
-        if abs(v - vertices) <= max(2, vertices // 100):
-            break
-        target = max(4, int(target * vertices / v))
+    decimate(ms, ms.current_mesh_id(), vertices)
     ms.save_current_mesh(str(out))
     return ms.current_mesh().vertex_number(), time.perf_counter() - t
 

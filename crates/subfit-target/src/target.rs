@@ -57,6 +57,9 @@ pub struct Target {
     nn_dist: Vec<f64>,
     imls_radius: f64,
     stats: TargetStats,
+    /// The cloud's boundary points at the default criterion ([`Self::cloud_rim`]), computed on
+    /// first use: every fitter, contour and start borrows the one copy (STYLE.md rule 11).
+    rim: std::sync::OnceLock<Vec<bool>>,
 }
 
 /// Per-point outputs for writers (e.g. the `subfit analyze` PLY): all arrays have `#P` rows, in
@@ -352,7 +355,8 @@ impl Target {
                 .collect();
             stats.triangles = tris.len();
             report(Phase::MeshIndex, 1, 1);
-            Some(TriangleBvh::new(points.clone(), tris))
+            // Built once, queried every iteration: SAH splits (CAD slivers).
+            Some(TriangleBvh::with_sah(points.clone(), tris))
         } else {
             None
         };
@@ -377,6 +381,7 @@ impl Target {
             nn_dist,
             imls_radius,
             stats,
+            rim: std::sync::OnceLock::new(),
         })
     }
 
@@ -463,6 +468,16 @@ impl Target {
     /// IMLS kernel support radius `h` (normalized units).
     pub fn imls_radius(&self) -> f64 {
         self.imls_radius
+    }
+
+    /// Whether each point is on the boundary of the cloud by the angle criterion at the
+    /// defaults ([`crate::cloud_boundary_points`] with [`crate::RIM_NEIGHBORS`] and
+    /// [`crate::RIM_GAP`]), `#P` flags. Computed on the first call (one 25-nearest query per
+    /// point, in parallel) and kept: later calls cost nothing.
+    pub fn cloud_rim(&self) -> &[bool] {
+        self.rim.get_or_init(|| {
+            crate::cloud_boundary_points(self, crate::RIM_NEIGHBORS, crate::RIM_GAP)
+        })
     }
 
     /// Sets the IMLS kernel support radius `h` (normalized units); ignored unless finite and > 0.

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 use subfit_fit::{ErrorStats, IterationRow, StageReport};
-use subfit_report::{DistanceStats, TwoSided};
+use subfit_measure::{DistanceStats, TwoSided};
 
 /// Errors of one cage, surface → data, as the fitter measures them (Cheng 2007 §II-B step 7).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -178,7 +178,7 @@ pub struct CurvatureLineSummary {
     /// Whether it is the initial cage.
     pub used: bool,
     /// Why it is not (it cannot be built, or the QEM start gave the better fit, see
-    /// `crate::initial_cage`). `None` when used.
+    /// `crate::starts`). `None` when used.
     pub reason: Option<String>,
     /// Its control points (0 when it could not be built).
     pub control_points: usize,

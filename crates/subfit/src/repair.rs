@@ -33,8 +33,8 @@ use subfit_mesh::{
 };
 
 use crate::error::Error;
+use crate::options::Input;
 use crate::pipeline_report::Reorientation;
-use crate::scan::Input;
 
 /// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
 /// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
@@ -232,7 +232,7 @@ pub fn repair_or_points(
 
 /// Reads `input` (a file, or takes the mesh given) and repairs it ([`repair_or_points`]) unless
 /// its faces are not used (`as_points`). Returns the mesh, its name for messages and what was
-/// re-oriented.
+/// re-oriented. The reader's warnings ([`subfit_io::FileInfo::warnings`]) go to `warn` first.
 pub(crate) fn read_input(
     input: Input,
     as_points: bool,
@@ -240,7 +240,10 @@ pub(crate) fn read_input(
 ) -> Result<(PolyMesh, String, Option<Reorientation>), Error> {
     let (mut mesh, name) = match input {
         Input::File(path) => {
-            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            let (m, info) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            for w in info.warnings {
+                warn(format!("{}: {w}", path.display()));
+            }
             (m, path.display().to_string())
         }
         Input::Mesh { mesh, name } => (mesh, name),
