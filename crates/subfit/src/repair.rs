@@ -21,7 +21,8 @@
 //!    ([`subfit_mesh::split_bowties`]): holes that touch at a vertex;
 //! 6. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
 //!    a messy scan. Non-orientable pieces (a Möbius strip) smaller than a hundredth of the mesh
-//!    ([`FLAP_FRACTION`]) are dropped, as the flaps the cut takes off are.
+//!    ([`FLAP_FRACTION`]) are dropped, as the flaps the cut takes off are;
+//! 7. the vertices that only dropped faces used go with them.
 //!
 //! What stays non-orientable is not refused: [`repair_or_points`] (what the pipeline reads
 //! with) takes such a mesh as its points, to be fitted as `--as-points` would, and says why.
@@ -138,6 +139,12 @@ pub fn repair_mesh(
         }
         other => other?,
     };
+    if r.needed {
+        mesh.faces = faces;
+    }
+    // The faces the cut and the drops took away leave their vertices unused: off the surface
+    // (a fin's tip), they would be fitted and measured as data points of no face.
+    mesh.remove_unreferenced();
     if !r.needed {
         return Ok(None);
     }
@@ -145,7 +152,6 @@ pub fn repair_mesh(
         "re-oriented {} faces in {} components of {name}",
         r.flipped_faces, r.repaired_components
     ));
-    mesh.faces = faces;
     Ok(Some(Reorientation {
         faces_flipped: r.flipped_faces,
         components_changed: r.repaired_components,
