@@ -212,41 +212,13 @@ fn bad_targets_exit_with_2_and_write_nothing() {
     std::fs::write(&empty, b"").unwrap();
     let five = d.path().join("five.xyz");
     std::fs::write(&five, b"0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n").unwrap();
-    // A Möbius strip of 8 quads: no orientation of its faces agrees across every edge.
-    let mobius = d.path().join("mobius.obj");
-    let mut text = String::new();
-    for i in 0..8 {
-        let t = std::f64::consts::TAU * i as f64 / 8.0;
-        let (c, s, h) = (t.cos(), t.sin(), 0.3 * (t / 2.0).cos());
-        let r = 0.3 * (t / 2.0).sin();
-        for side in [1.0, -1.0] {
-            let rr = 1.0 + side * r;
-            text += &format!("v {} {} {}\n", rr * c, rr * s, side * h);
-        }
-    }
-    for i in 0..8 {
-        let (a, b) = (2 * i + 1, 2 * i + 2);
-        let (c, e) = if i < 7 {
-            (2 * i + 4, 2 * i + 3)
-        } else {
-            (1, 2)
-        };
-        text += &format!("f {a} {b} {c} {e}\n");
-    }
-    std::fs::write(&mobius, text).unwrap();
-    for (target, needle) in [
-        (&empty, "empty.xyz"),
-        (&five, "five.xyz"),
-        (&mobius, "mobius.obj"),
-    ] {
+    // (A Möbius strip is not refused: it is fitted as its points, tests/repair.rs.)
+    for (target, needle) in [(&empty, "empty.xyz"), (&five, "five.xyz")] {
         let out = d.path().join("out");
         let r = subfit(&["fit", target.to_str().unwrap(), "-o", out.to_str().unwrap()]);
         assert_eq!(r.status.code(), Some(2), "{}", target.display());
         let msg = String::from_utf8_lossy(&r.stderr);
         assert!(msg.contains(needle), "{msg}");
-        if needle == "mobius.obj" {
-            assert!(msg.contains("Möbius"), "{msg}");
-        }
         assert!(!out.join("control.obj").exists() && !out.join("report.json").exists());
     }
 }

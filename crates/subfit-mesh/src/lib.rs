@@ -18,6 +18,7 @@ pub mod components;
 pub mod concave;
 pub mod deforming;
 pub mod diagnose;
+pub mod edge_pairs;
 mod edges;
 pub mod halfedge;
 pub mod ids;
@@ -27,6 +28,7 @@ pub mod range_scan;
 pub mod reorient;
 pub mod shapes;
 pub mod tags;
+pub mod twins;
 pub mod vec3;
 pub mod weld;
 
@@ -42,4 +44,5 @@ pub use nonmanifold::{clean_faces, cut_nonmanifold_edges, EdgeCutReport, FaceCle
 pub use polygons::{bounding_box, PolyMesh, Polygons};
 pub use reorient::{reorient_faces, ReorientError, ReorientReport};
 pub use tags::{Tags, SHARPNESS_INFINITE};
+pub use twins::{drop_twin_sides, TwinReport};
 pub use weld::{coincident_vertices, weld_coincident, WeldReport};

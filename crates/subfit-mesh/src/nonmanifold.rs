@@ -5,30 +5,40 @@
 //! *Polygon Mesh Processing*, 2010, ch. 8, "mesh repair"; Attene et al., "Polygon mesh
 //! repairing: an application perspective", ACM Computing Surveys 45(2), 2013, §3): a triangle
 //! whose corners collapsed onto one vertex, the same face written twice, a stray triangle
-//! ("fin") hanging from an edge of the surface, two parts of a model touching along an edge. The
-//! half-edge structure, the subdivision and the fit need an edge-manifold surface; refusing the
-//! whole scan for one such face helps nobody. Two repairs, each reporting what it did:
+//! ("fin") hanging from an edge of the surface, two parts of a model touching along an edge, a
+//! thin part that a volumetric reconstruction collapsed into a sheet of no thickness, both of
+//! whose sides are written as the same triangles turned. The half-edge structure, the
+//! subdivision and the fit need an edge-manifold surface; refusing the whole scan for one such
+//! face helps nobody. Two repairs, each reporting what it did:
 //!
 //! * [`clean_faces`]: a vertex repeated in a row is listed once (`a b b c` → `a b c`); a face
 //!   left with fewer than three vertices, or repeating one elsewhere (`a b a c`), is dropped; of
-//!   faces with the same vertex set (in either orientation) the first is kept.
-//! * [`cut_nonmanifold_edges`]: at an edge with more than two faces the faces are paired, best
-//!   pair first — faces that traverse the edge in opposite directions (consistently oriented)
-//!   before the others, then the pair whose surfaces continue most smoothly across the edge
-//!   (normals most nearly aligned, after turning one of an inconsistent pair) — and the pairs
-//!   are cut apart: each keeps its own copy of the edge's vertices (found as fans of faces, as
-//!   [`crate::split_bowties`] does), so a fin becomes a separate piece and two sheets touching
-//!   along an edge become two sheets. A piece the cut took off that is smaller than a hundredth
-//!   of the part it hung from ([`FLAP_FRACTION`]) is a flap of debris and is dropped (its
-//!   vertices stay, unused). The rare edge whose faces stay joined through their other edges
-//!   (the copies would not separate them) keeps its best pair and loses its other faces.
+//!   faces with the same vertex set in the same turn the first is kept — unless some face of
+//!   that set turns the other way: then all are kept, as the sides of a sheet of no thickness,
+//!   for the cut to pair each with the surface it continues (dropping one side leaves the
+//!   other's neighbours without their partner, and keeping the first copy of each face mixes
+//!   the two sides into a surface that cannot be oriented).
+//! * [`cut_nonmanifold_edges`]: at an edge with more than two faces the faces are paired so
+//!   that the surfaces continue each other with consistent orientations, by their order around
+//!   the edge ([`crate::edge_pairs`]), and the pairs are cut apart: each keeps its own copy of
+//!   the edge's vertices (found as fans of faces, as [`crate::split_bowties`] does), so a fin
+//!   becomes a separate piece and two sheets touching along an edge become two sheets. Where
+//!   the copies cannot separate the pairs — the surface passes the edge twice around both of
+//!   its ends, as where the two sides of a thin sheet fold into each other at its rim — each
+//!   pair after the first gets a vertex of its own at the edge's middle and its two faces are
+//!   split there (no face is dropped, no position moves). A piece the cut took off that is
+//!   smaller than a hundredth of the part it hung from ([`FLAP_FRACTION`]) is a flap of debris
+//!   (a fin, a sheet of no thickness closed on itself) and is dropped (its vertices stay,
+//!   unused).
 //!
-//! Positions are never changed. Cost `O(#H log #H)` for the duplicate search, `O(#H · α)` for
-//! the cut.
+//! Positions are never changed (the only vertices added are copies and edge middles). Cost
+//! `O(#H log #H)` for the duplicate search, `O(#H · α)` for the cut plus the pairing
+//! ([`crate::edge_pairs`]).
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
-use crate::edges::{corner_faces, corner_next, group_edges, EdgeGroups};
+use crate::edge_pairs::pair_up;
+use crate::edges::{corner_next, group_edges};
 use crate::polygons::{PolyMesh, Polygons};
 
 /// A piece the cut takes off a connected part is dropped as a flap when it has fewer than
@@ -46,8 +56,13 @@ pub struct FaceCleanReport {
     /// Faces dropped because fewer than three distinct vertices were left, or one repeated
     /// elsewhere in the face.
     pub degenerate_dropped: usize,
-    /// Faces dropped because an earlier face has the same vertices.
+    /// Faces dropped because an earlier face has the same vertices in the same turn, and no
+    /// face of those vertices turns the other way.
     pub duplicates_dropped: usize,
+    /// Faces kept although an earlier face has the same vertices, because faces of those
+    /// vertices come in both turns: the two sides of a sheet of no thickness (or a part written
+    /// twice, once inside out), left for [`cut_nonmanifold_edges`] to pair.
+    pub opposite_duplicates_kept: usize,
     /// Up to [`crate::diagnose::MAX_EXAMPLES`] input face ids of each kind of repair, in input
     /// order.
     pub examples: Vec<u32>,
@@ -65,49 +80,82 @@ impl FaceCleanReport {
 /// is proper and unique.
 pub fn clean_faces(mesh: &mut PolyMesh) -> FaceCleanReport {
     let mut report = FaceCleanReport::default();
-    let mut out = Polygons::with_capacity(mesh.faces.len(), mesh.faces.indices().len());
-    let mut seen: HashSet<Vec<u32>> = HashSet::with_capacity(mesh.faces.len());
-    let mut face: Vec<u32> = Vec::new();
+    let mut example = vec![false; mesh.faces.len()];
+    // Each proper face, shortened, with its vertex set and its turn (see `turn`).
+    let mut proper: Vec<Option<Proper>> = Vec::with_capacity(mesh.faces.len());
     for (f, src) in mesh.faces.iter().enumerate() {
-        face.clear();
-        for (i, &v) in src.iter().enumerate() {
-            // Cyclically: skip a vertex equal to the one before it.
-            let prev = src[(i + src.len() - 1) % src.len()];
-            if v != prev || src.len() == 1 {
-                face.push(v);
-            }
-        }
-        if face.is_empty() && !src.is_empty() {
-            face.push(src[0]);
-        }
-        let shortened = face.len() < src.len();
+        let face = shortened(src);
         let repeats = (0..face.len()).any(|i| face[i + 1..].contains(&face[i]));
-        let mut example = false;
         if face.len() < 3 || repeats {
             report.degenerate_dropped += 1;
-            example = true;
-        } else {
-            let mut key = face.clone();
-            key.sort_unstable();
-            if seen.insert(key) {
-                out.push(&face);
-                if shortened {
-                    report.faces_shortened += 1;
-                    example = true;
-                }
-            } else {
-                report.duplicates_dropped += 1;
-                example = true;
-            }
+            example[f] = true;
+            proper.push(None);
+            continue;
         }
-        if example && report.examples.len() < MAX_EXAMPLES {
-            report.examples.push(f as u32);
+        if face.len() < src.len() {
+            report.faces_shortened += 1;
+            example[f] = true;
+        }
+        let mut key = face.clone();
+        key.sort_unstable();
+        let t = turn(&face);
+        proper.push(Some((face, key, t)));
+    }
+    // Per vertex set: the turns its faces come in (bit 0: false, bit 1: true).
+    let mut turns: HashMap<&[u32], u8> = HashMap::with_capacity(proper.len());
+    for (_, key, t) in proper.iter().flatten() {
+        *turns.entry(key.as_slice()).or_default() |= 1 << u8::from(*t);
+    }
+    let mut out = Polygons::with_capacity(mesh.faces.len(), mesh.faces.indices().len());
+    let mut seen: HashSet<&[u32]> = HashSet::with_capacity(proper.len());
+    for (f, p) in proper.iter().enumerate() {
+        let Some((face, key, _)) = p else { continue };
+        if seen.insert(key.as_slice()) {
+            out.push(face);
+        } else if turns[key.as_slice()] == 3 {
+            // Both sides of a sheet: kept for the cut to pair.
+            out.push(face);
+            report.opposite_duplicates_kept += 1;
+        } else {
+            report.duplicates_dropped += 1;
+            example[f] = true;
         }
     }
+    report.examples = (0..example.len() as u32)
+        .filter(|&f| example[f as usize])
+        .take(MAX_EXAMPLES)
+        .collect();
     if report.changed() {
         mesh.faces = out;
     }
     report
+}
+
+/// A proper face of [`clean_faces`]: its vertices (shortened), their sorted set, its turn.
+type Proper = (Vec<u32>, Vec<u32>, bool);
+
+/// `src` with a vertex equal to the one before it (cyclically) skipped: `a b b c` → `a b c`.
+fn shortened(src: &[u32]) -> Vec<u32> {
+    let mut face: Vec<u32> = Vec::with_capacity(src.len());
+    for (i, &v) in src.iter().enumerate() {
+        let prev = src[(i + src.len() - 1) % src.len()];
+        if v != prev || src.len() == 1 {
+            face.push(v);
+        }
+    }
+    if face.is_empty() && !src.is_empty() {
+        face.push(src[0]);
+    }
+    face
+}
+
+/// Which way `face` turns, comparable between faces of the same vertices: from its smallest
+/// vertex, whether the next vertex is smaller than the previous one. A face and its reverse
+/// turn opposite ways.
+pub(crate) fn turn(face: &[u32]) -> bool {
+    let n = face.len();
+    let m = (0..n).min_by_key(|&i| face[i]).unwrap_or(0);
+    face[(m + 1) % n] < face[(m + n - 1) % n]
 }
 
 /// What [`cut_nonmanifold_edges`] did.
@@ -117,11 +165,13 @@ pub struct EdgeCutReport {
     pub edges_cut: usize,
     /// Vertex copies added so that the pairs of faces at those edges come apart.
     pub vertices_added: usize,
+    /// Of the cut edges, those whose pairs the vertex copies could not separate (the surface
+    /// passes the edge twice around each end): each pair after the first got a vertex of its
+    /// own at the edge's middle, its two faces split there.
+    pub edges_split: usize,
     /// Faces of flaps dropped: pieces the cut took off, smaller than `1 / FLAP_FRACTION` of the
     /// part they hung from.
     pub flap_faces_dropped: usize,
-    /// Faces dropped at edges the copies could not separate.
-    pub faces_dropped: usize,
     /// Up to [`crate::diagnose::MAX_EXAMPLES`] of the cut edges (input vertex ids).
     pub examples: Vec<[u32; 2]>,
 }
@@ -132,78 +182,83 @@ pub struct EdgeCutReport {
 pub fn cut_nonmanifold_edges(mesh: &mut PolyMesh) -> EdgeCutReport {
     let mut report = EdgeCutReport::default();
     let nv = mesh.num_vertices();
-    let faces = &mesh.faces;
     let valid = |f: &[u32]| {
         f.len() >= 3
             && f.iter().all(|&v| (v as usize) < nv)
             && (0..f.len()).all(|i| !f[i + 1..].contains(&f[i]))
     };
-    let ok: Vec<bool> = faces.iter().map(valid).collect();
-    let next = corner_next(faces);
-    let groups = group_edges(faces, &next, nv, |f| ok[f]);
-    if (0..groups.len()).all(|e| groups.group(e).len() <= 2) {
-        return report;
-    }
-    let normals = face_normals(faces, &mesh.positions);
-    let face_of = corner_faces(faces);
-    let pairing =
-        |faces: &Polygons, groups: &EdgeGroups| pair_up(faces, &next, groups, &face_of, &normals);
+    let ok: Vec<bool> = mesh.faces.iter().map(valid).collect();
+    let next = corner_next(&mesh.faces);
+    let groups = group_edges(&mesh.faces, &next, nv, |f| ok[f]);
+    let idx = mesh.faces.indices();
     for e in 0..groups.len() {
         let g = groups.group(e);
         if g.len() > 2 {
             report.edges_cut += 1;
             if report.examples.len() < MAX_EXAMPLES {
-                let idx = faces.indices();
                 let (a, b) = (idx[g[0] as usize], idx[next[g[0] as usize] as usize]);
                 report.examples.push([a.min(b), a.max(b)]);
             }
         }
     }
+    if report.edges_cut == 0 {
+        return report;
+    }
     let before = crate::face_components(&mesh.faces, nv);
-    let split = crate::bowtie::split_fans(mesh, |faces, _, groups| pairing(faces, &groups));
+    let pairs = pair_up(&mesh.faces, &mesh.positions, &next, &groups);
+    drop(groups);
+    // Per half-edge, the pair (or single) it is in.
+    let mut pair_of = vec![u32::MAX; idx.len()];
+    for p in 0..pairs.len() {
+        for &h in pairs.group(p) {
+            pair_of[h as usize] = p as u32;
+        }
+    }
+    let split = crate::bowtie::split_fans(mesh, |_, _, _| pairs);
     report.vertices_added = split.vertices_added;
-    let faces = &mesh.faces;
-    let nv = mesh.num_vertices();
-    let mut drop = vec![false; faces.len()];
-    let mut flap = vec![false; faces.len()];
-    // What the copies could not separate: keep each such edge's best pair, drop the rest.
-    let next = corner_next(faces);
-    let groups = group_edges(faces, &next, nv, |f| ok[f]);
+    // Pairs still on one edge: every pair but the first gets a vertex in the middle.
+    let next = corner_next(&mesh.faces);
+    let groups = group_edges(&mesh.faces, &next, mesh.num_vertices(), |f| ok[f]);
+    let mut middle: Vec<(u32, u32)> = Vec::new();
+    let mut m = mesh.num_vertices() as u32;
     for e in 0..groups.len() {
         let g = groups.group(e);
-        if g.len() > 2 {
-            let one = EdgeGroups {
-                order: g.to_vec(),
-                starts: vec![0, g.len() as u32],
-            };
-            let keep = pairing(faces, &one).group(0).to_vec();
-            for &h in g {
-                if !keep.contains(&h) {
-                    drop[face_of[h as usize] as usize] = true;
-                }
-            }
-        }
-    }
-    // Flaps: pieces the cut took off a part, smaller than a hundredth of it.
-    let after = crate::face_components(faces, nv);
-    let sizes = after.face_counts();
-    let whole = before.face_counts();
-    for (f, d) in drop.iter().enumerate() {
-        let (part, piece) = (before.face_labels[f], after.face_labels[f]);
-        if part == u32::MAX || piece == u32::MAX {
+        if g.len() <= 2 {
             continue;
         }
-        let (part, piece) = (part as usize, piece as usize);
-        if !*d && sizes[piece] * FLAP_FRACTION < whole[part] {
-            flap[f] = true;
+        report.edges_split += 1;
+        let first = pair_of[g[0] as usize];
+        let mut extra: Vec<u32> = g.iter().map(|&h| pair_of[h as usize]).collect();
+        extra.retain(|&p| p != first);
+        extra.sort_unstable();
+        extra.dedup();
+        for p in extra {
+            middle.extend(
+                g.iter()
+                    .filter(|&&h| pair_of[h as usize] == p)
+                    .map(|&h| (h, m)),
+            );
+            m += 1;
         }
     }
-    report.faces_dropped = drop.iter().filter(|&&d| d).count();
+    drop(groups);
+    let origin = split_at_middles(mesh, &middle, &next);
+    // Flaps: pieces the cut took off a part, smaller than a hundredth of it.
+    let after = crate::face_components(&mesh.faces, mesh.num_vertices());
+    let (sizes, whole) = (after.face_counts(), before.face_counts());
+    let flap: Vec<bool> = (0..mesh.faces.len())
+        .map(|f| {
+            let (part, piece) = (before.face_labels[origin[f] as usize], after.face_labels[f]);
+            part != u32::MAX
+                && piece != u32::MAX
+                && sizes[piece as usize] * FLAP_FRACTION < whole[part as usize]
+        })
+        .collect();
     report.flap_faces_dropped = flap.iter().filter(|&&d| d).count();
-    if report.faces_dropped + report.flap_faces_dropped > 0 {
-        let mut out = Polygons::with_capacity(faces.len(), faces.indices().len());
-        for (f, face) in faces.iter().enumerate() {
-            if !drop[f] && !flap[f] {
+    if report.flap_faces_dropped > 0 {
+        let mut out = Polygons::with_capacity(mesh.faces.len(), mesh.faces.indices().len());
+        for (f, face) in mesh.faces.iter().enumerate() {
+            if !flap[f] {
                 out.push(face);
             }
         }
@@ -212,68 +267,80 @@ pub fn cut_nonmanifold_edges(mesh: &mut PolyMesh) -> EdgeCutReport {
     report
 }
 
-/// `groups` with every edge of more than two half-edges split into pairs, best first (see the
-/// module docs), and a last single half-edge when the count is odd.
-fn pair_up(
-    faces: &Polygons,
-    next: &[u32],
-    groups: &EdgeGroups,
-    face_of: &[u32],
-    normals: &[[f64; 3]],
-) -> EdgeGroups {
-    let idx = faces.indices();
-    let mut order = Vec::with_capacity(groups.order.len());
-    let mut starts = Vec::with_capacity(groups.starts.len());
-    for e in 0..groups.len() {
-        let g = groups.group(e);
-        if g.len() <= 2 {
-            starts.push(order.len() as u32);
-            order.extend_from_slice(g);
-            continue;
-        }
-        let mut left: Vec<u32> = g.to_vec();
-        while left.len() >= 2 {
-            let mut best = (f64::NEG_INFINITY, 0, 1);
-            for i in 0..left.len() {
-                for j in i + 1..left.len() {
-                    let (hi, hj) = (left[i] as usize, left[j] as usize);
-                    let opposite = idx[hi] == idx[next[hj] as usize];
-                    let (ni, nj) = (normals[face_of[hi] as usize], normals[face_of[hj] as usize]);
-                    let d = crate::vec3::dot(ni, nj);
-                    let score = if opposite { 2.0 + d } else { -d };
-                    if score > best.0 {
-                        best = (score, i, j);
-                    }
-                }
-            }
-            let (_, i, j) = best;
-            starts.push(order.len() as u32);
-            order.push(left[i]);
-            order.push(left[j]);
-            left.remove(j);
-            left.remove(i);
-        }
-        for h in left {
-            starts.push(order.len() as u32);
-            order.push(h);
+/// Splits faces at new middle vertices: `middle` lists `(half-edge, vertex)`, the vertex (ids
+/// from `#V` on, in order, each listed for the half-edges that share it) to be put at the
+/// middle of the half-edge (a corner of `mesh.faces`, `next` its [`corner_next`]). A face
+/// with middles on its edges loses, after each middle, the corner that follows it, as a
+/// triangle of its own (middle, corner, corner after it): no face is left with three vertices
+/// in a line. The middle vertices are appended (positions, normals and colours halfway).
+/// Returns per face of the result the input face it came from. Cost `O(#H + #middle)`.
+fn split_at_middles(mesh: &mut PolyMesh, middle: &[(u32, u32)], next: &[u32]) -> Vec<u32> {
+    let nf = mesh.faces.len();
+    if middle.is_empty() {
+        return (0..nf as u32).collect();
+    }
+    let idx = mesh.faces.indices();
+    let mut at = vec![u32::MAX; idx.len()];
+    let mut ends: Vec<(u32, u32)> = Vec::new();
+    for &(h, m) in middle {
+        at[h as usize] = m;
+        if m as usize - mesh.num_vertices() == ends.len() {
+            ends.push((idx[h as usize], idx[next[h as usize] as usize]));
         }
     }
-    starts.push(order.len() as u32);
-    EdgeGroups { order, starts }
-}
-
-/// Unit normal of every face by Newell's method (zero for a face without area or with an id
-/// out of range).
-fn face_normals(faces: &Polygons, positions: &[[f64; 3]]) -> Vec<[f64; 3]> {
-    faces
-        .iter()
-        .map(|f| {
-            if f.iter().any(|&v| v as usize >= positions.len()) {
-                return [0.0; 3];
+    let mut out = Polygons::with_capacity(nf + middle.len(), idx.len() + 3 * middle.len());
+    let mut origin = Vec::with_capacity(nf + middle.len());
+    let (mut ring, mut marked): (Vec<u32>, Vec<bool>) = (Vec::new(), Vec::new());
+    for (f, w) in mesh.faces.offsets().windows(2).enumerate() {
+        let (s, e) = (w[0] as usize, w[1] as usize);
+        if (s..e).all(|h| at[h] == u32::MAX) {
+            out.push(&idx[s..e]);
+            origin.push(f as u32);
+            continue;
+        }
+        // The polygon with its middles; a corner right after a middle is marked.
+        ring.clear();
+        marked.clear();
+        for h in s..e {
+            let prev = if h == s { e - 1 } else { h - 1 };
+            ring.push(idx[h]);
+            marked.push(at[prev] != u32::MAX);
+            if at[h] != u32::MAX {
+                ring.push(at[h]);
+                marked.push(false);
             }
-            crate::vec3::normalize(crate::vec3::polygon_normal(positions, f)).unwrap_or([0.0; 3])
-        })
-        .collect()
+        }
+        let mut i = 0;
+        while i < ring.len() && ring.len() > 3 {
+            if marked[i] {
+                let k = ring.len();
+                let (p, q) = (ring[(i + k - 1) % k], ring[(i + 1) % k]);
+                out.push(&[p, ring[i], q]);
+                origin.push(f as u32);
+                ring.remove(i);
+                marked.remove(i);
+            } else {
+                i += 1;
+            }
+        }
+        out.push(&ring);
+        origin.push(f as u32);
+    }
+    mesh.faces = out;
+    let halfway = |a: [f64; 3], b: [f64; 3]| crate::vec3::scale(crate::vec3::add(a, b), 0.5);
+    for &(a, b) in &ends {
+        let p = halfway(mesh.positions[a as usize], mesh.positions[b as usize]);
+        mesh.positions.push(p);
+        if let Some(n) = mesh.normals.as_mut() {
+            let h = halfway(n[a as usize], n[b as usize]);
+            n.push(crate::vec3::normalize(h).unwrap_or(n[a as usize]));
+        }
+        if let Some(c) = mesh.colors.as_mut() {
+            let (x, y) = (c[a as usize], c[b as usize]);
+            c.push([0, 1, 2].map(|k| ((u16::from(x[k]) + u16::from(y[k])) / 2) as u8));
+        }
+    }
+    origin
 }
 
 #[cfg(test)]
@@ -288,15 +355,17 @@ mod tests {
 
     #[test]
     fn collapsed_and_repeated_faces_are_cleaned() {
-        let p = vec![[0.0; 3]; 6];
+        let p = vec![[0.0; 3]; 8];
         let mut faces = Polygons::new();
         for f in [
             &[0, 1, 2][..],
-            &[2, 1, 0],    // the first, turned: a duplicate
+            &[1, 2, 0],    // the first, in the same turn: a duplicate
             &[1, 1, 3, 2], // shortened to 1 3 2
             &[0, 4, 4],    // two vertices left: dropped
             &[0, 4, 0, 5], // repeats 0 apart: dropped
             &[3, 4, 5, 3], // repeats 3 in a row around the end: 4 5 3
+            &[5, 6, 7],
+            &[7, 6, 5], // the one before, turned: its other side, kept
         ] {
             faces.push(f);
         }
@@ -308,12 +377,19 @@ mod tests {
                 faces_shortened: 2,
                 degenerate_dropped: 2,
                 duplicates_dropped: 1,
+                opposite_duplicates_kept: 1,
                 examples: vec![1, 2, 3, 4, 5],
             }
         );
         assert_eq!(
             faces_of(&m),
-            vec![vec![0, 1, 2], vec![1, 3, 2], vec![4, 5, 3]]
+            vec![
+                vec![0, 1, 2],
+                vec![1, 3, 2],
+                vec![4, 5, 3],
+                vec![5, 6, 7],
+                vec![7, 6, 5]
+            ]
         );
         let again = m.clone();
         assert!(!clean_faces(&mut m).changed());
@@ -346,7 +422,7 @@ mod tests {
         assert_eq!(r.examples, vec![edge]);
         assert_eq!(r.vertices_added, 2, "{r:?}");
         // The fin came off as a triangle of its own, a flap, and is dropped.
-        assert_eq!((r.flap_faces_dropped, r.faces_dropped), (1, 0));
+        assert_eq!((r.flap_faces_dropped, r.edges_split), (1, 0));
         assert_eq!((m.num_vertices(), m.num_faces()), (nv + 2, nf - 1));
         let d = diagnose_mesh(&m);
         assert!(d.is_manifold, "{d:?}");
@@ -371,7 +447,7 @@ mod tests {
         }
         let mut m = PolyMesh::new(p, faces);
         let r = cut_nonmanifold_edges(&mut m);
-        assert_eq!((r.edges_cut, r.vertices_added, r.faces_dropped), (1, 2, 0));
+        assert_eq!((r.edges_cut, r.vertices_added, r.edges_split), (1, 2, 0));
         assert!(diagnose_mesh(&m).is_manifold);
         // The flat sheet (faces 0 and 2) keeps the edge; the upright one (1 and 3) gets copies.
         let f = faces_of(&m);

@@ -71,7 +71,7 @@ pub use outputs::{log_csv, usd_scheme, OutputOptions, OUTPUTS};
 pub use pipeline_report::Report;
 pub use prepare::Prepared;
 pub use progress::{Progress, Step};
-pub use repair::repair_mesh;
+pub use repair::{repair_mesh, repair_or_points};
 pub use scan::{fit_scan, read_cage};
 pub use sequence::{
     fit_sequence, frame_file_name, DriftDiagnostics, FrameReport, FrameTimings, MarkerObservation,

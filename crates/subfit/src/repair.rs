@@ -6,20 +6,31 @@
 //!    mesh exported with its vertices split along texture seams is one surface, not one patch
 //!    per chart with a boundary along every seam;
 //! 2. faces that collapse onto a repeated vertex are shortened or dropped, and faces written
-//!    twice are written once ([`subfit_mesh::clean_faces`]);
-//! 3. edges with more than two faces are cut into pairs of faces that continue each other
-//!    ([`subfit_mesh::cut_nonmanifold_edges`]): a stray triangle hanging from the surface comes
-//!    off as a piece of its own;
-//! 4. non-manifold vertices are split into one per fan of faces
+//!    twice in the same turn are written once ([`subfit_mesh::clean_faces`]); a face written
+//!    again turned is kept: the two sides of a sheet of no thickness (a thin part of a scan that
+//!    the reconstruction collapsed);
+//! 3. edges with more than two faces are cut into pairs of faces that continue each other with
+//!    consistent orientations, by their order around the edge
+//!    ([`subfit_mesh::cut_nonmanifold_edges`], [`subfit_mesh::edge_pairs`]): a stray triangle
+//!    hanging from the surface comes off as a piece of its own, and each side of a sheet of no
+//!    thickness continues the side of the surface it faces;
+//! 4. what the cut leaves of a part written twice, once inside out, goes
+//!    ([`subfit_mesh::drop_twin_sides`]): a sheet written on both sides keeps one, a part that
+//!    repeats another is dropped;
+//! 5. non-manifold vertices are split into one per fan of faces
 //!    ([`subfit_mesh::split_bowties`]): holes that touch at a vertex;
-//! 5. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
-//!    a messy scan.
+//! 6. faces that disagree with their neighbours are turned ([`subfit_mesh::reorient_faces`]):
+//!    a messy scan. Non-orientable pieces (a Möbius strip) smaller than a hundredth of the mesh
+//!    ([`FLAP_FRACTION`]) are dropped, as the flaps the cut takes off are;
+//! 7. the vertices that only dropped faces used go with them.
 //!
-//! Only what cannot be repaired is refused: a non-orientable part (a Möbius strip).
+//! What stays non-orientable is not refused: [`repair_or_points`] (what the pipeline reads
+//! with) takes such a mesh as its points, to be fitted as `--as-points` would, and says why.
 
+use subfit_mesh::nonmanifold::FLAP_FRACTION;
 use subfit_mesh::{
-    clean_faces, cut_nonmanifold_edges, reorient_faces, split_bowties, weld_coincident, PolyMesh,
-    ReorientError,
+    clean_faces, cut_nonmanifold_edges, diagnose_mesh, drop_twin_sides, face_components,
+    reorient_faces, split_bowties, weld_coincident, PolyMesh, Polygons, ReorientError,
 };
 
 use crate::error::Error;
@@ -103,8 +114,29 @@ pub fn repair_mesh(
             "cut {} edges of {name} shared by more than two faces (e.g. {a}-{b}) into pairs of faces that continue each other{}{}{}",
             e.edges_cut,
             clause(", ", e.vertices_added, "vertices copied"),
-            clause(", ", e.flap_faces_dropped, "faces of flaps that came off dropped"),
-            clause(", ", e.faces_dropped, "faces the cut could not separate dropped")
+            clause(", ", e.edges_split, "edges the surface passes twice split at their middle"),
+            clause(", ", e.flap_faces_dropped, "faces of flaps that came off dropped")
+        ));
+    }
+    let t = drop_twin_sides(mesh);
+    if t.faces_dropped > 0 {
+        let what = [
+            clause(
+                "",
+                t.pillows_halved,
+                "sheets written on both sides keep one side",
+            ),
+            clause(
+                ", ",
+                t.copies_dropped,
+                "parts that repeat another are dropped",
+            ),
+        ]
+        .concat();
+        warn(format!(
+            "dropped {} faces of {name} written a second time inside out: {}",
+            t.faces_dropped,
+            what.trim_start_matches(", ")
         ));
     }
     let b = split_bowties(mesh);
@@ -114,7 +146,18 @@ pub fn repair_mesh(
             b.vertices_split, b.examples[0]
         ));
     }
-    let (faces, r) = reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions))?;
+    let (faces, r) = match reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions)) {
+        Err(ReorientError::NonOrientable { .. }) if drop_small_non_orientable(mesh, name, warn) => {
+            reorient_faces(&mesh.faces, mesh.num_vertices(), Some(&mesh.positions))?
+        }
+        other => other?,
+    };
+    if r.needed {
+        mesh.faces = faces;
+    }
+    // The faces the cut and the drops took away leave their vertices unused: off the surface
+    // (a fin's tip), they would be fitted and measured as data points of no face.
+    mesh.remove_unreferenced();
     if !r.needed {
         return Ok(None);
     }
@@ -122,11 +165,51 @@ pub fn repair_mesh(
         "re-oriented {} faces in {} components of {name}",
         r.flipped_faces, r.repaired_components
     ));
-    mesh.faces = faces;
     Ok(Some(Reorientation {
         faces_flipped: r.flipped_faces,
         components_changed: r.repaired_components,
     }))
+}
+
+/// Drops the non-orientable components of `mesh` when each is smaller than
+/// `1 / FLAP_FRACTION` of its faces (debris, as the flaps the cut takes off), with a warning;
+/// returns whether it did. Left alone (`false`) when there is a larger one.
+fn drop_small_non_orientable(
+    mesh: &mut PolyMesh,
+    name: &str,
+    warn: &mut dyn FnMut(String),
+) -> bool {
+    let report = diagnose_mesh(mesh);
+    let labels = face_components(&mesh.faces, mesh.num_vertices()).face_labels;
+    let total = mesh.faces.len();
+    let bad: Vec<usize> = (0..report.components.len())
+        .filter(|&c| !report.components[c].orientable)
+        .collect();
+    if bad.is_empty()
+        || bad
+            .iter()
+            .any(|&c| report.components[c].faces * FLAP_FRACTION >= total)
+    {
+        return false;
+    }
+    let drop: Vec<bool> = labels
+        .iter()
+        .map(|&l| l != u32::MAX && bad.contains(&(l as usize)))
+        .collect();
+    let example = drop.iter().position(|&d| d).unwrap_or(0);
+    let mut faces = Polygons::with_capacity(total, mesh.faces.indices().len());
+    for (f, face) in mesh.faces.iter().enumerate() {
+        if !drop[f] {
+            faces.push(face);
+        }
+    }
+    warn(format!(
+        "dropped {} faces of {name} in {} non-orientable pieces (a Möbius strip, e.g. around face {example}), each smaller than 1/{FLAP_FRACTION} of the mesh",
+        total - faces.len(),
+        bad.len()
+    ));
+    mesh.faces = faces;
+    true
 }
 
 /// `"{sep}{n} {what}"` when `n > 0`, else nothing: an optional part of a warning.
@@ -138,8 +221,36 @@ fn clause(sep: &str, n: usize, what: &str) -> String {
     }
 }
 
-/// Reads `input` (a file, or takes the mesh given) and repairs it ([`repair_mesh`]) unless its
-/// faces are not used (`as_points`). Returns the mesh, its name for messages and what was
+/// [`repair_mesh`], except that a mesh that stays non-orientable after the repairs becomes its
+/// points (the vertices its faces use, with their normals when it has them; no faces), to be
+/// fitted as `--as-points` would, with a warning that says why. Errors: what else
+/// [`repair_mesh`] refuses (none for a mesh read by [`subfit_io`]).
+pub fn repair_or_points(
+    mesh: &mut PolyMesh,
+    name: &str,
+    warn: &mut dyn FnMut(String),
+) -> Result<Option<Reorientation>, ReorientError> {
+    let read = mesh.clone();
+    match repair_mesh(mesh, name, warn) {
+        Err(ReorientError::NonOrientable { face }) => {
+            let at = mesh.faces.face(face).first().map_or(String::new(), |&v| {
+                let p = mesh.positions[v as usize];
+                format!(" (at {:.6}, {:.6}, {:.6})", p[0], p[1], p[2])
+            });
+            warn(format!(
+                "{name} cannot be oriented consistently around face {face}{at}: a non-orientable surface, such as a Möbius strip; fitting its points instead, as --as-points would"
+            ));
+            *mesh = read;
+            mesh.remove_unreferenced();
+            mesh.faces = Polygons::new();
+            Ok(None)
+        }
+        other => other,
+    }
+}
+
+/// Reads `input` (a file, or takes the mesh given) and repairs it ([`repair_or_points`]) unless
+/// its faces are not used (`as_points`). Returns the mesh, its name for messages and what was
 /// re-oriented. The reader's warnings ([`subfit_io::FileInfo::warnings`]) go to `warn` first.
 pub(crate) fn read_input(
     input: Input,
@@ -159,7 +270,7 @@ pub(crate) fn read_input(
     let reoriented = if as_points {
         None
     } else {
-        repair_mesh(&mut mesh, &name, warn).map_err(|e| Error::input(&name, e))?
+        repair_or_points(&mut mesh, &name, warn).map_err(|e| Error::input(&name, e))?
     };
     Ok((mesh, name, reoriented))
 }

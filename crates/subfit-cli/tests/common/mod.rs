@@ -28,6 +28,22 @@ pub fn data_dir() -> Option<PathBuf> {
     }
 }
 
+/// The corpus of real models from `SUBFIT_CORPUS` (`shared/corpus`), as [`data_dir`] does for
+/// `SUBFIT_DATA`: a failure when `CI=true`, else a printed notice and `None`.
+pub fn corpus_dir() -> Option<PathBuf> {
+    match std::env::var_os("SUBFIT_CORPUS") {
+        Some(d) => Some(PathBuf::from(d)),
+        None => {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "SUBFIT_CORPUS is not set (needed on CI: the directory of shared/corpus)"
+            );
+            println!("notice: SUBFIT_CORPUS not set, skipping a test that needs the corpus");
+            None
+        }
+    }
+}
+
 pub fn checks() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/checks")
 }
