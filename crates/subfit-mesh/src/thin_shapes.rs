@@ -58,9 +58,12 @@ fn revolve(profile: &[(f64, f64)], nu: usize) -> PolyMesh {
     PolyMesh::new(pos, faces)
 }
 
+/// One piece of a meridian profile: its length and its `(ρ, z)` point at arc length `s`.
+type Piece<'a> = (f64, &'a dyn Fn(f64) -> (f64, f64));
+
 /// `n + 1` points at uniform arc length along a profile made of pieces, each a function of
 /// its own arc length `s ∈ [0, len]` (the pieces' lengths given).
-fn arc_profile(pieces: &[(f64, &dyn Fn(f64) -> (f64, f64))], n: usize) -> Vec<(f64, f64)> {
+fn arc_profile(pieces: &[Piece<'_>], n: usize) -> Vec<(f64, f64)> {
     let total: f64 = pieces.iter().map(|p| p.0).sum();
     (0..=n)
         .map(|k| {
