@@ -28,6 +28,7 @@ pub mod range_scan;
 pub mod reorient;
 pub mod shapes;
 pub mod tags;
+pub mod thin_shapes;
 pub mod twins;
 pub mod vec3;
 pub mod weld;
