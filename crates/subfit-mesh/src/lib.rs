@@ -22,6 +22,7 @@ mod edges;
 pub mod halfedge;
 pub mod ids;
 pub mod nonmanifold;
+pub mod parts;
 pub mod polygons;
 pub mod range_scan;
 pub mod reorient;
