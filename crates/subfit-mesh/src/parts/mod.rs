@@ -48,7 +48,14 @@ impl Part {
     /// An L-shaped angle bracket: the profile (0,0) (2,0) (2,1) (1,1) (1,2) (0,2) scaled by
     /// `size`, height `height`.
     pub fn l_bracket(size: f64, height: f64) -> Self {
-        let p = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 0.0], [2.0, 0.0], [2.0, 1.0]];
+        let p = [
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+        ];
         Self::prism(p.iter().map(|q| q.map(|c| c * size)).collect(), height)
     }
 
@@ -118,7 +125,10 @@ impl Part {
     /// If `chord` is not positive or the part's dimensions are not (see [`Profile`]).
     #[track_caller]
     pub fn tessellate(&self, chord: f64, max_edge: Option<f64>) -> PolyMesh {
-        assert!(chord > 0.0 && self.height > 0.0, "chord and height must be > 0");
+        assert!(
+            chord > 0.0 && self.height > 0.0,
+            "chord and height must be > 0"
+        );
         tessellate::extrude(&self.profile, self.height, chord, max_edge)
     }
 }

@@ -86,10 +86,9 @@ impl Profile {
             ),
             Self::Disc { radius: r } | Self::Annulus { outer: r, .. } => ([-r, -r], [*r, *r]),
             Self::RoundedRectangle { size, .. } => ([0.0; 2], *size),
-            Self::DrilledPlate { cells, cell, .. } => (
-                [0.0; 2],
-                [cells[0] as f64 * cell, cells[1] as f64 * cell],
-            ),
+            Self::DrilledPlate { cells, cell, .. } => {
+                ([0.0; 2], [cells[0] as f64 * cell, cells[1] as f64 * cell])
+            }
         }
     }
 }

@@ -94,6 +94,9 @@ fn the_distance_is_exact_on_simple_cases() {
     assert!((tube.distance([0.0, 0.0, 1.5]) - 0.6).abs() < 1e-15);
     assert!((tube.distance([0.8, 0.0, 1.5]) - 0.2).abs() < 1e-12);
     let plate = Part::drilled_plate([2, 1], 1.0, 0.25, 0.2);
-    assert!((plate.distance([1.5, 0.5, 0.1]) - 0.25).abs() < 1e-12, "hole axis");
+    assert!(
+        (plate.distance([1.5, 0.5, 0.1]) - 0.25).abs() < 1e-12,
+        "hole axis"
+    );
     assert!((plate.distance([1.5, 0.85, 0.1]) - 0.1).abs() < 1e-12);
 }
