@@ -123,6 +123,7 @@ pub(crate) fn given_cage(
             ..InitTimings::default()
         },
         curvature_lines: None,
+        cad: None,
     };
     Ok((normalized, tags.clone(), summary))
 }
@@ -174,6 +175,7 @@ pub(crate) fn init_summary(
             total: r.timings.total.as_secs_f64(),
         },
         curvature_lines: None,
+        cad: None,
     }
 }
 

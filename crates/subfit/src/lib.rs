@@ -27,6 +27,7 @@
 //! - [`report`]: two-sided distances, error colours, the limit tessellation, plots.
 
 mod budget_starts;
+pub mod cad_start;
 mod error;
 mod html_report;
 pub mod initial_cage;

@@ -164,6 +164,9 @@ pub struct InitSummary {
     /// keeps as crease and corner tags (`subfit_target::detect_features`). `None` otherwise.
     #[serde(default)]
     pub features: Option<FeatureSummary>,
+    /// The CAD tessellation start ([`crate::cad_start`]), when it built the cage.
+    #[serde(default)]
+    pub cad: Option<crate::cad_start::CadSummary>,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
     /// The curvature-line cage (`subfit_init::curvature_lines`) when it was built or tried:

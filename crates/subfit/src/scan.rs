@@ -341,13 +341,19 @@ pub(crate) fn fit_scan_from(
     step(Step::Init, &mut progress);
     let t_init = Instant::now();
     let budget = options.stages.max_control_points;
-    let mut feature_segments = None;
-    let (control, tags, init) = match &options.init {
-        InitialCage::Given {
-            mesh: c,
-            tags,
-            name: cname,
-        } => crate::initial_cage::given_cage(
+    // A CAD tessellation starts from its own features (crate::cad_start), or `None`.
+    let cad = crate::cad_start::cad_start(&target, &mesh, &name, options)?;
+    let mut feature_segments = cad.as_ref().map(|c| Arc::new(c.feature_segments.clone()));
+    let (control, tags, init) = match (&options.init, &cad) {
+        (_, Some(c)) => (c.cage.clone(), c.tags.clone(), c.init.clone()),
+        (
+            InitialCage::Given {
+                mesh: c,
+                tags,
+                name: cname,
+            },
+            None,
+        ) => crate::initial_cage::given_cage(
             &target,
             target_topology,
             &name,
@@ -358,10 +364,10 @@ pub(crate) fn fit_scan_from(
             options,
             &init_options,
         )?,
-        InitialCage::CurvatureLines => {
+        (InitialCage::CurvatureLines, None) => {
             crate::initial_cage::curvature_line_start(&target, &mesh, &name, options)?
         }
-        InitialCage::Auto | InitialCage::Qem => {
+        (InitialCage::Auto | InitialCage::Qem, None) => {
             let mut budget_start = None;
             let n = match options.control_points {
                 Some(n) if n > budget => {
@@ -497,16 +503,21 @@ pub(crate) fn fit_scan_from(
         ..options.fit.clone()
     };
 
-    let tolerance_kind = options
-        .target_tolerances
-        .then(|| ToleranceKind::of(target.stats(), &fit.tags, edge_count(&control.faces)));
-    let judged = match tolerance_kind {
+    let tolerance_kind = options.target_tolerances.then(|| match &cad {
+        Some(c) => c.kind,
+        None => ToleranceKind::of(target.stats(), &fit.tags, edge_count(&control.faces)),
+    });
+    let mut judged = match tolerance_kind {
         Some(kind) => {
             let diagonal = FootPointTerm::from_options(&target, &fit).bbox_diagonal();
             target_tolerances(&options.stages, kind, diagonal)
         }
         None => options.stages.clone(),
     };
+    if let Some(c) = &cad {
+        // No more control points than the tessellation has vertices.
+        judged.max_control_points = judged.max_control_points.min(c.max_control_points);
+    }
     let (stages, noise_floor) = noise_floored(&judged, target.stats());
     if let Some(t) = noise_floor {
         warn(

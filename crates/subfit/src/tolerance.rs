@@ -68,6 +68,9 @@ pub enum ToleranceKind {
     CadPart,
     /// [`SCAN_RMS`] without a maximum: a noisy scan.
     NoisyScan,
+    /// [`CAD_RMS`], [`CAD_MAX`] from the facets of a CAD tessellation
+    /// ([`crate::cad_start`]): the export is the part.
+    Tessellation,
 }
 
 impl ToleranceKind {
@@ -97,6 +100,7 @@ impl ToleranceKind {
             Self::Scan => "a scan",
             Self::CadPart => "a CAD part (sharp creases)",
             Self::NoisyScan => "a noisy scan",
+            Self::Tessellation => "a CAD tessellation (from its facets)",
         };
         let max = match self {
             Self::Scan => format!(
@@ -117,7 +121,7 @@ impl ToleranceKind {
     pub fn fractions(self) -> (f64, f64) {
         match self {
             Self::Scan => (SCAN_RMS, SCAN_MAX),
-            Self::CadPart => (CAD_RMS, CAD_MAX),
+            Self::CadPart | Self::Tessellation => (CAD_RMS, CAD_MAX),
             Self::NoisyScan => (SCAN_RMS, 0.0),
         }
     }

@@ -1,0 +1,214 @@
+//! The start of a CAD tessellation (DESIGN.md §2, "tessellation-aware CAD cages"): when the
+//! target is a mesh whose facets say it is a CAD export ([`subfit_target::tessellation`]) and
+//! has creases, its cage is built from its own features ([`subfit_init::cad_cage`]) instead of
+//! by QEM to a point count, and it is judged by the tessellation's tolerances.
+//!
+//! What the facets allow is decided here, from the tolerance the fit is judged by: an edge of a
+//! curved face may be smoothed when the smooth limit's predicted deviation from the facets
+//! (two thirds of its sag at most, 0.3 of it in RMS) stays within [`SAG_SHARE`] of the maximum
+//! tolerance and, summed over the surface, within [`RMS_SHARE`] of the RMS one; every other edge
+//! that turns is an infinitely sharp crease, which reproduces its facets exactly. So the
+//! default fit of a coarse export is the export itself, emptied of the vertices its planes do
+//! not need; a fine export's cylinders and fillets come out smooth.
+//!
+//! The hook is one call ([`cad_start`]) in [`crate::scan`]'s pipeline, before the QEM start:
+//! it returns `None` (the pipeline goes on as for any mesh) unless the start is automatic, no
+//! control-point count was asked, features are on, the target is a tessellation with creases
+//! and the cage fits the budget.
+
+use subfit_init::{cad_cage, CadOptions};
+use subfit_mesh::{PolyMesh, Tags};
+use subfit_target::tessellation::{classify_edges, EdgeClass, Facets, SmoothBudget};
+use subfit_target::Target;
+
+use crate::error::Error;
+use crate::pipeline_report::{face_counts, BoundaryLoops, InitSummary, InitTimings};
+use crate::scan::topology;
+use crate::tolerance::{ToleranceKind, CAD_MAX, CAD_RMS};
+use crate::{FitScanOptions, InitialCage};
+
+/// A smooth edge may sag by at most this share of the maximum tolerance: the smooth limit
+/// fitted to its facets lies within two thirds of the sag of them, so half the tolerance is
+/// left to the fit.
+pub const SAG_SHARE: f64 = 0.75;
+
+/// The smooth edges' predicted RMS deviation from the facets, over the whole surface, stays
+/// within this share of the RMS tolerance.
+pub const RMS_SHARE: f64 = 0.5;
+
+/// A smooth face's cage may lie this many sags (the largest of a smooth edge) off its facets
+/// after simplification: the fitted limit of a coarser polygon lies much closer than the
+/// polygon.
+pub const SMOOTH_CAGE_SAGS: f64 = 4.0;
+
+/// What the CAD start found and built (report.json `init.cad`).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CadSummary {
+    /// Share of the tessellation's interior edges that are flat (coplanar faces).
+    pub flat_edge_share: f64,
+    /// Planar regions of three faces or more.
+    pub planar_regions: usize,
+    /// Share of the triangles that are slivers.
+    pub sliver_share: f64,
+    /// The exporter's chord height read from the curved faces, fraction of the diagonal.
+    pub chord_height: f64,
+    /// Edges of the tessellation by class.
+    pub flat_edges: usize,
+    /// Edges a smooth limit may round.
+    pub smooth_edges: usize,
+    /// Edges tagged as creases.
+    pub crease_edges: usize,
+    /// Largest sag of a smooth edge, fraction of the diagonal.
+    pub smooth_sag: f64,
+    /// Predicted RMS deviation of the smooth faces from the facets, fraction of the diagonal.
+    pub predicted_rms: f64,
+    /// Vertices of the tessellation.
+    pub vertices: usize,
+    /// Corners locked before simplification.
+    pub locked_corners: usize,
+}
+
+/// The CAD start of a tessellation ([`cad_start`]).
+#[derive(Clone, Debug)]
+pub struct CadStart {
+    /// The cage, in the target's normalized units.
+    pub cage: PolyMesh,
+    /// Its crease and corner tags.
+    pub tags: Tags,
+    /// Its summary for the report (`init`, with `init.cad`).
+    pub init: InitSummary,
+    /// The tolerances it is judged by, with the target's tolerances.
+    pub kind: ToleranceKind,
+    /// The control points the fit may reach: the budget, at most the tessellation's vertices.
+    pub max_control_points: usize,
+    /// The crease edges of the tessellation as segments (normalized units), for the fit's
+    /// crease-curve term.
+    pub feature_segments: Vec<[[f64; 3]; 2]>,
+}
+
+/// The CAD start of `target`, built from `mesh` (the repaired input, original coordinates;
+/// see the module docs), or `None` when it does not apply. Errors: the cage cannot be built
+/// (the mesh is no oriented manifold), or the run was cancelled.
+pub fn cad_start(
+    target: &Target,
+    mesh: &PolyMesh,
+    name: &str,
+    options: &FitScanOptions,
+) -> Result<Option<CadStart>, Error> {
+    let applies = matches!(options.init, InitialCage::Auto)
+        && options.control_points.is_none()
+        && !options.as_points
+        && options.init_options.features.is_some();
+    let Some(recognised) = target
+        .facets()
+        .filter(|_| applies && !mesh.faces.is_empty())
+    else {
+        return Ok(None);
+    };
+    // The target merged coincident vertices again; the cage keeps the repaired mesh's own
+    // (split non-manifold vertices stay split).
+    let points: Vec<[f64; 3]> = mesh
+        .positions
+        .iter()
+        .map(|&p| target.to_normalized(p))
+        .collect();
+    let facets = &Facets::new(
+        &points,
+        &mesh.faces.triangulate_fan(),
+        recognised.flat_tolerance,
+    );
+    let points = &points[..];
+    let diagonal = subfit_mesh::bounding_box(points).map_or(1.0, |(lo, hi)| {
+        subfit_mesh::vec3::norm(subfit_mesh::vec3::sub(hi, lo))
+    });
+    let (rms, max) = if options.target_tolerances {
+        (CAD_RMS * diagonal, CAD_MAX * diagonal)
+    } else {
+        (options.stages.tolerance_rms, options.stages.tolerance_max)
+    };
+    // Without a maximum, the sag is bounded through the RMS (a strip deviates by 0.3 of it).
+    let max_sag = if max > 0.0 {
+        SAG_SHARE * max
+    } else {
+        RMS_SHARE * rms / 0.3
+    };
+    let budget = SmoothBudget {
+        max_sag,
+        max_rms: RMS_SHARE * rms,
+    };
+    let features = classify_edges(points, facets, &budget);
+    if features.count(EdgeClass::Crease) == 0 {
+        return Ok(None);
+    }
+    let cad_options = CadOptions {
+        smooth_error: SMOOTH_CAGE_SAGS * features.threshold,
+        max_control_points: options.stages.max_control_points,
+        cancel: options.cancel.clone(),
+    };
+    let (cage, tags, report) =
+        cad_cage(points, facets, &features, &cad_options).map_err(|e| match e {
+            subfit_init::InitError::Interrupted => Error::Interrupted,
+            e => Error::Init {
+                name: name.to_string(),
+                source: e,
+            },
+        })?;
+    if cage.num_vertices() > options.stages.max_control_points {
+        return Ok(None);
+    }
+    let topo = topology(&cage).map_err(|e| Error::input(name, e))?;
+    let stats = facets.stats(points);
+    let feature_segments = facets
+        .edges
+        .iter()
+        .zip(&features.class)
+        .filter(|(_, c)| **c == EdgeClass::Crease)
+        .map(|(e, _)| e.ends.map(|v| points[v as usize]))
+        .collect();
+    let (quads, triangles, quad_fraction) = face_counts(&cage.faces);
+    let init = InitSummary {
+        source: "CadTessellation".into(),
+        control_points: cage.num_vertices(),
+        faces: cage.faces.len(),
+        quads,
+        triangles,
+        quad_fraction,
+        genus_target: topo.genus,
+        genus: topo.genus,
+        genus_matches: true,
+        boundary_loops: BoundaryLoops {
+            target: topo.boundary_loops,
+            cage: topo.boundary_loops,
+        },
+        timings_s: InitTimings {
+            simplify: report.time.as_secs_f64(),
+            total: report.time.as_secs_f64(),
+            ..InitTimings::default()
+        },
+        cad: Some(CadSummary {
+            flat_edge_share: stats.flat_edge_share,
+            planar_regions: stats.planar_regions,
+            sliver_share: stats.sliver_share,
+            chord_height: features.chord_height / diagonal,
+            flat_edges: features.count(EdgeClass::Flat),
+            smooth_edges: features.count(EdgeClass::Smooth),
+            crease_edges: features.count(EdgeClass::Crease),
+            smooth_sag: features.threshold / diagonal,
+            predicted_rms: features.predicted_rms / diagonal,
+            vertices: report.vertices_before,
+            locked_corners: report.locked_corners,
+        }),
+        ..InitSummary::default()
+    };
+    Ok(Some(CadStart {
+        cage,
+        tags,
+        init,
+        kind: ToleranceKind::Tessellation,
+        max_control_points: options
+            .stages
+            .max_control_points
+            .min(report.vertices_before),
+        feature_segments,
+    }))
+}
