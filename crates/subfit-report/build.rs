@@ -8,6 +8,10 @@
 //! Without Node.js/npm the crate still builds: the viewer is replaced by a script that says
 //! so on the page, and `subfit_report::html::VIEWER_BUILT` is false — except under `CI=true`,
 //! where a missing viewer is a build error.
+//!
+//! All of this only with the cargo feature `viewer` (turned on by the crates that write
+//! report.html: the CLI and the Python package). Without it the build runs no npm and the
+//! page says the viewer was not built in: the fit engine and the library build without Node.js.
 
 use std::env;
 use std::fs;
@@ -23,16 +27,30 @@ fn main() {
     }
     println!("cargo:rerun-if-env-changed=SUBFIT_VIEWER_JS");
     let target = out.join("viewer.js");
-    let built = match bundle(&viewer, &out, &target) {
+    let bundled = if env::var_os("CARGO_FEATURE_VIEWER").is_some() {
+        bundle(&viewer, &out, &target)
+    } else {
+        Err("the cargo feature `viewer` of subfit-report was off".to_string())
+    };
+    let built = match bundled {
         Ok(()) => true,
         Err(why) => {
-            if env::var("CI").is_ok_and(|v| v == "true") {
+            let asked = env::var_os("CARGO_FEATURE_VIEWER").is_some();
+            if asked && env::var("CI").is_ok_and(|v| v == "true") {
                 panic!("the report viewer could not be bundled (CI=true): {why}");
             }
-            println!("cargo:warning=report.html will have no 3-D viewer: {why}");
+            if asked {
+                println!("cargo:warning=report.html will have no 3-D viewer: {why}");
+            }
             let note = format!(
                 "window.SUBFIT_VIEWER_MISSING = {:?};",
-                format!("This subfit was built without its 3-D viewer ({why}); install Node.js and npm and rebuild.")
+                if asked {
+                    format!("This subfit was built without its 3-D viewer ({why}); install Node.js and npm and rebuild.")
+                } else {
+                    format!(
+                        "This subfit was built without its 3-D viewer ({why}); rebuild with it on."
+                    )
+                }
             );
             fs::write(&target, note).expect("OUT_DIR is writable");
             false

@@ -136,6 +136,62 @@ pub enum BenchCommand {
     /// Fit generated deforming sequences (known correspondence: drift measured exactly) with
     /// and without the silhouette term; print per-frame errors, drift and time.
     Sequence(BenchSequenceArgs),
+    /// Fit every model of a corpus as a user would (defaults; its manifest.tsv, or every model
+    /// file of a plain folder), judge each result independently (exact two-sided distances to
+    /// the input) and print the scoreboard: per row exit, time, memory, control points, errors,
+    /// topology; per category the share within tolerance; regressions against a baseline.
+    Corpus(BenchCorpusArgs),
+}
+
+/// `subfit bench corpus`.
+#[derive(clap::Args, Debug)]
+pub struct BenchCorpusArgs {
+    /// The corpus: a folder with a manifest.tsv (categories scan, open, range, cad, cage, seq,
+    /// refused), or any folder of model files (each fitted with defaults) [default:
+    /// $SUBFIT_CORPUS].
+    pub dir: Option<PathBuf>,
+    /// Only these categories (repeat the flag).
+    #[arg(long = "category", value_name = "C")]
+    pub categories: Vec<String>,
+    /// Only these entries, by name (e.g. `scan-kitten`; repeat the flag).
+    #[arg(long = "entry", value_name = "NAME")]
+    pub entries: Vec<String>,
+    /// Entries fitted at once (each fit then gets cores / N threads).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub jobs: u32,
+    /// A fixed subset from every category, chosen by size: the two smallest inputs of each
+    /// fitted category, the smallest cage pair, the smallest sequence's first frames, every
+    /// read check.
+    #[arg(long)]
+    pub quick: bool,
+    /// The scoreboard as JSON; the Markdown tables are written beside it (same name, `.md`).
+    #[arg(long, default_value = "corpus-scoreboard.json")]
+    pub out: PathBuf,
+    /// Where each entry's runs and outputs are kept [default: beside --out, `NAME-runs/`].
+    #[arg(long)]
+    pub work: Option<PathBuf>,
+    /// A committed scoreboard to compare with: rows whose error is more than 10 % worse, whose
+    /// exit got worse or that no longer pass are error regressions; runs more than 25 % (and
+    /// 1 s) slower are time regressions [default: bench/corpus-baseline.json when it exists].
+    #[arg(long)]
+    pub baseline: Option<PathBuf>,
+    /// Exit with code 1 when an error regressed against the baseline (not on time).
+    #[arg(long)]
+    pub fail_on_regression: bool,
+    /// A folder made by tools/peers/peers.py (its peers.json): each peer's result is judged the
+    /// same way and set beside ours.
+    #[arg(long)]
+    pub peers: Option<PathBuf>,
+    /// Seconds one run may take before it is stopped (a row `timeout`).
+    #[arg(long, default_value_t = 900)]
+    pub timeout: u64,
+    /// Area-uniform samples of each limit surface the judge measures (at least 200,000 for
+    /// the scoreboard's figures).
+    #[arg(long, default_value_t = 200_000)]
+    pub surface_samples: usize,
+    /// The `subfit` executable to score [default: this one].
+    #[arg(long)]
+    pub subfit: Option<PathBuf>,
 }
 
 /// `subfit bench sequence`.

@@ -64,6 +64,30 @@ pub fn install() {
     });
 }
 
+/// Sends `signal` (`INT`, `TERM` or `HUP`) to this process, as a user's Ctrl-C or `kill`
+/// would, and returns once the handler has cancelled the [`token`] (or after 10 s at most,
+/// when no handler is installed): used by [`crate::progress::INTERRUPT_AT_ENV`] so tests
+/// interrupt a run at a named phase without racing it. Unix only (`kill`); elsewhere it does
+/// nothing but say so.
+pub fn raise(signal: &str) {
+    let sent = std::process::Command::new("kill")
+        .args([format!("-{signal}"), std::process::id().to_string()])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !sent {
+        eprintln!("subfit: could not send SIG{signal} to itself (kill -{signal})");
+        return;
+    }
+    // The handler runs on its own thread: wait for it, so the phase starts cancelled.
+    let token = token();
+    for _ in 0..10_000 {
+        if token.is_cancelled() {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}
+
 fn watched() -> MutexGuard<'static, Vec<Watched>> {
     // A panic while holding the lock cannot leave the list inconsistent: keep using it.
     WATCHED.lock().unwrap_or_else(|e| e.into_inner())

@@ -16,13 +16,34 @@ const BAR_THRESHOLD: u64 = 8 << 20;
 /// run is (e.g. to interrupt it in a given phase).
 pub const PHASE_LOG_ENV: &str = "SUBFIT_PHASE_LOG";
 
-/// Announces the start of a phase (see [`PHASE_LOG_ENV`]); spinners and bars call it.
+/// Environment variable for tests of the interruption: `SUBFIT_INTERRUPT_AT=PHASE[:SIGNAL]`
+/// makes the run send itself `SIGNAL` (`INT`, the default, `TERM` or `HUP`) when the phase
+/// named `PHASE` starts (the names [`PHASE_LOG_ENV`] prints), and go on once the signal handler
+/// has cancelled the run ([`crate::interrupt::raise`]): the whole signal path, from the
+/// handler to the exit code and the clean-up, at a known step and with no timing.
+pub const INTERRUPT_AT_ENV: &str = "SUBFIT_INTERRUPT_AT";
+
+/// Announces the start of a phase (see [`PHASE_LOG_ENV`], [`INTERRUPT_AT_ENV`]); spinners and
+/// bars call it.
 pub fn phase(name: &str) {
     static ON: OnceLock<bool> = OnceLock::new();
+    static AT: OnceLock<Option<(String, String)>> = OnceLock::new();
     let on = *ON
         .get_or_init(|| std::env::var_os(PHASE_LOG_ENV).is_some_and(|v| !v.is_empty() && v != "0"));
     if on {
         eprintln!("subfit: phase: {name}");
+    }
+    let at = AT.get_or_init(|| {
+        let v = std::env::var(INTERRUPT_AT_ENV)
+            .ok()
+            .filter(|v| !v.is_empty())?;
+        let (phase, signal) = v.rsplit_once(':').unwrap_or((&v, "INT"));
+        Some((phase.to_string(), signal.to_string()))
+    });
+    if let Some((phase, signal)) = at {
+        if phase == name {
+            crate::interrupt::raise(signal);
+        }
     }
 }
 
@@ -78,7 +99,8 @@ pub fn read_with_progress(path: &Path) -> Result<Vec<u8>, subfit::io::Error> {
     Ok(buf)
 }
 
-/// Reads and parses a mesh or point-cloud file, with progress for large files.
+/// Reads and parses a mesh or point-cloud file, with progress for large files; the reader's
+/// warnings are printed on stderr.
 pub fn load(
     path: &Path,
 ) -> Result<(subfit::mesh::PolyMesh, subfit::io::FileInfo), subfit::io::Error> {
@@ -88,5 +110,16 @@ pub fn load(
     if let Some(sp) = sp {
         sp.finish_and_clear();
     }
+    if let Ok((_, info)) = &out {
+        print_read_warnings(path, &info.warnings);
+    }
     out
+}
+
+/// Prints what a reader decided about a file it read ([`subfit::io::FileInfo::warnings`]) on
+/// stderr, one `subfit: warning: FILE: …` line each.
+pub fn print_read_warnings(path: &Path, warnings: &[String]) {
+    for w in warnings {
+        eprintln!("subfit: warning: {}: {w}", path.display());
+    }
 }

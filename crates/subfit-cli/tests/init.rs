@@ -200,8 +200,8 @@ fn bad_inputs_exit_with_2_and_leave_no_file() {
         &[&mobius, "--control-points", "4"],
         &[
             "mobius.obj",
-            "faces 0 and 7",
-            "inconsistent orientation",
+            "face 4",
+            "cannot be oriented consistently",
             "--from-points",
         ],
     );

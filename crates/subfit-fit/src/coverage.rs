@@ -96,6 +96,9 @@ pub struct Coverage {
     faces: Polygons,
     /// Sample rows on the tessellation's boundary.
     sample_boundary: Vec<bool>,
+    /// Whether a data point is on the boundary or has no normal ([`Self::any_pair_counts`]),
+    /// computed on first use.
+    data_pairs: std::sync::OnceLock<bool>,
     /// Tessellation neighbours of the boundary samples (empty elsewhere).
     rings: Vec<Vec<u32>>,
     /// The data's sharp feature curves, as points with their unit tangent and weight (see
@@ -247,6 +250,7 @@ impl Coverage {
             noisy: target.stats().is_noisy(),
             faces: Polygons::default(),
             sample_boundary: Vec::new(),
+            data_pairs: std::sync::OnceLock::new(),
             rings: Vec::new(),
             features: Vec::new(),
             crease_samples: Vec::new(),
@@ -400,10 +404,29 @@ impl Coverage {
         if m == 0 || self.points.is_empty() || self.sample_boundary.len() != m {
             return out;
         }
-        let Some(index) = PointIndex::new(xs) else {
-            return out;
-        };
         let sample_normals = vertex_normals(&self.faces, xs);
+        let spacing = mean_edge_length(&self.faces, xs);
+        // Where no data point can pull its nearest sample the search is skipped.
+        if self.any_pair_counts(&sample_normals) {
+            self.assign_pairs(xs, &sample_normals, spacing, &mut out);
+        }
+        self.assign_features(xs, spacing, &mut out);
+        out
+    }
+
+    /// The data points' part of [`Self::assign`]: every data point's pair with its nearest
+    /// sample (normals of the samples `sample_normals`, mean sample spacing `spacing`).
+    fn assign_pairs(
+        &self,
+        xs: &[[f64; 3]],
+        sample_normals: &[[f64; 3]],
+        spacing: f64,
+        out: &mut [Option<Box<CoverSum>>],
+    ) {
+        let m = xs.len();
+        let Some(index) = PointIndex::new(xs) else {
+            return;
+        };
         // Nearest sample and the normals' agreement of every data point.
         let pairs: Vec<(u32, f64, f64)> = self
             .points
@@ -418,7 +441,6 @@ impl Coverage {
                 )
             })
             .collect();
-        let spacing = mean_edge_length(&self.faces, xs);
         let orient: f64 = pairs.iter().map(|&(_, c, _)| c.signum()).sum();
         let s = if orient < 0.0 { -1.0 } else { 1.0 };
         let w = self.weight * m as f64 / self.points.len() as f64;
@@ -465,8 +487,26 @@ impl Coverage {
                 None => sum.add(self.points[j], (!point_to_point).then_some(plane), w * gate),
             }
         }
-        self.assign_features(xs, spacing, &mut out);
-        out
+    }
+
+    /// Whether any data point's pair with its nearest sample can count in [`Self::assign`]
+    /// (the samples' vertex normals `sample_normals`): a pair is skipped there unless the
+    /// cloud is noisy, interior pairs are on, it is point-to-point (a data point without a
+    /// normal or on the data's boundary, a sample without a normal, or a sample on the
+    /// surface's rim, the only place data can lie beyond it). When none of those can hold, no
+    /// pair counts, whichever sample is nearest: on a closed cage over closed, clean data the
+    /// nearest-sample search of every data point (a kd-tree over the samples and one query per
+    /// data point, every projection) is skipped with the same result. Cost O(#points) the
+    /// first time (cached per term), O(m) after.
+    fn any_pair_counts(&self, sample_normals: &[[f64; 3]]) -> bool {
+        let data = *self
+            .data_pairs
+            .get_or_init(|| self.boundary.iter().any(|&b| b) || self.normals.contains(&[0.0; 3]));
+        self.noisy
+            || self.interior
+            || data
+            || self.sample_boundary.iter().any(|&b| b)
+            || sample_normals.contains(&[0.0; 3])
     }
 
     /// The feature part of [`Self::assign`]: every data feature point pulls its nearest crease
@@ -561,6 +601,47 @@ mod tests {
             let fd = (s.energy(xp) - s.energy(xm)) / (4.0 * h);
             assert!((fd - r[a]).abs() < 1e-6, "{a}: {fd} vs {}", r[a]);
         }
+    }
+
+    /// The skipped search gives what the search gives: on a closed torus target with a
+    /// closed cage (clean data, every normal known) no data point's pair counts, so the full
+    /// pair pass assigns nothing; a coverage with interior pairs on does search.
+    #[test]
+    fn no_pair_counts_on_closed_clean_data() {
+        use subfit_mesh::shapes::torus_mesh;
+        use subfit_subdiv::{sampling_operator, Options, Scheme};
+        use subfit_target::{Target, TargetOptions};
+        let dense = torus_mesh(1.0, 0.35, 48, 24, true);
+        let target = Target::from_mesh(&dense, &TargetOptions::default()).unwrap();
+        let cage = torus_mesh(1.0, 0.1, 16, 6, true);
+        let cage_n: Vec<[f64; 3]> = cage
+            .positions
+            .iter()
+            .map(|&p| target.to_normalized(p))
+            .collect();
+        let op = sampling_operator(
+            &cage.faces,
+            cage.num_vertices(),
+            &subfit_mesh::Tags::new(),
+            &Options::new(Scheme::Loop),
+            2,
+        )
+        .unwrap();
+        let xs = op.position.apply(&cage_n);
+        let mut c = Coverage::new(&target, 1.0);
+        c.prepare(&op);
+        let normals = vertex_normals(&c.faces, &xs);
+        assert!(!c.any_pair_counts(&normals));
+        let mut full: Vec<Option<Box<CoverSum>>> = Vec::new();
+        full.resize_with(xs.len(), || None);
+        c.assign_pairs(&xs, &normals, mean_edge_length(&c.faces, &xs), &mut full);
+        assert!(full.iter().all(Option::is_none));
+        assert!(c.assign(&xs).iter().all(Option::is_none));
+        let mut inner = Coverage::new(&target, 1.0).with_interior(true);
+        inner.prepare(&op);
+        assert!(inner.any_pair_counts(&normals));
+        // The cage sits 0.25 inside the tube (several sample spacings): interior pairs pull.
+        assert!(inner.assign(&xs).iter().any(Option::is_some));
     }
 
     #[test]

@@ -40,7 +40,7 @@ use std::collections::HashMap;
 
 use subfit_mesh::{PolyMesh, Polygons, Tags};
 
-use subfit_report::PointToLimit;
+use subfit_measure::PointToLimit;
 use subfit_subdiv::SamplingOperator;
 
 use crate::error_field::{

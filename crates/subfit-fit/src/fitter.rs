@@ -38,6 +38,9 @@ struct State<S> {
     stats: ErrorStats,
 }
 
+/// A state over all samples with the control points it was evaluated at.
+type KeptState<S> = (Vec<[f64; 3]>, State<S>);
+
 /// What a step trial ends with: (accepted, the trial's state, step length, gain ratio).
 type Trial<S> = (bool, State<S>, f64, f64);
 
@@ -70,6 +73,11 @@ pub struct Fitter<'t, T: DataTerm = FootPointTerm<'t>> {
     /// The tessellation a [`FitOptions::surface_term`] sees (its own sampling operator at its
     /// level and the triangles of its faces).
     surface: Option<(SamplingOperator, Vec<[u32; 3]>)>,
+    /// The state over all samples at the control points [`Self::run`] returned, with those
+    /// points: a measurement or the next run at the same points reuses its projections
+    /// instead of projecting the same samples again (Cheng 2007 §II-B: one projection per
+    /// iteration).
+    last: Option<KeptState<T::Sample>>,
     /// The target (or whatever the term borrows) outlives the fitter.
     _data: PhantomData<&'t ()>,
 }
@@ -184,6 +192,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
             arap: (options.arap > 0.0).then(|| ArapState::Pending(faces.clone())),
             surface,
             op,
+            last: None,
             _data: PhantomData,
         })
     }
@@ -280,13 +289,19 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         control: &[[f64; 3]],
         data: &[[f64; 3]],
     ) -> (
-        subfit_report::TwoSided,
+        subfit_measure::TwoSided,
         Vec<f64>,
-        Vec<subfit_report::PointToLimit>,
+        Vec<subfit_measure::PointToLimit>,
     ) {
-        use subfit_report::{vertex_areas, DistanceStats, MeshDistance, TwoSided};
-        let samples = self.op.position.apply(control);
-        let err2 = self.squared_errors(&samples);
+        use subfit_measure::{vertex_areas, DistanceStats, MeshDistance, TwoSided};
+        let (samples, err2) = match self.last_at(control) {
+            Some(st) => (st.samples.clone(), self.state_errors(st)),
+            None => {
+                let samples = self.op.position.apply(control);
+                let err2 = self.squared_errors(&samples);
+                (samples, err2)
+            }
+        };
         let to_surface = MeshDistance::new(&samples, &self.op.faces).distances(data);
         let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
         let two = TwoSided {
@@ -315,6 +330,23 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         self.options.tolerance_rms = tolerance_rms;
         self.options.tolerance_max = tolerance_max;
         self.options.min_relative_decrease = stall;
+    }
+
+    /// The kept state over all samples ([`Self::last`]) when it was evaluated at `control`.
+    fn last_at(&self, control: &[[f64; 3]]) -> Option<&State<T::Sample>> {
+        self.last
+            .as_ref()
+            .filter(|(c, _)| c[..] == control[..])
+            .map(|(_, st)| st)
+    }
+
+    /// The squared error of every sample of `st` ([`DataTerm::squared_error`]), in order.
+    fn state_errors(&self, st: &State<T::Sample>) -> Vec<f64> {
+        st.samples
+            .par_iter()
+            .zip(st.projected.par_iter())
+            .map(|(&x, s)| self.term.squared_error(s, x))
+            .collect()
     }
 
     /// Squared errors of `samples` (e.g. `C·P`, or any points) from fresh projections
@@ -361,6 +393,9 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
     /// Errors of `control` (`n by 3`, normalized units) with fresh samples and projections.
     /// Cost: one `C·P` and one projection of the `m` samples.
     pub fn evaluate(&self, control: &[[f64; 3]]) -> ErrorStats {
+        if let Some(st) = self.last_at(control) {
+            return self.restat(control, st);
+        }
         let mut t = PhaseTimings::default();
         self.full_state(control, &mut t).stats
     }
@@ -407,6 +442,14 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 max,
             });
         }
+    }
+
+    /// The statistics of the state `st` over all samples at `control`, at the current options
+    /// (`λ`): the projections are kept, the sums are taken anew (O(m)).
+    fn restat(&self, control: &[[f64; 3]], st: &State<T::Sample>) -> ErrorStats {
+        let (objective, sum, max) = sums_d2(&self.term, &st.samples, &st.projected);
+        let surface = self.surface_value(control);
+        self.stats(control, objective + surface, sum, max)
     }
 
     /// The state at `control` over all samples.
@@ -490,7 +533,16 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         let opts = self.options.clone();
         self.ensure_arap(control)?;
         self.ensure_fixed(control);
-        let mut cur = self.state(control, &mut PhaseTimings::default());
+        // The last run's final state at these control points (a `λ` change keeps the cage
+        // and the topology) is reused: its samples need no second projection.
+        let kept = self.last.take().filter(|(c, _)| c[..] == control[..]);
+        let mut cur = match kept {
+            Some((_, mut st)) if self.active.is_none() => {
+                st.stats = self.restat(control, &st);
+                st
+            }
+            _ => self.state(control, &mut PhaseTimings::default()),
+        };
         check_finite(cur.stats.objective, 0, FitPhase::Evaluate, "objective")?;
         let mut report = FitReport {
             method: opts.method,
@@ -504,6 +556,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         };
         if self.reached(&cur.stats) {
             report.stop = StopReason::Tolerance;
+            self.keep(control, cur);
             return Ok(report);
         }
         if opts.optimizer != Optimizer::GaussNewton {
@@ -617,7 +670,16 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 break;
             }
         }
+        self.keep(control, cur);
         Ok(report)
+    }
+
+    /// Keeps `cur`, the state at `control`, for reuse ([`Self::last`]) when it is over all
+    /// samples (not an active set's).
+    fn keep(&mut self, control: &[[f64; 3]], cur: State<T::Sample>) {
+        if self.active.is_none() {
+            self.last = Some((control.to_vec(), cur));
+        }
     }
 
     /// Builds the ARAP regularizer, if on and not built yet, with the rest shape of the options

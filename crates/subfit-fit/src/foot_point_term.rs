@@ -241,13 +241,9 @@ impl<'t> FootPointTerm<'t> {
             }
         } else {
             // A point cloud: its edge by the angle criterion.
-            let rim = subfit_target::cloud_boundary_points(
-                self.target,
-                subfit_target::RIM_NEIGHBORS,
-                subfit_target::RIM_GAP,
-            );
+            let rim = self.target.cloud_rim();
             if rim.iter().any(|&b| b) {
-                self.rim = rim;
+                self.rim = rim.to_vec();
             }
         }
         self
@@ -294,12 +290,17 @@ impl<'t> FootPointTerm<'t> {
     }
 
     /// [`Self::foot_points`] warm-started: `hints` holds, per point, the nearest data point
-    /// found last time (resized to `xs.len()` with "no hint"; updated). Same results as
-    /// [`Self::foot_points`] (the quadric path certifies every warm-started nearest point or
-    /// falls back to the kd-tree; see [`Target::foot_points_hinted`]).
+    /// (a mesh target's closest triangle) found last time (resized to `xs.len()` with "no
+    /// hint"; updated). Same results as [`Self::foot_points`] (the quadric path certifies
+    /// every warm-started nearest point or falls back to the kd-tree, see
+    /// [`Target::foot_points_hinted`]; the mesh path only bounds its BVH search by the hint,
+    /// see [`Target::mesh_foot_points_hinted`]).
     fn foot_points_hinted(&self, xs: &[[f64; 3]], hints: &mut Vec<u32>) -> Vec<FootPoint> {
         match self.source {
-            FootPointSource::Auto if self.target.mesh().is_some() => self.foot_points(xs),
+            FootPointSource::Auto if self.target.mesh().is_some() => {
+                hints.resize(xs.len(), u32::MAX);
+                self.target.mesh_foot_points_hinted(xs, hints)
+            }
             _ => {
                 hints.resize(xs.len(), u32::MAX);
                 self.target.foot_points_hinted(xs, hints)

@@ -71,6 +71,7 @@ mod report;
 pub mod silhouette;
 mod smooth;
 mod solve;
+mod stage_flips;
 mod stage_refine;
 mod stages;
 mod surface_term;

@@ -27,7 +27,7 @@
 
 use std::time::Instant;
 
-use subfit_report::data_samples::DataSamples;
+use subfit_measure::data_samples::DataSamples;
 use subfit_target::Target;
 
 use crate::error::FitError;

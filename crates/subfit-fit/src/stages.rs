@@ -10,7 +10,7 @@
 //!
 //! Every stage ends with a measurement both ways (DESIGN.md decisions 11 and 12): the limit
 //! surface against the data (Cheng's measure) and the data against the limit surface (the
-//! tessellation of the fitter's samples, [`subfit_report::MeshDistance`]). Tolerances hold only when both do; faces
+//! tessellation of the fitter's samples, [`subfit_measure::MeshDistance`]). Tolerances hold only when both do; faces
 //! that miss in either direction are refined; the best cage measured is the one returned.
 //!
 //! Every scheme is refined; flips change pairs of triangles only (a quad's edge is never
@@ -18,10 +18,10 @@
 
 use std::time::{Duration, Instant};
 
+use subfit_measure::data_samples::{DataSamples, SampleKind};
+use subfit_measure::{data_samples, TwoSided};
 use subfit_mesh::{PolyMesh, Polygons, Tags};
-use subfit_report::data_samples::{DataSamples, SampleKind};
-use subfit_report::{data_samples, TwoSided};
-use subfit_subdiv::{sampling_operator, Scheme};
+use subfit_subdiv::Scheme;
 use subfit_target::Target;
 
 use crate::any_term::AnyTerm;
@@ -31,12 +31,10 @@ use crate::error_field::FIELD_THRESHOLD;
 use crate::fitter::Fitter;
 use crate::options::FitOptions;
 use crate::polish::polish_best;
-use crate::remesh::{
-    apply_flips, face_errors, face_owners, independent_flips, FaceError, RefineStats,
-};
+use crate::remesh::{face_errors, face_owners, FaceError, RefineStats};
 use crate::report::{ErrorStats, FitReport, IterationRow, StopReason};
+use crate::stage_flips::flip_pass;
 use crate::stage_refine::{refine_step, Splitter};
-use crate::term::DataTerm;
 
 /// Options of the stage driver; the per-iteration options (method, step control, sample
 /// level, scheme) come from a [`FitOptions`].
@@ -103,7 +101,7 @@ pub struct StageOptions {
     /// measured and reported either way.
     pub two_sided: bool,
     /// Data → surface samples of a mesh target, uniform by area (0 = as many as it has
-    /// points, at least [`subfit_report::data_samples::MIN_AREA_SAMPLES`]; a point cloud
+    /// points, at least [`subfit_measure::data_samples::MIN_AREA_SAMPLES`]; a point cloud
     /// always uses its points). Default 0.
     pub data_samples: usize,
     /// The error power of the last step, a polish of the best cage towards a lower maximum
@@ -575,7 +573,7 @@ pub(crate) struct Best {
 /// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
 /// After each stage's fit the cage is measured both ways (surface → data with fresh
-/// projections; data → surface from the target's data samples, [`subfit_report::data_samples()`],
+/// projections; data → surface from the target's data samples, [`subfit_measure::data_samples()`],
 /// to the tessellation of the limit samples); the tolerances are judged on both
 /// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
 /// direction, so data the surface leaves uncovered gets control points. The cage returned is
@@ -584,8 +582,10 @@ pub(crate) struct Best {
 /// optimized: no refinement or flip is made when no iteration or stage is left to fit it.
 ///
 /// Errors: those of [`Fitter::new`] and [`Fitter::run`]; invalid stage options. Cost: per topology one [`Fitter`] setup (sampling
-/// operator, symbolic analysis); per stage its iterations and one measurement (one projection
-/// of the samples, a BVH over their tessellation and one query per data sample); flips cost one more sampling operator and projection.
+/// operator, symbolic analysis); per stage its iterations and one measurement (the last
+/// iteration's projections reused, a BVH over the samples' tessellation and one query per data
+/// sample); flips cost one more sampling operator and a projection of the samples of the faces
+/// they change.
 pub fn fit_stages(
     target: &Target,
     mesh: &PolyMesh,
@@ -915,7 +915,7 @@ fn needed_growth(stages: &StageOptions, rms: f64, unmet: (bool, bool)) -> f64 {
 /// whole surface does not meet yet (`unmet`: RMS, max): once `E_rms` is within its tolerance,
 /// a face whose own RMS is above it needs no refinement for it (the budget goes where `E_max`
 /// is still missed).
-fn face_score(e: &FaceError, stages: &StageOptions, unmet: (bool, bool)) -> f64 {
+pub(crate) fn face_score(e: &FaceError, stages: &StageOptions, unmet: (bool, bool)) -> f64 {
     let mut s: f64 = 0.0;
     if unmet.0 {
         s = s.max(e.rms() / stages.tolerance_rms);
@@ -924,68 +924,6 @@ fn face_score(e: &FaceError, stages: &StageOptions, unmet: (bool, bool)) -> f64 
         s = s.max(e.max / stages.tolerance_max);
     }
     s
-}
-
-/// Tries independent edge flips on faces scoring above the tolerance with the current
-/// control points (no re-fit): a flip is kept when the squared surface → data error summed
-/// over the faces whose limit it changes goes down; the scores of those faces are updated.
-/// Returns (tried, kept).
-fn flip_pass(
-    term: &impl DataTerm,
-    mesh: &mut PolyMesh,
-    (surface, data): (&[FaceError], &[FaceError]),
-    score: &mut [f64],
-    stages: &StageOptions,
-    unmet: (bool, bool),
-    base: &FitOptions,
-) -> Result<(usize, usize), FitError> {
-    let mut flips = independent_flips(&mesh.faces, mesh.num_vertices(), score, 1.0);
-    // A crease stays where the features put it.
-    flips.retain(|f| base.tags.crease(f.a, f.b) == 0.0);
-    if flips.is_empty() {
-        return Ok((0, 0));
-    }
-    let flipped = apply_flips(&mesh.faces, &flips);
-    let op = sampling_operator(
-        &flipped,
-        mesh.num_vertices(),
-        &base.tags,
-        &base.subdivision(),
-        base.sample_level,
-    )?;
-    let samples = op.position.apply(&mesh.positions);
-    let new_errors = face_errors(&flipped, &op, &term.squared_errors(&samples));
-    // Faces incident to each vertex of the old mesh (the same faces are incident to a, b, c,
-    // d in both meshes).
-    let mut vf: Vec<Vec<u32>> = vec![Vec::new(); mesh.num_vertices()];
-    for (f, face) in mesh.faces.iter().enumerate() {
-        for &v in face {
-            vf[v as usize].push(f as u32);
-        }
-    }
-    let mut kept = Vec::new();
-    for fl in &flips {
-        let mut region: Vec<u32> = [fl.a, fl.b, fl.c, fl.d]
-            .iter()
-            .flat_map(|&v| vf[v as usize].iter().copied())
-            .collect();
-        region.sort_unstable();
-        region.dedup();
-        let before: f64 = region.iter().map(|&f| surface[f as usize].sum_sq).sum();
-        let after: f64 = region.iter().map(|&f| new_errors[f as usize].sum_sq).sum();
-        if after < before {
-            kept.push(*fl);
-            for &f in &region {
-                let f = f as usize;
-                score[f] = face_score(&new_errors[f], stages, unmet)
-                    .max(face_score(&data[f], stages, unmet));
-            }
-        }
-    }
-    if !kept.is_empty() {
-        mesh.faces = apply_flips(&mesh.faces, &kept);
-    }
-    Ok((flips.len(), kept.len()))
 }
 
 #[cfg(test)]

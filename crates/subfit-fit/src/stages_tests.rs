@@ -108,8 +108,8 @@ fn boundary_vertices_are_judged_by_their_own_tolerance() {
         ..StageOptions::default()
     };
     let two = TwoSided {
-        surface_to_data: subfit_report::DistanceStats::of(&[1.0, 2.0]),
-        data_to_surface: subfit_report::DistanceStats::of(&[1.0, 5.0, 4.0]),
+        surface_to_data: subfit_measure::DistanceStats::of(&[1.0, 2.0]),
+        data_to_surface: subfit_measure::DistanceStats::of(&[1.0, 5.0, 4.0]),
     };
     // The last distance (4.0) is a boundary vertex: judged as 8 against 7.
     let judged = judged_with_boundary(&two, &[4.0], &stages);
@@ -164,8 +164,8 @@ fn badness_counts_progress_on_either_missed_tolerance() {
         ..StageOptions::default()
     };
     let two = TwoSided {
-        surface_to_data: subfit_report::DistanceStats::of(&[0.0]),
-        data_to_surface: subfit_report::DistanceStats::of(&[0.0]),
+        surface_to_data: subfit_measure::DistanceStats::of(&[0.0]),
+        data_to_surface: subfit_measure::DistanceStats::of(&[0.0]),
     };
     let bad = |rms: f64, max: f64| {
         let e = ErrorStats {

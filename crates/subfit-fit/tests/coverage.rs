@@ -6,8 +6,8 @@
 use subfit_fit::{
     fit_stages, Coverage, DataTerm, FitOptions, Fitter, FootPointTerm, FootSample, StageOptions,
 };
+use subfit_measure::MeshDistance;
 use subfit_mesh::{PolyMesh, Polygons};
-use subfit_report::MeshDistance;
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 use subfit_target::{Target, TargetOptions};
 

@@ -9,9 +9,9 @@ mod common;
 use subfit_fit::{
     fit, DataTerm, FitOptions, FootPointSource, FootPointTerm, ImlsTerm, Method, StepControl,
 };
+use subfit_measure::{DistanceStats, MeshDistance, TwoSided};
 use subfit_mesh::shapes::Shape;
 use subfit_mesh::Tags;
-use subfit_report::{DistanceStats, MeshDistance, TwoSided};
 use subfit_subdiv::sampling_operator;
 use subfit_target::{Target, TargetOptions};
 

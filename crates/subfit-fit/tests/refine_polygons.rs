@@ -7,9 +7,9 @@ use std::collections::HashMap;
 
 use subfit_fit::internals::face_owners;
 use subfit_fit::{refine_polygons, PolyRefinement};
+use subfit_measure::MeshDistance;
 use subfit_mesh::shapes::{octahedron_mesh, torus_mesh};
 use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons, Tags, SHARPNESS_INFINITE};
-use subfit_report::MeshDistance;
 use subfit_subdiv::{sampling_operator, Options, Scheme};
 
 use common::quad_sphere;

@@ -383,11 +383,7 @@ impl Frame {
             band,
             root_level,
             dims,
-            rim: subfit_target::cloud_boundary_points(
-                target,
-                subfit_target::RIM_NEIGHBORS,
-                subfit_target::RIM_GAP,
-            ),
+            rim: target.cloud_rim().to_vec(),
         })
     }
 

@@ -59,7 +59,7 @@ fn bench(c: &mut Criterion) {
     for (name, bytes) in &cases {
         group.throughput(Throughput::Bytes(bytes.len() as u64));
         group.bench_function(*name, |b| {
-            b.iter(|| obj::read(black_box(bytes), path).expect("valid OBJ"))
+            b.iter(|| obj::read(black_box(bytes), path, &mut Vec::new()).expect("valid OBJ"))
         });
     }
     group.finish();

@@ -51,7 +51,7 @@ fn bench(c: &mut Criterion) {
     for (name, bytes) in &cases {
         group.throughput(Throughput::Bytes(bytes.len() as u64));
         group.bench_function(*name, |b| {
-            b.iter(|| ply::read(black_box(bytes), path).expect("valid PLY"))
+            b.iter(|| ply::read(black_box(bytes), path, &mut Vec::new()).expect("valid PLY"))
         });
     }
     group.finish();

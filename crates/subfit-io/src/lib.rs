@@ -9,8 +9,10 @@
 //! partial file is ever left behind.
 
 pub mod error;
+mod mni;
 pub mod obj;
 pub mod off;
+mod off_binary;
 pub mod ply;
 pub mod stl;
 pub mod tags_json;
@@ -31,11 +33,12 @@ pub enum Format {
     Ply,
     /// Wavefront OBJ (`v`, `vn`, `f`).
     Obj,
-    /// Object File Format (OFF, COFF, NOFF, CNOFF).
+    /// Object File Format (OFF, COFF, NOFF, CNOFF…; text or binary).
     Off,
     /// Stereolithography (ascii or binary; triangles, vertices welded on reading).
     Stl,
-    /// Point list: `x y z` or `x y z nx ny nz` per line (`.xyz`, `.pts`, `.txt`).
+    /// Point list: `x y z` per line with optional normal, colour or intensity columns, or
+    /// `p x y z` statements (`.xyz`, `.pts`, `.txt`; see [`xyz`]).
     Xyz,
 }
 
@@ -47,7 +50,7 @@ pub enum Encoding {
     Ascii,
     /// Binary, little-endian.
     BinaryLittleEndian,
-    /// Binary, big-endian (PLY only).
+    /// Binary, big-endian (PLY; binary OFF on reading).
     BinaryBigEndian,
 }
 
@@ -169,6 +172,11 @@ pub struct FileInfo {
     pub encoding: Encoding,
     /// Size of the file in bytes.
     pub bytes: u64,
+    /// What the reader decided or skipped in a file it still read, one sentence each, for the
+    /// caller to show (columns taken as colours rather than normals, unknown header lines
+    /// skipped, normals averaged, a file read as another variant of its format…). Each names
+    /// the line or element it concerns where there is one; the file path is not repeated.
+    pub warnings: Vec<String>,
 }
 
 /// Options for reading.
@@ -221,12 +229,17 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
     if bytes.is_empty() {
         return Err(Error::file(path, ErrorKind::Empty));
     }
+    let mut warnings = Vec::new();
+    let w = &mut warnings;
     let (mesh, encoding) = match format {
-        Format::Ply => ply::read(bytes, path)?,
-        Format::Obj => (obj::read(bytes, path)?, Encoding::Ascii),
-        Format::Off => (off::read(bytes, path)?, Encoding::Ascii),
+        Format::Ply => ply::read(bytes, path, w)?,
+        // An MNI surface is the one other `.obj` found in the wild; its first statement (`P`)
+        // is not Wavefront's, so the content decides unambiguously.
+        Format::Obj if mni::is_mni(bytes) => (mni::read(bytes, path, w)?, Encoding::Ascii),
+        Format::Obj => (obj::read(bytes, path, w)?, Encoding::Ascii),
+        Format::Off => off::read(bytes, path, w)?,
         Format::Stl => stl::read(bytes, path, opts.weld_stl)?,
-        Format::Xyz => (xyz::read(bytes, path)?, Encoding::Ascii),
+        Format::Xyz => (xyz::read(bytes, path, w)?, Encoding::Ascii),
     };
     Ok((
         mesh,
@@ -234,6 +247,7 @@ pub fn read_bytes(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<(Poly
             format,
             encoding,
             bytes: bytes.len() as u64,
+            warnings,
         },
     ))
 }

@@ -1,24 +1,32 @@
-//! Wavefront OBJ: polygon meshes and point clouds as text.
+//! Wavefront OBJ: polygon meshes and point clouds as text (the format of Wavefront's Advanced
+//! Visualizer manual, Appendix B1, "Object Files").
 //!
 //! Supported on reading:
 //! - `v x y z`, `v x y z w` (the weight `w` is validated and ignored) and the common colour
 //!   extension `v x y z r g b` (floats in 0..1, clamped, rounded to 8 bits). Colours are kept only
 //!   when *every* vertex has them; otherwise they are dropped.
 //! - `vn x y z`; `vt u [v [w]]` (validated, then ignored: subfit has no texture coordinates).
-//! - `f` with corners `v`, `v/vt`, `v//vn`, `v/vt/vn`; negative indices count back from the
-//!   last element defined so far; positive ones may refer forward (they are checked once the
-//!   whole file is read). Faces need at least three corners; polygons of any size are kept.
+//! - `f` with corners `v`, `v/vt`, `v//vn`, `v/vt/vn`, and the same with empty trailing slots
+//!   (`v/`, `v//`, `v/vt/`, as some exporters write them); faces with and without `vt` may be
+//!   mixed. Negative indices count back from the last element defined so far; positive ones
+//!   may refer forward (they are checked once the whole file is read). Faces need at least
+//!   three corners; polygons of any size are kept.
 //! - Comments from `#` to the end of the line, and line continuation with a trailing `\`.
-//!   Every line, comments included, must be UTF-8 (an error names the line and column).
+//! - Lines are bytes: comments, names (`o`, `g`, `usemtl`, `mtllib`) and every other statement
+//!   that carries no geometry may hold any bytes (old exporters wrote names in Latin-1 or
+//!   code pages); the statements that are read (`v`, `vn`, `vt`, `f`) must be ASCII numbers.
 //! - `l`, `p`, `o`, `g`, `s`, `usemtl`, `mtllib` and the free-form geometry statements
 //!   (`vp`, `curv`, `surf`, `cstype`…) are ignored. Any other statement is a syntax error.
 //!
-//! Normals: OBJ normals belong to face corners, subfit's to vertices. When every vertex is
-//! used with exactly one normal (the same `vn` index, or `vn` entries with bit-identical
-//! values, at all of its corners, and every vertex has one), the result has per-vertex normals.
-//! Otherwise (split normals at creases, corners without a normal, vertices used by no face)
-//! normals are dropped. When no corner refers to a normal and there are exactly as many `vn` as
-//! `v` (a point cloud with normals), they are paired in order.
+//! Normals: OBJ normals belong to face corners, subfit's to vertices. Each vertex takes the
+//! normals of its corners: the `vn` itself when all of them name the same normal (the same
+//! index, or bit-identical values), otherwise the normalized mean of its corners' normals
+//! (each normalized first; the first corner's normal where they cancel) — a vertex on a crease
+//! exported with split normals gets the direction between its faces — with a warning counting
+//! such vertices. Corners without a normal are passed over (warned). When some vertex has no
+//! normal at all (used by no face, or only by corners without one) normals are dropped, with
+//! a warning. When no corner refers to a normal and there are exactly as many `vn` as `v` (a
+//! point cloud with normals), they are paired in order.
 //!
 //! Tags: OpenSubdiv's OBJ tag statements (the `t` lines of its `shape_utils` reader and of
 //! Hbr's test shapes), `t crease 2/1/0 a b sharpness` and `t corner 1/1/0 v sharpness` with
@@ -27,7 +35,8 @@
 //! creases).
 //!
 //! Dropped: texture coordinates, groups, materials, smoothing groups, lines, points, free-form
-//! geometry. A file without any `v` is [`ErrorKind::Empty`].
+//! geometry. A file without any `v` is [`ErrorKind::Empty`]. An MNI surface file with an
+//! `.obj` extension is read by the registry's MNI reader, not this one.
 //!
 //! Writing: `v` with the shortest decimal that reads back to the same f64, `vn` when the mesh has
 //! normals, `f` with 1-based indices (`a//a` when there are normals). Colours are not written.
@@ -37,77 +46,80 @@ use std::path::Path;
 use subfit_mesh::{PolyMesh, Polygons, Tags};
 
 use crate::error::{Error, ErrorKind, Result};
-use crate::text::{parse_int, push_f64_exact, push_u64, syntax, unit_to_u8, NumberedLines};
+use crate::text::{
+    finite_f64, parse_int, push_f64_exact, push_u64, strip_hash_comment, syntax, tokens,
+    unit_to_u8, NumberedLines,
+};
 
 /// Marks a corner without a normal, or a vertex without one.
 const NONE: u32 = u32::MAX;
 
 /// Statements that are read and ignored.
-const IGNORED: &[&str] = &[
-    "t",
-    "l",
-    "p",
-    "o",
-    "g",
-    "s",
-    "usemtl",
-    "mtllib",
-    "vp",
-    "cstype",
-    "deg",
-    "bmat",
-    "step",
-    "curv",
-    "curv2",
-    "surf",
-    "parm",
-    "trim",
-    "hole",
-    "scrv",
-    "sp",
-    "end",
-    "con",
-    "mg",
-    "lod",
-    "usemap",
-    "maplib",
-    "shadow_obj",
-    "trace_obj",
-    "ctech",
-    "stech",
-    "bevel",
-    "c_interp",
-    "d_interp",
-    "call",
-    "csh",
+const IGNORED: &[&[u8]] = &[
+    b"t",
+    b"l",
+    b"p",
+    b"o",
+    b"g",
+    b"s",
+    b"usemtl",
+    b"mtllib",
+    b"vp",
+    b"cstype",
+    b"deg",
+    b"bmat",
+    b"step",
+    b"curv",
+    b"curv2",
+    b"surf",
+    b"parm",
+    b"trim",
+    b"hole",
+    b"scrv",
+    b"sp",
+    b"end",
+    b"con",
+    b"mg",
+    b"lod",
+    b"usemap",
+    b"maplib",
+    b"shadow_obj",
+    b"trace_obj",
+    b"ctech",
+    b"stech",
+    b"bevel",
+    b"c_interp",
+    b"d_interp",
+    b"call",
+    b"csh",
 ];
 
-/// Parses a whole OBJ file.
+/// Parses a whole OBJ file; what was decided about normals goes to `warnings`.
 ///
 /// Cost: O(file size) time; memory proportional to the data actually present.
-/// Errors: non-UTF-8 text, syntax errors (quoting the token), NaN/infinite values, zero or
-/// out-of-range indices (with their line), faces with fewer than three corners, no vertices.
-pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
+/// Errors: syntax errors (quoting the token), NaN/infinite values, zero or out-of-range
+/// indices (with their line), faces with fewer than three corners, no vertices.
+pub fn read(bytes: &[u8], path: &Path, warnings: &mut Vec<String>) -> Result<PolyMesh> {
     let mut p = Parser::new(path, bytes.len());
-    let mut lines = NumberedLines::new(bytes).map(|(no, raw)| (no, utf8_line(raw, no, path)));
-    let mut joined = String::new();
-    while let Some((no, text)) = lines.next() {
-        let line = strip_comment(text?);
+    let mut lines = NumberedLines::new(bytes);
+    let mut joined = Vec::new();
+    while let Some((no, raw)) = lines.next() {
+        let line = strip_hash_comment(raw);
         match continued(line) {
             None => p.statement(no, line)?,
             Some(head) => {
                 joined.clear();
-                joined.push_str(head);
-                joined.push(' ');
+                joined.extend_from_slice(head);
+                joined.push(b' ');
                 for (_, next) in lines.by_ref() {
-                    let next = strip_comment(next?);
+                    let next = strip_hash_comment(next);
                     match continued(next) {
                         Some(h) => {
-                            joined.push_str(h);
-                            joined.push(' ');
+                            joined.extend_from_slice(h);
+                            joined.push(b' ');
                         }
                         None => {
-                            joined.push_str(next);
+                            joined.extend_from_slice(next);
                             break;
                         }
                     }
@@ -116,52 +128,16 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
             }
         }
     }
-    p.finish()
-}
-
-/// A line as text: validated once here, so that number tokens need no further check.
-fn utf8_line<'a>(raw: &'a [u8], no: u64, path: &Path) -> Result<&'a str> {
-    std::str::from_utf8(raw).map_err(|e| {
-        let at = e.valid_up_to();
-        let bad = &raw[at..raw.len().min(at + 4)];
-        Error::at_line(
-            path,
-            no,
-            ErrorKind::Syntax(format!(
-                "not UTF-8 text (column {}: {bad:02x?}); is this a binary file?",
-                at + 1
-            )),
-        )
-    })
-}
-
-/// Cuts a line at `#`.
-fn strip_comment(line: &str) -> &str {
-    line.split('#').next().unwrap_or_default()
+    p.finish(warnings)
 }
 
 /// If `line` ends with a continuation backslash (before trailing blanks), the part before it.
-fn continued(line: &str) -> Option<&str> {
-    line.trim_end_matches(|c: char| c.is_ascii_whitespace())
-        .strip_suffix('\\')
-}
-
-/// Parses a number token that must be finite (errors as [`crate::text`]'s `finite_f64`).
-fn float(tok: &str, path: &Path, no: u64, what: &str) -> Result<f64> {
-    match tok.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(Error::at_line(
-            path,
-            no,
-            ErrorKind::NonFinite(format!("{what} `{tok}`")),
-        )),
-        Err(_) => Err(syntax(
-            path,
-            no,
-            &format!("expected a number ({what})"),
-            tok.as_bytes(),
-        )),
-    }
+fn continued(line: &[u8]) -> Option<&[u8]> {
+    let end = line
+        .iter()
+        .rposition(|c| !c.is_ascii_whitespace())
+        .map_or(0, |i| i + 1);
+    line[..end].strip_suffix(b"\\")
 }
 
 /// Reading state: everything seen so far.
@@ -220,34 +196,29 @@ impl<'p> Parser<'p> {
         }
     }
 
-    fn statement(&mut self, no: u64, line: &str) -> Result<()> {
-        let mut toks = line.split_ascii_whitespace();
+    fn statement(&mut self, no: u64, line: &[u8]) -> Result<()> {
+        let mut toks = tokens(line);
         let Some(kw) = toks.next() else {
             return Ok(());
         };
         match kw {
-            "v" => self.vertex(no, toks),
-            "vn" => {
+            b"v" => self.vertex(no, toks),
+            b"vn" => {
                 let n = self.triple(no, &mut toks, "normal component")?;
                 self.no_more(no, toks, "`vn` takes 3 numbers")?;
                 self.normals.push(n);
                 Ok(())
             }
-            "vt" => self.texcoord(no, toks),
-            "f" | "fo" => self.face(no, toks),
+            b"vt" => self.texcoord(no, toks),
+            b"f" | b"fo" => self.face(no, toks),
             _ if IGNORED.contains(&kw) => Ok(()),
-            _ => Err(syntax(
-                self.path,
-                no,
-                "unknown OBJ statement",
-                kw.as_bytes(),
-            )),
+            _ => Err(syntax(self.path, no, "unknown OBJ statement", kw)),
         }
     }
 
-    fn number(&self, no: u64, tok: Option<&str>, what: &str) -> Result<f64> {
+    fn number(&self, no: u64, tok: Option<&[u8]>, what: &str) -> Result<f64> {
         match tok {
-            Some(t) => float(t, self.path, no, what),
+            Some(t) => finite_f64(t, self.path, no, what),
             None => Err(Error::at_line(
                 self.path,
                 no,
@@ -259,7 +230,7 @@ impl<'p> Parser<'p> {
     fn triple<'a>(
         &self,
         no: u64,
-        toks: &mut impl Iterator<Item = &'a str>,
+        toks: &mut impl Iterator<Item = &'a [u8]>,
         what: &str,
     ) -> Result<[f64; 3]> {
         Ok([
@@ -272,21 +243,16 @@ impl<'p> Parser<'p> {
     fn no_more<'a>(
         &self,
         no: u64,
-        mut toks: impl Iterator<Item = &'a str>,
+        mut toks: impl Iterator<Item = &'a [u8]>,
         what: &str,
     ) -> Result<()> {
         match toks.next() {
-            Some(t) => Err(syntax(
-                self.path,
-                no,
-                &format!("extra value ({what})"),
-                t.as_bytes(),
-            )),
+            Some(t) => Err(syntax(self.path, no, &format!("extra value ({what})"), t)),
             None => Ok(()),
         }
     }
 
-    fn vertex<'a>(&mut self, no: u64, mut toks: impl Iterator<Item = &'a str>) -> Result<()> {
+    fn vertex<'a>(&mut self, no: u64, mut toks: impl Iterator<Item = &'a [u8]>) -> Result<()> {
         if self.positions.len() >= NONE as usize {
             return Err(Error::at_line(
                 self.path,
@@ -303,10 +269,10 @@ impl<'p> Parser<'p> {
                     self.path,
                     no,
                     "extra value (`v` takes x y z, x y z w or x y z r g b)",
-                    t.as_bytes(),
+                    t,
                 ));
             }
-            extra[n] = float(t, self.path, no, "vertex weight or colour")?;
+            extra[n] = finite_f64(t, self.path, no, "vertex weight or colour")?;
             n += 1;
         }
         let color = match n {
@@ -330,7 +296,7 @@ impl<'p> Parser<'p> {
         Ok(())
     }
 
-    fn texcoord<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a str>) -> Result<()> {
+    fn texcoord<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a [u8]>) -> Result<()> {
         let mut n = 0;
         for t in toks {
             if n == 3 {
@@ -338,10 +304,10 @@ impl<'p> Parser<'p> {
                     self.path,
                     no,
                     "extra value (`vt` takes 1 to 3 numbers)",
-                    t.as_bytes(),
+                    t,
                 ));
             }
-            float(t, self.path, no, "texture coordinate")?;
+            finite_f64(t, self.path, no, "texture coordinate")?;
             n += 1;
         }
         if n == 0 {
@@ -355,20 +321,21 @@ impl<'p> Parser<'p> {
         Ok(())
     }
 
-    fn face<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a str>) -> Result<()> {
+    fn face<'a>(&mut self, no: u64, toks: impl Iterator<Item = &'a [u8]>) -> Result<()> {
         self.face_buf.clear();
         self.normal_buf.clear();
         for corner in toks {
-            let mut parts = corner.split('/');
+            let mut parts = corner.split(|&c| c == b'/');
             let v = parts.next().unwrap_or_default();
             let vt = parts.next().unwrap_or_default();
             let vn = parts.next().unwrap_or_default();
-            if parts.next().is_some() || v.is_empty() || (vt.is_empty() && corner.ends_with('/')) {
+            // Empty trailing slots (`1/`, `1//`, `1/2/`) are accepted: they say "none".
+            if parts.next().is_some() || v.is_empty() {
                 return Err(syntax(
                     self.path,
                     no,
                     "bad face corner (expected v, v/vt, v//vn or v/vt/vn)",
-                    corner.as_bytes(),
+                    corner,
                 ));
             }
             let vi = self.resolve(no, v, Target::Vertex)?;
@@ -407,15 +374,10 @@ impl<'p> Parser<'p> {
 
     /// Turns a 1-based or negative index token into a 0-based index. Positive indices past the
     /// current count are allowed here (forward references) and checked in [`Parser::finish`].
-    fn resolve(&mut self, no: u64, tok: &str, target: Target) -> Result<u32> {
+    fn resolve(&mut self, no: u64, tok: &[u8], target: Target) -> Result<u32> {
         let what = target.name();
-        let Some(i) = parse_int(tok.as_bytes()) else {
-            return Err(syntax(
-                self.path,
-                no,
-                &format!("bad {what} index"),
-                tok.as_bytes(),
-            ));
+        let Some(i) = parse_int(tok) else {
+            return Err(syntax(self.path, no, &format!("bad {what} index"), tok));
         };
         let count = match target {
             Target::Vertex => self.positions.len() as u64,
@@ -441,7 +403,7 @@ impl<'p> Parser<'p> {
                 self.path,
                 no,
                 &format!("{what} index 0 (OBJ indices start at 1; negative ones count back)"),
-                tok.as_bytes(),
+                tok,
             ));
         }
         if i < 0 {
@@ -462,7 +424,7 @@ impl<'p> Parser<'p> {
         Ok((i - 1) as u32)
     }
 
-    fn finish(self) -> Result<PolyMesh> {
+    fn finish(self, warnings: &mut Vec<String>) -> Result<PolyMesh> {
         let counts = [
             self.positions.len() as u64,
             self.texcoords,
@@ -503,6 +465,7 @@ impl<'p> Parser<'p> {
             &self.normals,
             self.faces.indices(),
             &self.corner_normals,
+            warnings,
         );
         let colors = (self.colored == self.positions.len()).then_some(self.colors);
         Ok(PolyMesh {
@@ -514,39 +477,93 @@ impl<'p> Parser<'p> {
     }
 }
 
-/// Per-vertex normals from per-corner normal indices, when they are consistent (see the module
-/// documentation); `None` otherwise. All indices are already validated.
+/// Per-vertex normals from per-corner normal indices (see the module documentation for the
+/// rule); `None`, with a warning, when some vertex has none. All indices are already validated.
+/// Cost: O(#corners + #V).
 fn vertex_normals(
     nv: usize,
     normals: &[[f64; 3]],
     corners: &[u32],
     corner_normals: &[u32],
+    warnings: &mut Vec<String>,
 ) -> Option<Vec<[f64; 3]>> {
     if normals.is_empty() {
         return None;
     }
     if corner_normals.iter().all(|&n| n == NONE) {
-        return (normals.len() == nv).then(|| normals.to_vec());
+        if normals.len() == nv {
+            return Some(normals.to_vec());
+        }
+        warnings.push(format!(
+            "{} `vn` normals, none used by a face corner and not one per vertex ({nv}): \
+             normals dropped",
+            normals.len()
+        ));
+        return None;
     }
-    let mut of_vertex = vec![NONE; nv];
     let same = |a: u32, b: u32| {
         a == b || normals[a as usize].map(f64::to_bits) == normals[b as usize].map(f64::to_bits)
     };
+    // The first normal of each vertex, whether another differs, and the sum of unit normals.
+    let mut first = vec![NONE; nv];
+    let mut mixed = vec![false; nv];
+    let mut sum = vec![[0.0f64; 3]; nv];
+    let mut bare_corners = 0usize;
     for (&v, &n) in corners.iter().zip(corner_normals) {
         if n == NONE {
-            return None;
+            bare_corners += 1;
+            continue;
         }
-        let slot = &mut of_vertex[v as usize];
-        if *slot == NONE {
-            *slot = n;
-        } else if !same(*slot, n) {
-            return None;
+        let v = v as usize;
+        if first[v] == NONE {
+            first[v] = n;
+        } else if !same(first[v], n) {
+            mixed[v] = true;
+        }
+        let u = unit(normals[n as usize]).unwrap_or([0.0; 3]);
+        for k in 0..3 {
+            sum[v][k] += u[k];
         }
     }
-    of_vertex
-        .iter()
-        .map(|&n| (n != NONE).then(|| normals[n as usize]))
-        .collect()
+    let without = first.iter().filter(|&&n| n == NONE).count();
+    if without > 0 {
+        warnings.push(format!(
+            "{without} of {nv} vertices have no normal (used by no face, or only by corners \
+             without `vn`): normals dropped"
+        ));
+        return None;
+    }
+    if bare_corners > 0 {
+        warnings.push(format!(
+            "{bare_corners} face corners have no `vn`; their vertices take the normals of \
+             their other corners"
+        ));
+    }
+    let averaged = mixed.iter().filter(|&&m| m).count();
+    if averaged > 0 {
+        warnings.push(format!(
+            "{averaged} vertices have corners with different normals (per-face or split \
+             normals): each takes the normalized mean of its corners' normals"
+        ));
+    }
+    Some(
+        (0..nv)
+            .map(|v| {
+                let own = normals[first[v] as usize];
+                if mixed[v] {
+                    unit(sum[v]).unwrap_or(own)
+                } else {
+                    own
+                }
+            })
+            .collect(),
+    )
+}
+
+/// `v / |v|`, or `None` when `v` is zero or not finite.
+fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    (len > 0.0 && len.is_finite()).then(|| v.map(|c| c / len))
 }
 
 /// Writes a mesh as OBJ (see the module documentation for what is written).
@@ -597,11 +614,15 @@ pub fn write_with_tags(mesh: &PolyMesh, tags: &Tags, out: &mut Vec<u8>) -> std::
 pub fn read_tags(bytes: &[u8], path: &Path, num_vertices: usize) -> Result<Tags> {
     let mut tags = Tags::new();
     for (no, raw) in NumberedLines::new(bytes) {
-        let line = strip_comment(utf8_line(raw, no, path)?);
-        let mut tok = line.split_ascii_whitespace();
-        if tok.next() != Some("t") {
+        let line = strip_hash_comment(raw);
+        if tokens(line).next() != Some(&b"t"[..]) {
             continue;
         }
+        // A tag line is read as text; other lines may hold any bytes (see the module doc).
+        let line = std::str::from_utf8(line)
+            .map_err(|_| syntax(path, no, "a `t` tag line that is not UTF-8 text", line))?;
+        let mut tok = line.split_ascii_whitespace();
+        tok.next();
         let name = tok.next().unwrap_or_default();
         let wanted = match name {
             "crease" => 2,

@@ -1,18 +1,23 @@
-//! Object File Format (Geomview OFF) as text.
+//! Object File Format (Geomview OFF; the Geomview manual, "OFF Files"), text and binary.
 //!
 //! Supported on reading:
 //! - The header keyword `[ST][C][N]OFF` (`OFF`, `COFF`, `NOFF`, `CNOFF`, `NCOFF`, `STOFF`…),
-//!   alone on its line or followed by the counts; the keyword may also be missing (the file
-//!   starts with the counts). `4OFF`, `nOFF` (other dimensions) and `OFF BINARY` are
-//!   [`ErrorKind::Unsupported`].
+//!   alone on its line or followed by the counts, also glued to them (`OFF8 6 12`); the keyword
+//!   may also be missing (the file starts with the counts). `4OFF` and `nOFF` (other
+//!   dimensions) are [`ErrorKind::Unsupported`].
+//! - `[ST][C][N]OFF BINARY`: binary OFF (32-bit counts, floats and indices after the header
+//!   line), big- or little-endian, with or without a colour count after each face: the one
+//!   combination that accounts for every byte is taken, with a warning when it is not the
+//!   spec's (big-endian with colour counts). Its encoding is reported as binary.
 //! - Counts `V F [E]` (the edge count is ignored), on the header line or the next one.
 //! - One vertex per line: `x y z [nx ny nz] [r g b [a]] [s t]`, in that order, with the
 //!   normal when the keyword has `N`, the colour when it has `C`, texture coordinates (ignored)
 //!   when it has `ST`. Colours are 3 or 4 values: integers in 0..255, or floats in 0..1 when
 //!   any of them is written with a `.` or an exponent; alpha is dropped and values are clamped.
-//! - One face per line: `n i1 … in`, 0-based indices, `n >= 3`, optionally followed by up to
-//!   four colour values, which are ignored.
-//! - `#` comments anywhere (to the end of the line) and blank lines.
+//! - Faces `n i1 … in`, 0-based indices, `n >= 3`; a face starts on a new line and its indices
+//!   may continue on the following lines until `n` are read; the rest of the line holding the
+//!   last index may be up to four colour values, which are ignored.
+//! - `#` comments anywhere (to the end of the line; they may hold any bytes) and blank lines.
 //!
 //! The data must match the counts: a file that ends early is [`ErrorKind::Truncated`] (at the
 //! missing vertex or face); data after the last face is [`ErrorKind::BadCount`].
@@ -28,24 +33,63 @@ use subfit_mesh::{PolyMesh, Polygons};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{
-    check_utf8, finite_f64, parse_f64, parse_i64, parse_int, push_f64_exact, push_u64,
-    strip_hash_comment, syntax, tokens, unit_to_u8, NumberedLines,
+    finite_f64, parse_f64, parse_i64, parse_int, push_f64_exact, push_u64, strip_hash_comment,
+    syntax, tokens, unit_to_u8, NumberedLines,
 };
+use crate::Encoding;
 
 /// What the header keyword announces per vertex.
 #[derive(Clone, Copy, Debug, Default)]
-struct Layout {
-    normals: bool,
-    colors: bool,
-    texcoords: bool,
+pub(crate) struct Layout {
+    pub(crate) normals: bool,
+    pub(crate) colors: bool,
+    pub(crate) texcoords: bool,
 }
 
-/// Parses a whole OFF file.
+/// Parses a whole OFF file, text or binary; returns the mesh and the encoding read.
 ///
 /// Cost: O(file size) time; memory proportional to the data present (the counts are never
 /// trusted for allocation beyond what the file size allows).
-pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
-    check_utf8(bytes, path)?;
+pub fn read(bytes: &[u8], path: &Path, warnings: &mut Vec<String>) -> Result<(PolyMesh, Encoding)> {
+    if let Some((layout, no, data_start)) = binary_header(bytes, path)? {
+        return crate::off_binary::read(layout, bytes, data_start, no, path, warnings);
+    }
+    read_text(bytes, path).map(|m| (m, Encoding::Ascii))
+}
+
+/// When the first line that is not blank or a comment is `<keyword> BINARY`: the layout, that
+/// line's number and the byte offset where the binary data starts (after its line end).
+fn binary_header(bytes: &[u8], path: &Path) -> Result<Option<(Layout, u64, usize)>> {
+    let mut lines = NumberedLines::new(bytes);
+    while let Some((no, raw)) = lines.next() {
+        let line = strip_hash_comment(raw);
+        let mut toks = tokens(line);
+        let Some(kw) = toks.next() else { continue };
+        if !toks
+            .next()
+            .is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY"))
+        {
+            return Ok(None);
+        }
+        if let Some(t) = toks.next() {
+            return Err(syntax(path, no, "unexpected value after `BINARY`", t));
+        }
+        let layout = keyword(kw, path, no)?;
+        return Ok(Some((layout, no, bytes.len() - lines.rest().len())));
+    }
+    Ok(None)
+}
+
+/// Splits a keyword glued to the vertex count (`OFF8` → `OFF`, rest of the line from `8`).
+fn split_glued(kw: &[u8]) -> usize {
+    match kw.windows(3).position(|w| w == b"OFF") {
+        Some(i) if kw.get(i + 3).is_some_and(|c| c.is_ascii_digit()) => i + 3,
+        _ => kw.len(),
+    }
+}
+
+/// Parses a text OFF file.
+fn read_text(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
     // Non-blank lines with comments removed.
     let mut lines = NumberedLines::new(bytes)
         .map(|(no, l)| (no, strip_hash_comment(l)))
@@ -53,23 +97,16 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
     let Some((first_no, first)) = lines.next() else {
         return Err(Error::file(path, ErrorKind::Empty));
     };
-    let mut toks = tokens(first);
-    let kw = toks.next().unwrap_or_default();
-    let (layout, count_line) = if parse_i64(kw).is_some() {
+    let tok = tokens(first).next().unwrap_or_default();
+    let (layout, count_line) = if parse_i64(tok).is_some() {
         (Layout::default(), (first_no, first))
     } else {
-        let layout = keyword(kw, path, first_no)?;
-        let rest: Vec<&[u8]> = toks.collect();
-        if let Some(&t) = rest.first() {
-            if t.eq_ignore_ascii_case(b"BINARY") {
-                return Err(Error::at_line(
-                    path,
-                    first_no,
-                    ErrorKind::Unsupported("binary OFF".into()),
-                ));
-            }
-        }
-        if rest.is_empty() {
+        let kw_len = split_glued(tok);
+        let layout = keyword(&tok[..kw_len], path, first_no)?;
+        // The counts may follow the keyword on the same line (`tok` is the first token).
+        let start = first.iter().position(|c| !c.is_ascii_whitespace());
+        let rest = &first[start.unwrap_or(0) + kw_len..];
+        if tokens(rest).next().is_none() {
             match lines.next() {
                 Some(l) => (layout, l),
                 None => {
@@ -81,8 +118,7 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
                 }
             }
         } else {
-            let at = kw.len() + first.windows(kw.len()).position(|w| w == kw).unwrap_or(0);
-            (layout, (first_no, &first[at..]))
+            (layout, (first_no, rest))
         }
     };
     let (nv, nf) = counts(count_line.1, path, count_line.0)?;
@@ -128,7 +164,7 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
                 )),
             ));
         };
-        face_line(line, no, path, nv, &mut face)?;
+        face_lines(line, no, &mut lines, path, nv, &mut face)?;
         if faces.indices().len() + face.len() > u32::MAX as usize {
             return Err(Error::at_line(
                 path,
@@ -156,7 +192,7 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
 }
 
 /// Decodes `[ST][C][N][4][n]OFF`.
-fn keyword(kw: &[u8], path: &Path, no: u64) -> Result<Layout> {
+pub(crate) fn keyword(kw: &[u8], path: &Path, no: u64) -> Result<Layout> {
     let Some(mut pre) = kw.strip_suffix(b"OFF") else {
         return Err(syntax(path, no, "expected the OFF header keyword", kw));
     };
@@ -311,10 +347,19 @@ fn describe(layout: Layout) -> String {
     s
 }
 
-/// Parses one face line `n i1 … in [colour]` into `face`.
-fn face_line(line: &[u8], no: u64, path: &Path, nv: u64, face: &mut Vec<u32>) -> Result<()> {
+/// Parses one face `n i1 … in [colour]` into `face`: it starts on `line` (number `no`) and
+/// takes further lines from `more` until its `n` indices are read.
+fn face_lines<'a>(
+    line: &'a [u8],
+    no: u64,
+    more: &mut impl Iterator<Item = (u64, &'a [u8])>,
+    path: &Path,
+    nv: u64,
+    face: &mut Vec<u32>,
+) -> Result<()> {
     face.clear();
     let mut toks = tokens(line);
+    let mut at = no;
     let first = toks.next().unwrap_or_default();
     let n = match parse_int(first) {
         Some(n) if n >= 3 => n as u64,
@@ -328,20 +373,31 @@ fn face_line(line: &[u8], no: u64, path: &Path, nv: u64, face: &mut Vec<u32>) ->
         None => return Err(syntax(path, no, "expected a face vertex count", first)),
     };
     for k in 0..n {
-        let Some(t) = toks.next() else {
-            return Err(Error::at_line(
-                path,
-                no,
-                ErrorKind::Syntax(format!("face announces {n} vertices but lists {k}")),
-            ));
+        let t = loop {
+            if let Some(t) = toks.next() {
+                break t;
+            }
+            match more.next() {
+                Some((next_no, next)) => {
+                    at = next_no;
+                    toks = tokens(next);
+                }
+                None => {
+                    return Err(Error::at_line(
+                        path,
+                        no,
+                        ErrorKind::Syntax(format!("face announces {n} vertices but lists {k}")),
+                    ))
+                }
+            }
         };
         let Some(i) = parse_int(t) else {
-            return Err(syntax(path, no, "bad vertex index", t));
+            return Err(syntax(path, at, "bad vertex index", t));
         };
         if i < 0 || i as u64 >= nv {
             return Err(Error::at_line(
                 path,
-                no,
+                at,
                 ErrorKind::IndexOutOfRange {
                     index: i,
                     count: nv,
@@ -354,7 +410,7 @@ fn face_line(line: &[u8], no: u64, path: &Path, nv: u64, face: &mut Vec<u32>) ->
         if k == 4 || parse_f64(t).is_none() {
             return Err(syntax(
                 path,
-                no,
+                at,
                 "unexpected value after the face (at most a colour may follow)",
                 t,
             ));

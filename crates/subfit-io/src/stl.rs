@@ -268,8 +268,8 @@ impl<'a> Ascii<'a, '_> {
 
     fn number(&mut self, what: &str) -> Result<f64> {
         let (at, t) = self.token(what)?;
-        // The line is counted only for a message: counting it for every number made reading
-        // quadratic in the file's size (a 3.7 MB file took minutes).
+        // The line is counted only for an error (O(file) each: counted for every number it
+        // made reading a 3.7 MB ascii STL take minutes).
         match parse_f64(t) {
             Some(v) if v.is_finite() => Ok(v),
             _ => finite_f64(t, self.path, self.line(at), what),

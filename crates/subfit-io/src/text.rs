@@ -77,10 +77,21 @@ pub(crate) fn parse_i64(tok: &[u8]) -> Option<i64> {
     std::str::from_utf8(tok).ok()?.parse::<i64>().ok()
 }
 
-/// A syntax error at a line, quoting the offending token (shortened).
+/// A syntax error at a line, quoting the offending token (shortened). A token that is not
+/// UTF-8 text is shown lossily and said to be so (binary data read as text).
 pub(crate) fn syntax(path: &Path, line: u64, what: &str, tok: &[u8]) -> Error {
-    let shown = String::from_utf8_lossy(&tok[..tok.len().min(40)]).into_owned();
-    Error::at_line(path, line, ErrorKind::Syntax(format!("{what}: `{shown}`")))
+    let cut = &tok[..tok.len().min(40)];
+    let shown = String::from_utf8_lossy(cut).into_owned();
+    let note = if std::str::from_utf8(tok).is_err() {
+        " (bytes that are not UTF-8 text: is this a binary file?)"
+    } else {
+        ""
+    };
+    Error::at_line(
+        path,
+        line,
+        ErrorKind::Syntax(format!("{what}: `{shown}`{note}")),
+    )
 }
 
 /// Appends the shortest decimal that parses back to exactly `v`.

@@ -260,8 +260,8 @@ fn obj_all_face_forms_and_negative_indices() {
             vec![0, 2, 3]
         ]
     );
-    // Some corners have no normal: normals are dropped.
-    assert!(m.normals.is_none());
+    // Some corners have no normal, but every vertex has a corner with `vn 0 0 1`: kept.
+    assert_eq!(m.normals.unwrap(), vec![[0.0, 0.0, 1.0]; 4]);
 }
 
 #[test]
@@ -282,10 +282,13 @@ fn obj_normals_consistent_split_and_paired() {
     let by_value =
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1//2 3//2 2//2\n";
     assert!(ok(Format::Obj, by_value).normals.is_some());
-    // Vertex 1 gets two different normals: dropped.
+    // Vertex 1 gets two different normals: their normalized mean; the others keep theirs.
     let split =
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 1 0 0\nf 1//1 2//1 3//1\nf 1//2 3//1 2//1\n";
-    assert!(ok(Format::Obj, split).normals.is_none());
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 2 0 0\nf 1//1 2//1 3//1\nf 1//2 3//1 2//1\n";
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let n = ok(Format::Obj, split).normals.unwrap();
+    assert!((n[0][0] - h).abs() < 1e-15 && n[0][1] == 0.0 && (n[0][2] - h).abs() < 1e-15);
+    assert_eq!(&n[1..], &[[0.0, 0.0, 1.0]; 2]);
     // An unused vertex has no normal: dropped.
     let unused = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nvn 0 0 1\nf 1//1 2//1 3//1\n";
     assert!(ok(Format::Obj, unused).normals.is_none());
@@ -369,9 +372,9 @@ fn obj_errors() {
             |k| matches!(k, ErrorKind::Syntax(s) if s.contains("2 corner")),
         ),
         (
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/ 2 3\n",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf /1 2 3\n",
             Location::Line(4),
-            |k| matches!(k, ErrorKind::Syntax(s) if s.contains("`1/`")),
+            |k| matches!(k, ErrorKind::Syntax(s) if s.contains("`/1`")),
         ),
         (
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//2 2 3\n",
@@ -537,9 +540,11 @@ fn off_errors() {
         ("nOFF\n3\n", Location::Line(1), |k| {
             matches!(k, ErrorKind::Unsupported(_))
         }),
-        ("OFF BINARY\n", Location::Line(1), |k| {
-            matches!(k, ErrorKind::Unsupported(_))
-        }),
+        (
+            "OFF BINARY\n",
+            Location::Byte(11),
+            |k| matches!(k, ErrorKind::Truncated(s) if s.contains("binary OFF")),
+        ),
         (
             "OFX\n",
             Location::Line(1),
@@ -699,10 +704,11 @@ fn xyz_forms() {
     let m = ok(Format::Xyz, "1\n0 0 0 -1200 255 10 300\n");
     assert_eq!(m.colors.unwrap(), vec![[255, 10, 255]]);
     assert!(m.normals.is_none());
-    // 4 columns: intensity ignored; 9: normals, the rest ignored.
+    // 4 columns: intensity ignored; 9: normals, then colours (integers in 0..255).
     assert_eq!(ok(Format::Xyz, "0 0 0 7\n").positions.len(), 1);
     let m = ok(Format::Xyz, "0 0 0 1 0 0 9 9 9\n");
     assert_eq!(m.normals.unwrap(), vec![[1.0, 0.0, 0.0]]);
+    assert_eq!(m.colors.unwrap(), vec![[9, 9, 9]]);
 }
 
 #[test]

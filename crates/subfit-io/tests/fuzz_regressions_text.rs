@@ -54,6 +54,16 @@ fn obj_hostile() {
         b"\xef\xbb\xbfv 0 0 0\n",
         b"v 0 0 0\r\rf 1 1 1\r",
         b"#\xff\n",
+        b"v 0 0 0\nvn 0 0 0\nvn 0 0 0\nf 1//1 1//2 1//1\n",
+        b"v 0 0 0\nvn nan 0 0\n",
+        b"g \xff\xfe\nv 0 0 0\n",
+        b"P 1",
+        b"P 0 0 0 0 0 4294967295",
+        b"P 0 0 0 0 0 1 0 0 0 0 0 1 99999999999 0 0 0 0 0",
+        b"P 0 0 0 0 0 1 0 0 0 0 0 1 1 2 0 0 0 0 3 0 0 0",
+        b"P 0 0 0 0 0 1 0 0 0 0 0 1 1 0 0 0 0 0 -3 0 0 0",
+        b"L 1 2",
+        b"X 0",
     ];
     for c in cases {
         check(Format::Obj, c);
@@ -75,6 +85,16 @@ fn off_hostile() {
         b"STCNOFF\n1 0\n0 0 0 0 0 1 1 1 1 0 0\n",
         b"COFF\n1 0\n0 0 0 1e999 0 0\n",
         b"OFF\n1 0\n0 0 0 # \xff\n",
+        b"OFF8",
+        b"\tOFF4294967295 1\n",
+        b"OFF3 1\n0 0 0\n1 0 0\n0 1 0\n3\n",
+        b"OFF BINARY",
+        b"OFF BINARY\n",
+        b"OFF BINARY\n\x7f\xff\xff\xff\x7f\xff\xff\xff\0\0\0\0",
+        b"OFF BINARY\n\0\0\0\x01\0\0\0\x01\0\0\0\0\x7f\xc0\0\0\0\0\0\0\0\0\0\0",
+        b"STCNOFF BINARY\n\0\0\0\x01\0\0\0\0\0\0\0\0",
+        b"4OFF BINARY\n",
+        b"OFF BINARY extra\n",
     ];
     for c in cases {
         check(Format::Off, c);
@@ -126,6 +146,17 @@ fn xyz_hostile() {
         b"0 0 0 nan\n",
         b"/\n/",
         b"0 0 0\n\xff",
+        b"p",
+        b"p 0 0\n",
+        b"d 1 1 1\n",
+        b"p 0 0 0\n\xff 1 1\n",
+        b"1\n0 0 0\n0\n",
+        b"1\n0 0 0\n1\n",
+        b"0 0 0 nan nan nan\n",
+        b"0 0 0 nan nan nan nan\n",
+        b"0 0 0 1 0 0 nan nan nan nan\n",
+        b"0 0 0\n-",
+        b"0\n",
     ];
     for c in cases {
         check(Format::Xyz, c);

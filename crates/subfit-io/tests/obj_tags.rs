@@ -21,7 +21,7 @@ fn tags_round_trip_through_obj_and_the_mesh_reader_skips_them() {
     let text = String::from_utf8(out.clone()).unwrap();
     assert!(text.contains("t crease 2/1/0 0 1 10\n"), "{text}");
     assert!(text.contains("t corner 1/1/0 7 10\n"), "{text}");
-    let back = read(&out, Path::new("cage.obj")).unwrap();
+    let back = read(&out, Path::new("cage.obj"), &mut Vec::new()).unwrap();
     assert_eq!(back.positions, cube.positions);
     assert_eq!(back.faces, cube.faces);
     assert_eq!(read_tags(&out, Path::new("cage.obj"), 8).unwrap(), tags);

@@ -3,9 +3,15 @@
 //! tessellation, the starting guess of the closest point on a subdivision surface
 //! (subfit-subdiv).
 //!
-//! The hierarchy is a binary tree of axis-aligned boxes: each node's triangles are split at the
-//! median of their centroids along the longest axis of the centroids' box, down to leaves of at
-//! most 4 triangles. A query descends the nearer child first and skips boxes no nearer than the
+//! The hierarchy is a binary tree of axis-aligned boxes, down to leaves of at most 4 triangles.
+//! [`TriangleBvh::new`] splits each node's triangles at the median of their centroids along
+//! the longest axis of the centroids' box (a fast build, for a hierarchy queried about once per
+//! triangle). [`TriangleBvh::with_sah`] splits by the surface area heuristic over 16 bins of
+//! the centroids along that axis (Wald 2007, "On fast construction of SAH-based bounding
+//! volume hierarchies", §3: the cut minimising `area(left)·#left + area(right)·#right`), down
+//! to depth [`SAH_DEPTH`]: long thin triangles (tessellated CAD, aspect ratios up to 1e5) then
+//! get boxes of their own instead of inflating their neighbours' — for a hierarchy built once
+//! and queried many times (a mesh target's). A query descends the nearer child first and skips boxes no nearer than the
 //! best distance so far. The point–triangle test is Ericson, *Real-Time Collision Detection*
 //! (2005), §5.1.5 (Voronoi regions of the vertices and edges, barycentric result).
 //!
@@ -53,10 +59,17 @@ const BLANK: Node = Node {
 /// Most triangles in a leaf.
 const LEAF: usize = 4;
 
-/// Depth of the traversal stack: a median split halves the triangles at every level, so the
-/// tree is at most `log2(#T / LEAF) + 1 < 32` deep, and a depth-first traversal that pushes both
-/// children holds at most one entry per level plus one.
+/// Depth of the traversal stack: a depth-first traversal that pushes both children holds at
+/// most one entry per level plus one. SAH splits are made down to depth [`SAH_DEPTH`] only;
+/// below it a median split halves the triangles at every level (at most `log2(#T / LEAF) + 1
+/// < 32` more), so the tree is under 56 deep.
 const STACK: usize = 64;
+
+/// Deepest level split by the surface area heuristic (see the module doc and [`STACK`]).
+const SAH_DEPTH: usize = 24;
+
+/// Centroid bins per axis of the SAH split.
+const BINS: usize = 16;
 
 /// A BVH over triangles. Built in O(#T log #T); a query visits O(log #T) nodes on typical
 /// meshes. Memory: the vertices and indices, one copy of the corners (`72 · #T` bytes) and
@@ -81,6 +94,22 @@ impl TriangleBvh {
     /// their indices first).
     #[track_caller]
     pub fn new(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Self {
+        Self::build_with(vertices, triangles, false)
+    }
+
+    /// [`Self::new`] with surface-area-heuristic splits (see the module doc): a slower build,
+    /// faster queries on meshes with long thin triangles. The same closest distances as
+    /// [`Self::new`]'s (among equidistant triangles another may be met first).
+    ///
+    /// # Panics
+    /// As [`Self::new`].
+    #[track_caller]
+    pub fn with_sah(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> Self {
+        Self::build_with(vertices, triangles, true)
+    }
+
+    #[track_caller]
+    fn build_with(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>, sah: bool) -> Self {
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
         let cent: Vec<[f64; 3]> = triangles
             .iter()
@@ -102,7 +131,13 @@ impl TriangleBvh {
         if !bvh.triangles.is_empty() {
             bvh.nodes.push(BLANK);
             let n = order.len();
-            bvh.build(0, &mut order, 0, n, &cent);
+            let boxes: Vec<Aabb> = bvh
+                .triangles
+                .iter()
+                .map(|t| Aabb::of(t.map(|v| bvh.vertices[v as usize])))
+                .collect();
+            let depth = if sah { 0 } else { SAH_DEPTH };
+            bvh.build(0, &mut order, (0, n), &cent, &boxes, depth);
         }
         bvh.corners = order
             .iter()
@@ -121,51 +156,60 @@ impl TriangleBvh {
         Self::new(triangles.into_iter().flatten().collect(), ids)
     }
 
+    /// Builds node `node` over the triangles `order[start..end]` (centroids `cent`, boxes
+    /// `boxes`, by triangle id) at depth `depth`, and its subtree (SAH splits above
+    /// [`SAH_DEPTH`], median splits below).
     fn build(
         &mut self,
         node: usize,
         order: &mut [u32],
-        start: usize,
-        end: usize,
+        (start, end): (usize, usize),
         cent: &[[f64; 3]],
+        boxes: &[Aabb],
+        depth: usize,
     ) {
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        let (mut clo, mut chi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        let mut bounds = Aabb::EMPTY;
+        let mut cbox = Aabb::EMPTY;
         for &t in &order[start..end] {
-            for &v in &self.triangles[t as usize] {
-                let p = self.vertices[v as usize];
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k]);
-                    hi[k] = hi[k].max(p[k]);
-                }
-            }
-            let c = cent[t as usize];
-            for k in 0..3 {
-                clo[k] = clo[k].min(c[k]);
-                chi[k] = chi[k].max(c[k]);
-            }
+            bounds = bounds.union(&boxes[t as usize]);
+            cbox = cbox.union(&Aabb::of([cent[t as usize]]));
         }
-        self.nodes[node].lo = lo;
-        self.nodes[node].hi = hi;
+        self.nodes[node].lo = bounds.lo;
+        self.nodes[node].hi = bounds.hi;
         if end - start <= LEAF {
             self.nodes[node].first = start as u32;
             self.nodes[node].count = (end - start) as u32;
             return;
         }
-        let axis = (0..3)
-            .max_by(|&a, &b| (chi[a] - clo[a]).total_cmp(&(chi[b] - clo[b])))
-            .unwrap_or(0);
-        let mid = (start + end) / 2;
-        order[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
-            cent[a as usize][axis].total_cmp(&cent[b as usize][axis])
-        });
+        let axis = cbox.longest_axis();
+        let sah = if depth < SAH_DEPTH {
+            sah_split(&order[start..end], cent, boxes, &cbox, axis)
+        } else {
+            None
+        };
+        let mid = match sah {
+            Some(cut) => {
+                let (lo, w) = (cbox.lo[axis], cbox.hi[axis] - cbox.lo[axis]);
+                start
+                    + partition(&mut order[start..end], |t| {
+                        bin_of(cent[t as usize][axis], lo, w) <= cut
+                    })
+            }
+            None => {
+                let mid = (start + end) / 2;
+                order[start..end].select_nth_unstable_by(mid - start, |&a, &b| {
+                    cent[a as usize][axis].total_cmp(&cent[b as usize][axis])
+                });
+                mid
+            }
+        };
         let left = self.nodes.len();
         self.nodes.push(BLANK);
         self.nodes.push(BLANK);
         self.nodes[node].first = left as u32;
         self.nodes[node].count = 0;
-        self.build(left, order, start, mid, cent);
-        self.build(left + 1, order, mid, end, cent);
+        self.build(left, order, (start, mid), cent, boxes, depth + 1);
+        self.build(left + 1, order, (mid, end), cent, boxes, depth + 1);
     }
 
     /// Number of triangles.
@@ -192,6 +236,29 @@ impl TriangleBvh {
     /// triangles. Among triangles at the same distance, the first one the traversal meets wins.
     /// Allocates nothing.
     pub fn closest(&self, x: [f64; 3]) -> Option<MeshClosestPoint> {
+        self.closest_bounded(x, f64::INFINITY)
+    }
+
+    /// [`Self::closest`] started from a guess: triangle `hint` (e.g. the closest one of a
+    /// nearby or earlier query point) bounds the search by its own distance, so that boxes
+    /// farther than it are never opened. The same result as [`Self::closest`], ties included
+    /// (the traversal order is the same; only boxes that cannot hold the answer are skipped).
+    /// An out-of-range `hint` is ignored.
+    pub fn closest_near(&self, x: [f64; 3], hint: u32) -> Option<MeshClosestPoint> {
+        let Some(t) = self.triangles.get(hint as usize) else {
+            return self.closest(x);
+        };
+        let [a, b, c] = t.map(|v| self.vertices[v as usize]);
+        let (p, _) = closest_on_triangle(x, a, b, c);
+        let d = sub(x, p);
+        let bound = dot(d, d);
+        self.closest_bounded(x, if bound.is_nan() { f64::INFINITY } else { bound })
+            .or_else(|| self.closest(x))
+    }
+
+    /// [`Self::closest`] among the triangles within squared distance `bound` (`None` when none
+    /// is): nodes whose box is farther than `bound` are skipped.
+    fn closest_bounded(&self, x: [f64; 3], bound: f64) -> Option<MeshClosestPoint> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -203,7 +270,7 @@ impl TriangleBvh {
         while top > 0 {
             top -= 1;
             let (ni, d2) = stack[top];
-            if d2 >= best {
+            if d2 >= best || d2 > bound {
                 continue;
             }
             let node = self.nodes[ni as usize];
@@ -214,7 +281,7 @@ impl TriangleBvh {
                     let (p, bary) = closest_on_triangle(x, a, b, c);
                     let dd = sub(x, p);
                     let dd = dot(dd, dd);
-                    if dd < best {
+                    if dd < best && dd <= bound {
                         best = dd;
                         best_hit = Some((t, p, bary));
                     }
@@ -291,6 +358,113 @@ impl TriangleBvh {
         }
         out
     }
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug)]
+struct Aabb {
+    lo: [f64; 3],
+    hi: [f64; 3],
+}
+
+impl Aabb {
+    const EMPTY: Self = Self {
+        lo: [f64::INFINITY; 3],
+        hi: [f64::NEG_INFINITY; 3],
+    };
+
+    fn of<const N: usize>(points: [[f64; 3]; N]) -> Self {
+        let mut b = Self::EMPTY;
+        for p in points {
+            b.lo = std::array::from_fn(|k| b.lo[k].min(p[k]));
+            b.hi = std::array::from_fn(|k| b.hi[k].max(p[k]));
+        }
+        b
+    }
+
+    fn union(&self, o: &Self) -> Self {
+        Self {
+            lo: std::array::from_fn(|k| self.lo[k].min(o.lo[k])),
+            hi: std::array::from_fn(|k| self.hi[k].max(o.hi[k])),
+        }
+    }
+
+    /// Half the surface area (0 for an empty box).
+    fn half_area(&self) -> f64 {
+        let e: [f64; 3] = std::array::from_fn(|k| (self.hi[k] - self.lo[k]).max(0.0));
+        e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    }
+
+    fn longest_axis(&self) -> usize {
+        (0..3)
+            .max_by(|&a, &b| (self.hi[a] - self.lo[a]).total_cmp(&(self.hi[b] - self.lo[b])))
+            .unwrap_or(0)
+    }
+}
+
+/// The bin (0..[`BINS`]) of centroid coordinate `c` over a centroid extent starting at `lo`
+/// of width `w > 0`.
+#[inline]
+fn bin_of(c: f64, lo: f64, w: f64) -> usize {
+    (((c - lo) / w * BINS as f64) as usize).min(BINS - 1)
+}
+
+/// The SAH split along `axis` of the triangles `ids` (centroids `cent`, boxes `boxes`, by id)
+/// whose centroids span `cbox`: the last bin of the left side, or `None` when no cut between
+/// bins leaves triangles on both sides (every centroid in one bin): the caller splits at the
+/// median.
+fn sah_split(
+    ids: &[u32],
+    cent: &[[f64; 3]],
+    boxes: &[Aabb],
+    cbox: &Aabb,
+    axis: usize,
+) -> Option<usize> {
+    let (lo, w) = (cbox.lo[axis], cbox.hi[axis] - cbox.lo[axis]);
+    if !(w > 0.0 && w.is_finite()) {
+        return None;
+    }
+    let mut bins = [(Aabb::EMPTY, 0usize); BINS];
+    for &t in ids {
+        let b = &mut bins[bin_of(cent[t as usize][axis], lo, w)];
+        b.0 = b.0.union(&boxes[t as usize]);
+        b.1 += 1;
+    }
+    // Right-side areas and counts for cuts after bin i (i = 0..BINS-2).
+    let mut right = [(0.0, 0usize); BINS];
+    let (mut acc, mut n) = (Aabb::EMPTY, 0);
+    for i in (1..BINS).rev() {
+        acc = acc.union(&bins[i].0);
+        n += bins[i].1;
+        right[i - 1] = (acc.half_area(), n);
+    }
+    let mut best: Option<(f64, usize)> = None;
+    let (mut acc, mut n) = (Aabb::EMPTY, 0);
+    for (i, bin) in bins.iter().enumerate().take(BINS - 1) {
+        acc = acc.union(&bin.0);
+        n += bin.1;
+        let (ra, rn) = right[i];
+        if n == 0 || rn == 0 {
+            continue;
+        }
+        let cost = acc.half_area() * n as f64 + ra * rn as f64;
+        if best.is_none_or(|b| cost < b.0) {
+            best = Some((cost, i));
+        }
+    }
+    best.map(|(_, cut)| cut)
+}
+
+/// Moves the ids for which `left` holds to the front (unstable); returns how many there are.
+fn partition(ids: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..ids.len() {
+        if left(ids[j]) {
+            ids.swap(i, j);
+            i += 1;
+        }
+    }
+    i
 }
 
 /// Squared distance from `x` to the box of node `n` (0 inside).
@@ -479,5 +653,56 @@ mod tests {
         assert!(TriangleBvh::from_triangles(Vec::new())
             .closest([0.0; 3])
             .is_none());
+    }
+
+    /// Slivers (aspect ratios up to 1e6, as in tessellated CAD) among ordinary triangles: the
+    /// SAH tree finds the brute-force closest point, and a query started from any hint
+    /// ([`TriangleBvh::closest_near`]) returns exactly what [`TriangleBvh::closest`] does.
+    #[test]
+    fn slivers_and_hints_agree_with_brute_force() {
+        let mut s = 7u64;
+        let mut r = || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut tris: Vec<[[f64; 3]; 3]> = Vec::new();
+        for i in 0..400 {
+            let c = [r(), r(), r()];
+            if i % 3 == 0 {
+                // A sliver: long along a random axis, 1e-6 wide.
+                let len = 0.3 + 0.7 * r();
+                let a = [r() - 0.5, r() - 0.5, r() - 0.5];
+                let b = [c[0] + len * a[0], c[1] + len * a[1], c[2] + len * a[2]];
+                tris.push([c, b, [c[0] + 1e-6, c[1], c[2] + 1e-6]]);
+            } else {
+                tris.push(
+                    [0, 1, 2].map(|_| [c[0] + 0.05 * r(), c[1] + 0.05 * r(), c[2] + 0.05 * r()]),
+                );
+            }
+        }
+        let bvh = TriangleBvh::from_triangles(tris.clone());
+        let corners: Vec<[f64; 3]> = tris.iter().flatten().copied().collect();
+        let ids = (0..tris.len() as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        let sah = TriangleBvh::with_sah(corners, ids);
+        for _ in 0..300 {
+            let q = [1.4 * r() - 0.2, 1.4 * r() - 0.2, 1.4 * r() - 0.2];
+            let n = bvh.closest(q).unwrap();
+            let bf = tris
+                .iter()
+                .map(|&[a, b, c]| dist2(q, closest_on_triangle(q, a, b, c).0))
+                .fold(f64::INFINITY, f64::min);
+            assert!((dist2(q, n.point) - bf).abs() <= 1e-15);
+            let m = sah.closest(q).unwrap();
+            assert!((dist2(q, m.point) - bf).abs() <= 1e-15);
+            assert_eq!(sah.closest_near(q, m.triangle), Some(m));
+            let hint = (r() * tris.len() as f64) as u32;
+            assert_eq!(bvh.closest_near(q, hint), Some(n));
+            assert_eq!(bvh.closest_near(q, n.triangle), Some(n));
+            assert_eq!(bvh.closest_near(q, u32::MAX), Some(n));
+        }
     }
 }

@@ -1,7 +1,8 @@
 //! `subfit.fit`: numpy arrays and keywords → [`subfit::FitScanOptions`] → [`subfit::fit_scan`]
 //! (the pipeline of `subfit fit`, nothing re-implemented) → a [`NativeFit`] holding the result.
 //!
-//! Keywords mirror the CLI's flags (`--max-control-points` → `max_control_points`, `--lambda`
+//! Keywords mirror the CLI's flags (every `--method`, `imls` with `imls_radius` and `arap`
+//! included) (`--max-control-points` → `max_control_points`, `--lambda`
 //! → `lambda_start`, `--no-refine` → `refine=False`, …) with the same defaults and ranges. The
 //! fit runs with the interpreter detached; once per iteration the progress hook re-attaches to
 //! check for Ctrl-C (`KeyboardInterrupt`), pass warnings to Python's `warnings`, and call the
@@ -13,7 +14,7 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyRuntimeWarning;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use subfit::fit::{FitOptions, Method, StageOptions, StepControl};
+use subfit::fit::{FitOptions, StageOptions, StepControl};
 use subfit::mesh::{Cancel, PolyMesh, Tags};
 use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
 
@@ -66,7 +67,9 @@ fn options(
     local_rings: Option<i64>,
     local_field: (f64, f64),
     error_scale: Option<f64>,
+    imls: (Option<f64>, f64),
 ) -> PyResult<FitScanOptions> {
+    let (imls_radius, arap) = imls;
     let (local_field_peak, local_field_share) = local_field;
     if !(local_field_peak > 0.5 && local_field_peak <= 1.0) {
         return Err(value_error(format!(
@@ -83,16 +86,7 @@ fn options(
             "coverage must be a finite number >= 0, got {coverage}"
         )));
     }
-    let method = match method.to_ascii_lowercase().as_str() {
-        "pdm" => Method::Pdm,
-        "tdm" => Method::Tdm,
-        "sdm" => Method::Sdm,
-        _ => {
-            return Err(value_error(format!(
-                "method must be \"pdm\", \"tdm\" or \"sdm\", got {method:?}"
-            )))
-        }
-    };
+    let method = subfit::method_named(method).map_err(|e| value_error(e.to_string()))?;
     let step = match step.to_ascii_lowercase().as_str() {
         "none" => StepControl::None,
         "lm" => StepControl::LevenbergMarquardt,
@@ -106,7 +100,7 @@ fn options(
     if local_rings.is_some() && !local {
         return Err(value_error("local_rings needs local=True"));
     }
-    Ok(FitScanOptions {
+    let mut o = FitScanOptions {
         control_points: control_points
             .map(|n| range("control_points", n, 4, 1_000_000))
             .transpose()?,
@@ -117,21 +111,13 @@ fn options(
             method,
             step,
             coverage,
+            imls_radius,
+            arap,
             ..FitOptions::default()
         },
         stages: StageOptions {
-            lambda_start,
-            lambda_end: lambda_end.unwrap_or(lambda_start.min(1e-5)),
             iterations_per_stage: range("stage_iterations", stage_iterations, 1, 10_000)?,
             max_iterations: range("max_iterations", max_iterations, 1, 10_000)?,
-            tolerance_rms: tolerance.unwrap_or(StageOptions::default().tolerance_rms),
-            tolerance_max: max_error.unwrap_or(0.0),
-            max_control_points: match max_control_points {
-                Some(n) => range("max_control_points", n, 4, 10_000_000)?,
-                None => StageOptions::default().max_control_points,
-            },
-            refine,
-            edge_flips: refine && edge_flips,
             max_depth: range("max_depth", max_depth, 1, 12)? as u8,
             local,
             local_rings: range("local_rings", local_rings.unwrap_or(2), 0, 1_000)?,
@@ -141,11 +127,18 @@ fn options(
             ..StageOptions::default()
         },
         error_scale,
-        target_tolerances: tolerance.is_none()
-            && max_error.is_none()
-            && max_control_points.is_none(),
         ..FitScanOptions::default()
-    })
+    };
+    o.set_limits(
+        tolerance,
+        max_error,
+        max_control_points
+            .map(|n| range("max_control_points", n, 4, 10_000_000))
+            .transpose()?,
+    );
+    o.set_lambda(lambda_start, lambda_end);
+    o.set_refinement(refine, edge_flips);
+    Ok(o)
 }
 
 /// A progress event as a Python dict.
@@ -197,7 +190,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
     max_depth=5, local=false, local_rings=None, local_field_peak=0.8, local_field_share=0.5,
-    error_scale=None, name=None, progress=None
+    error_scale=None, imls_radius=None, arap=0.0, name=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
@@ -230,6 +223,8 @@ pub fn fit(
     local_field_peak: f64,
     local_field_share: f64,
     error_scale: Option<f64>,
+    imls_radius: Option<f64>,
+    arap: f64,
     name: Option<String>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeFit> {
@@ -256,6 +251,7 @@ pub fn fit(
         local_rings,
         (local_field_peak, local_field_share),
         error_scale,
+        (imls_radius, arap),
     )?;
     let positions = vec3s("points", &points, subfit::target::MIN_POINTS)?;
     let n = positions.len();

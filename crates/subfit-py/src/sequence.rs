@@ -63,6 +63,48 @@ fn marker_observations(m: &Bound<'_, PyAny>) -> PyResult<Vec<subfit::MarkerObser
         .collect())
 }
 
+/// The template of `subfit.fit_sequence`: fitted to the first frame, or the cage given (then
+/// `control_points` cannot be).
+fn template_cage(
+    template: Option<&(PyReadonlyArray2<'_, f64>, FaceArrays<'_>)>,
+    control_points: Option<usize>,
+) -> PyResult<InitialCage> {
+    let Some((v, (c, i))) = template else {
+        return Ok(InitialCage::Auto);
+    };
+    if control_points.is_some() {
+        return Err(value_error(
+            "control_points sets the size of the fitted template; it cannot be used with template",
+        ));
+    }
+    let cage = vec3s("template vertices", v, 4)?;
+    let faces = polygons(c, i, cage.len())?;
+    Ok(InitialCage::Given {
+        mesh: PolyMesh::new(cage, faces),
+        tags: Tags::new(),
+        name: "template".into(),
+    })
+}
+
+/// The tracking step of `subfit.fit_sequence`: `nodes` deformation nodes (0: off) and the
+/// markers, which need it.
+fn tracking_options(
+    nodes: usize,
+    markers: Option<Bound<'_, PyAny>>,
+) -> PyResult<Option<subfit::TrackingOptions>> {
+    match (nodes, markers.map(|m| marker_observations(&m)).transpose()?) {
+        (0, None) => Ok(None),
+        (0, Some(_)) => Err(value_error(
+            "markers need the tracking step (track_nodes > 0)",
+        )),
+        (nodes, markers) => Ok(Some(subfit::TrackingOptions {
+            nodes,
+            markers: markers.unwrap_or_default(),
+            ..subfit::TrackingOptions::default()
+        })),
+    }
+}
+
 /// Fits one cage to every frame (see the Python `subfit.fit_sequence`).
 #[pyfunction]
 #[pyo3(name = "fit_sequence", signature = (
@@ -132,23 +174,7 @@ pub fn fit_sequence_py(
     if let Some(n) = control_points {
         template_fit.stages.max_control_points = n;
     }
-    let template = match &template {
-        None => InitialCage::Auto,
-        Some((v, (c, i))) => {
-            if control_points.is_some() {
-                return Err(value_error(
-                    "control_points sets the size of the fitted template; it cannot be used with template",
-                ));
-            }
-            let cage = vec3s("template vertices", v, 4)?;
-            let faces = polygons(c, i, cage.len())?;
-            InitialCage::Given {
-                mesh: PolyMesh::new(cage, faces),
-                tags: Tags::new(),
-                name: "template".into(),
-            }
-        }
-    };
+    let template = template_cage(template.as_ref(), control_points)?;
     let cancel = Cancel::new();
     let options = SequenceOptions {
         template,
@@ -164,22 +190,7 @@ pub fn fit_sequence_py(
             weight: silhouette_weight,
             ..subfit::SilhouetteOptions::default()
         },
-        tracking: match (
-            in_range("track_nodes", track_nodes, 0, 2000)?,
-            markers.map(|m| marker_observations(&m)).transpose()?,
-        ) {
-            (0, None) => None,
-            (0, Some(_)) => {
-                return Err(value_error(
-                    "markers need the tracking step (track_nodes > 0)",
-                ))
-            }
-            (nodes, markers) => Some(subfit::TrackingOptions {
-                nodes,
-                markers: markers.unwrap_or_default(),
-                ..subfit::TrackingOptions::default()
-            }),
-        },
+        tracking: tracking_options(in_range("track_nodes", track_nodes, 0, 2000)?, markers)?,
         cancel: cancel.clone(),
         ..SequenceOptions::default()
     };

@@ -132,3 +132,22 @@ def test_curvature_line_start_on_an_open_patch():
     # Loop needs triangles: said before anything is fitted.
     with pytest.raises(ValueError, match="quad-tri"):
         subfit.fit(pos, faces=tris, scheme="loop", init="curvature-lines")
+
+
+def test_imls_method_as_the_cli():
+    # The IMLS distance of Xie et al. 2023 through the same pipeline as `subfit fit --method
+    # imls`: the report says which method and radius, and the cage lies on the ellipsoid.
+    points, normals = ellipsoid_cloud(4000, seed=5)
+    f = subfit.fit(
+        points, normals=normals, method="imls", imls_radius=0.02, arap=0.01,
+        tolerance=2e-3, max_control_points=400, max_iterations=30,
+    )
+    assert f.report["options"]["method"] == "IMLS"
+    assert f.report["options"]["imls_radius"] == pytest.approx(0.02)
+    assert f.report["options"]["arap"] == pytest.approx(0.01)
+    d = ellipsoid_distance(f.surface().sample(2))
+    assert d.max() < 2e-2, d.max()
+    with pytest.raises(ValueError, match="imls"):
+        subfit.fit(points, method="nope")
+    with pytest.raises(ValueError, match="imls-radius"):
+        subfit.fit(points, imls_radius=0.02)

@@ -237,10 +237,52 @@ impl Target {
     /// On a CAD tessellation ([`Self::facets`]) the facets are the surface: see
     /// [`facet_foot_point`].
     pub fn mesh_foot_point(&self, x: [f64; 3]) -> FootPoint {
+        self.mesh_foot_point_near(x, u32::MAX).0
+    }
+
+    /// [`Self::mesh_foot_point`] with the closest-triangle search bounded by triangle `hint`
+    /// (e.g. this query's closest triangle last time: [`TriangleBvh::closest_near`]); also
+    /// returns the closest triangle (`u32::MAX` when the quadric fallback answered). The same
+    /// result as [`Self::mesh_foot_point`]; a good hint spares most of the BVH traversal.
+    ///
+    /// [`TriangleBvh::closest_near`]: subfit_mesh::bvh::TriangleBvh::closest_near
+    pub fn mesh_foot_point_near(&self, x: [f64; 3], hint: u32) -> (FootPoint, u32) {
         let Some(bvh) = self.mesh() else {
-            return self.foot_point(x);
+            return (self.foot_point(x), u32::MAX);
         };
-        let Some(c) = bvh.closest(x) else {
+        let Some(c) = bvh.closest_near(x, hint) else {
+            return (self.foot_point(x), u32::MAX);
+        };
+        (self.mesh_foot_from(x, &c), c.triangle)
+    }
+
+    /// [`Self::mesh_foot_point_near`] for many points: `hints[q]` is
+    /// the closest triangle of query `q` last time (any out-of-range value: none), updated on
+    /// return. Same results as [`Self::mesh_foot_point`] per query, in parallel.
+    ///
+    /// # Panics
+    /// If `hints.len() != xs.len()`.
+    #[track_caller]
+    pub fn mesh_foot_points_hinted(&self, xs: &[[f64; 3]], hints: &mut [u32]) -> Vec<FootPoint> {
+        assert_eq!(
+            xs.len(),
+            hints.len(),
+            "mesh_foot_points_hinted: length mismatch"
+        );
+        xs.par_iter()
+            .zip(hints.par_iter_mut())
+            .map(|(&x, h)| {
+                let (f, t) = self.mesh_foot_point_near(x, *h);
+                *h = t;
+                f
+            })
+            .collect()
+    }
+
+    /// The foot point of `x` whose closest point on the triangles is `c`
+    /// ([`Self::mesh_foot_point`]).
+    fn mesh_foot_from(&self, x: [f64; 3], c: &MeshClosestPoint) -> FootPoint {
+        let Some(bvh) = self.mesh() else {
             return self.foot_point(x);
         };
         if self.facets().is_some() && c.face_normal != [0.0; 3] {

@@ -61,6 +61,9 @@ pub struct Target {
     /// The facets of a mesh recognised as a CAD tessellation ([`crate::tessellation`]): its
     /// foot points then come from the facets themselves.
     facets: Option<Facets>,
+    /// The cloud's boundary points at the default criterion ([`Self::cloud_rim`]), computed on
+    /// first use: every fitter, contour and start borrows the one copy (STYLE.md rule 11).
+    rim: std::sync::OnceLock<Vec<bool>>,
 }
 
 /// Per-point outputs for writers (e.g. the `subfit analyze` PLY): all arrays have `#P` rows, in
@@ -368,7 +371,8 @@ impl Target {
             report(Phase::MeshIndex, 0, 1);
             stats.triangles = triangles.len();
             report(Phase::MeshIndex, 1, 1);
-            Some(TriangleBvh::new(points.clone(), triangles))
+            // Built once, queried every iteration: SAH splits (CAD slivers).
+            Some(TriangleBvh::with_sah(points.clone(), triangles))
         } else {
             None
         };
@@ -394,6 +398,7 @@ impl Target {
             imls_radius,
             stats,
             facets,
+            rim: std::sync::OnceLock::new(),
         })
     }
 
@@ -486,6 +491,16 @@ impl Target {
     /// IMLS kernel support radius `h` (normalized units).
     pub fn imls_radius(&self) -> f64 {
         self.imls_radius
+    }
+
+    /// Whether each point is on the boundary of the cloud by the angle criterion at the
+    /// defaults ([`crate::cloud_boundary_points`] with [`crate::RIM_NEIGHBORS`] and
+    /// [`crate::RIM_GAP`]), `#P` flags. Computed on the first call (one 25-nearest query per
+    /// point, in parallel) and kept: later calls cost nothing.
+    pub fn cloud_rim(&self) -> &[bool] {
+        self.rim.get_or_init(|| {
+            crate::cloud_boundary_points(self, crate::RIM_NEIGHBORS, crate::RIM_GAP)
+        })
     }
 
     /// Sets the IMLS kernel support radius `h` (normalized units); ignored unless finite and > 0.

@@ -8,17 +8,18 @@
 //! stays small and quick; the files written beside it keep the full resolution.
 
 use subfit_fit::{DataTerm, FootPointTerm};
+use subfit_measure::DistanceStats;
 use subfit_mesh::PolyMesh;
 use subfit_report::html::{Block, ColorScale, Layer, LayerKind, Page, Scene, Section};
 use subfit_report::plot::{
     bar_chart, histogram_chart, log_chart_with, Bar, HistogramOptions, LogChartOptions, Series,
 };
 use subfit_report::preview::ColorBar as PreviewColorBar;
-use subfit_report::{error_color, preview_png, DistanceStats, PreviewOptions, Wireframe};
+use subfit_report::{error_color, preview_png, PreviewOptions, Wireframe};
 use subfit_subdiv::{sampling_operator, Scheme};
 
 use crate::error::Error;
-use crate::scan::Fitted;
+use crate::fitted::Fitted;
 
 /// Most triangles shown in the viewer.
 pub const VIEW_TRIANGLES: usize = 300_000;

@@ -18,7 +18,7 @@ use subfit_report::error_color;
 use subfit_subdiv::{BoundaryRule, Scheme};
 
 use crate::error::Error;
-use crate::scan::Fitted;
+use crate::fitted::Fitted;
 
 /// The files [`Fitted::write_into`] writes, in the order to move them into place.
 pub const OUTPUTS: [&str; 9] = [

@@ -7,7 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 use subfit_fit::{ErrorStats, IterationRow, StageReport};
-use subfit_report::{DistanceStats, TwoSided};
+use subfit_measure::{DistanceStats, TwoSided};
 
 /// Errors of one cage, surface → data, as the fitter measures them (Cheng 2007 §II-B step 7).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -164,9 +164,9 @@ pub struct InitSummary {
     /// keeps as crease and corner tags (`subfit_target::detect_features`). `None` otherwise.
     #[serde(default)]
     pub features: Option<FeatureSummary>,
-    /// The CAD tessellation start ([`crate::cad_start`]), when it built the cage.
+    /// The CAD tessellation start ([`crate::start_cad`]), when it built the cage.
     #[serde(default)]
-    pub cad: Option<crate::cad_start::CadSummary>,
+    pub cad: Option<crate::start_cad::CadSummary>,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
     /// The curvature-line cage (`subfit_init::curvature_lines`) when it was built or tried:
@@ -181,7 +181,7 @@ pub struct CurvatureLineSummary {
     /// Whether it is the initial cage.
     pub used: bool,
     /// Why it is not (it cannot be built, or the QEM start gave the better fit, see
-    /// `crate::initial_cage`). `None` when used.
+    /// `crate::starts`). `None` when used.
     pub reason: Option<String>,
     /// Its control points (0 when it could not be built).
     pub control_points: usize,

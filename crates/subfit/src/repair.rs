@@ -23,8 +23,8 @@ use subfit_mesh::{
 };
 
 use crate::error::Error;
+use crate::options::Input;
 use crate::pipeline_report::Reorientation;
-use crate::scan::Input;
 
 /// Repairs `mesh` (named `name` in the warnings) in place, as the module docs say, calling `warn`
 /// once per repair; returns what was re-oriented. A point cloud (no faces) is left alone. On
@@ -127,7 +127,7 @@ fn clause(sep: &str, n: usize, what: &str) -> String {
 
 /// Reads `input` (a file, or takes the mesh given) and repairs it ([`repair_mesh`]) unless its
 /// faces are not used (`as_points`). Returns the mesh, its name for messages and what was
-/// re-oriented.
+/// re-oriented. The reader's warnings ([`subfit_io::FileInfo::warnings`]) go to `warn` first.
 pub(crate) fn read_input(
     input: Input,
     as_points: bool,
@@ -135,7 +135,10 @@ pub(crate) fn read_input(
 ) -> Result<(PolyMesh, String, Option<Reorientation>), Error> {
     let (mut mesh, name) = match input {
         Input::File(path) => {
-            let (m, _) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            let (m, info) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
+            for w in info.warnings {
+                warn(format!("{}: {w}", path.display()));
+            }
             (m, path.display().to_string())
         }
         Input::Mesh { mesh, name } => (mesh, name),

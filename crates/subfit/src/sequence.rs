@@ -54,13 +54,14 @@ use std::time::Instant;
 
 use serde::Serialize;
 use subfit_fit::{AnyTerm, FitOptions, Fitter, Method, WeightedSurfaceTerm};
+use subfit_measure::data_samples;
 use subfit_mesh::vec3::{cross, dist2, dot, sub};
 use subfit_mesh::{Cancel, PolyMesh, Polygons, Tags};
-use subfit_report::data_samples;
-use subfit_subdiv::{sampling_operator, BoundaryRule, Scheme, StencilMatrix};
+use subfit_subdiv::{sampling_operator, BoundaryRule, Scheme};
 use subfit_target::{Normalization, Target, TargetOptions};
 
 use crate::error::Error;
+use crate::limit_stencils::LimitStencils;
 use crate::pipeline_report::{Reorientation, TwoSidedErrors};
 use crate::repair::read_input;
 use crate::sequence_tracking::Tracking;
@@ -323,12 +324,6 @@ struct Carry {
     template_edges: Vec<(u32, u32, f64)>,
     /// The tracking step's graph, the limit samples it tracks and its last motion.
     tracking: Option<Tracking>,
-}
-
-pub(crate) struct LimitStencils {
-    pub(crate) position: StencilMatrix,
-    pub(crate) tangent1: StencilMatrix,
-    pub(crate) tangent2: StencilMatrix,
 }
 
 /// Fits one cage to every frame of `frames` in order (see the module docs), calling

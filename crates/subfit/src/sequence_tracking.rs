@@ -20,12 +20,12 @@ use subfit_fit::track::{
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::{Normalization, Target};
 
-use crate::sequence::LimitStencils;
+use crate::limit_stencils::LimitStencils;
 
 /// The embedded-deformation tracking step of a sequence ([`subfit_fit::track`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrackingOptions {
-    /// Nodes of the deformation graph. Default 60 (see [`crate::sequence`]'s module docs).
+    /// Nodes of the deformation graph. Default 60 (see the module docs of `sequence.rs`).
     pub nodes: usize,
     /// Nearest nodes each node is tied to. Default 8.
     pub neighbors: usize,

@@ -1,7 +1,7 @@
 //! The tolerances a fit is judged by when the user gives none, and the noise floor of a noisy
 //! scan's RMS tolerance.
 //!
-//! **Defaults relative to the target** ([`FitScanOptions::target_tolerances`]): a fixed
+//! **Defaults relative to the target** ([`crate::FitScanOptions::target_tolerances`]): a fixed
 //! tolerance in the unit cube (Cheng et al. 2007's Table IV works at `E_rms` 5e-4) is 2–3.5e-4
 //! of a typical model's diagonal — far stricter than a scan needs, and paid for in control
 //! points: an armadillo with 27 holes took 4,698 of them. Users judge a cage by its distance to
@@ -16,7 +16,7 @@
 //!   a rounded sharp edge is what a CAD user sees first;
 //! - a **noisy scan** ([`subfit_target::TargetStats::is_noisy`]): the scan's RMS, no maximum
 //!   (an outlier or the noise's tail sets it), then raised to the noise floor
-//!   ([`noise_floored`]).
+//!   (`noise_floored`).
 //!
 //! Measured with `subfit fit MODEL` on the shared models and the hard cases of
 //! `examples/hard_cases.rs` (two-sided, from report.json, fractions of the diagonal; control
@@ -69,7 +69,7 @@ pub enum ToleranceKind {
     /// [`SCAN_RMS`] without a maximum: a noisy scan.
     NoisyScan,
     /// [`CAD_RMS`], [`CAD_MAX`] from the facets of a CAD tessellation
-    /// ([`crate::cad_start`]): the export is the part.
+    /// ([`crate::start_cad`]): the export is the part.
     Tessellation,
 }
 
@@ -184,7 +184,7 @@ pub(crate) fn edge_count(faces: &Polygons) -> usize {
     edges.len()
 }
 
-/// Factor on a noisy scan's noise level in its RMS tolerance ([`noise_floored`]).
+/// Factor on a noisy scan's noise level in its RMS tolerance (`noise_floored`).
 pub const NOISE_FLOOR_FACTOR: f64 = 1.25;
 
 /// `stages` with the RMS tolerance raised to `√(tol² + (1.25 σ)²)` when the target is a noisy
@@ -209,6 +209,18 @@ pub(crate) fn noise_floored(
     options.noise_rms = sigma;
     let floor = options.tolerance_rms;
     (options, Some(floor))
+}
+
+/// The tolerances one fit works to and is judged by.
+pub(crate) struct Tolerances {
+    /// The default set chosen for the target, when the target's defaults are asked.
+    pub(crate) kind: Option<ToleranceKind>,
+    /// The tolerances before the noise floor (the report's options).
+    pub(crate) judged: StageOptions,
+    /// The tolerances the cage is judged by (noise floor applied).
+    pub(crate) stages: StageOptions,
+    /// The raised RMS tolerance of a noisy scan, if it was raised.
+    pub(crate) noise_floor: Option<f64>,
 }
 
 #[cfg(test)]

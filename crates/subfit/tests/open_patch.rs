@@ -4,8 +4,8 @@
 //! rim are not yet fitted this well: see `subfit_target::boundary_corners`.)
 #![allow(clippy::print_stdout)]
 
+use subfit::measure::MeshDistance;
 use subfit::mesh::{HalfEdgeMesh, PolyMesh, Polygons};
-use subfit::report::MeshDistance;
 use subfit::subdiv::{sampling_operator, Options};
 use subfit::{fit_scan, FitScanOptions, Input};
 

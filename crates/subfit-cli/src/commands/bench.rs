@@ -27,6 +27,7 @@ pub fn run(cmd: BenchCommand) -> anyhow::Result<ExitCode> {
         BenchCommand::Convergence(a) => convergence(a),
         BenchCommand::Fit(a) => crate::commands::bench_fit::run(a),
         BenchCommand::Sequence(a) => crate::commands::bench_sequence::run(a),
+        BenchCommand::Corpus(a) => crate::commands::bench_corpus::run(a),
     }
 }
 

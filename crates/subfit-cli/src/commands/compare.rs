@@ -18,9 +18,9 @@ use std::process::ExitCode;
 use anyhow::{bail, Context};
 use rayon::prelude::*;
 use serde::Serialize;
+use subfit::measure::data_samples::area_samples;
+use subfit::measure::DistanceStats;
 use subfit::mesh::PolyMesh;
-use subfit::report::data_samples::area_samples;
-use subfit::report::DistanceStats;
 use subfit::subdiv::{
     area_weights, random_samples, ClosestOptions, ClosestPointFinder, Evaluator, Options,
 };

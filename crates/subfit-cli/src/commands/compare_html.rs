@@ -5,10 +5,11 @@
 
 use anyhow::Context;
 use rayon::prelude::*;
+use subfit::measure::DistanceStats;
 use subfit::mesh::{PolyMesh, Tags};
+use subfit::report::error_color;
 use subfit::report::html::{self, Block, ColorScale, Layer, LayerKind, Page, Scene, Section};
 use subfit::report::plot::{histogram_chart, HistogramOptions};
-use subfit::report::{error_color, DistanceStats};
 use subfit::subdiv::{sampling_operator, Options};
 use subfit::target::TriangleBvh;
 use subfit::{VIEW_POINTS, VIEW_TRIANGLES};

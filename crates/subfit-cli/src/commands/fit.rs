@@ -66,16 +66,12 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         }
     };
     let (method, step) = (method_of(a.method), step_of(a.step));
-    Ok(FitScanOptions {
+    let defaults = FitScanOptions::default();
+    let mut o = FitScanOptions {
         init,
         control_points: a.control_points.map(|n| n as usize),
         as_points: a.as_points,
-        scheme: match a.scheme {
-            SchemeArg::Auto => None,
-            SchemeArg::Loop => Some(Scheme::Loop),
-            SchemeArg::CatmullClark => Some(Scheme::CatmullClark),
-            SchemeArg::QuadTri => Some(Scheme::QuadTriangle),
-        },
+        scheme: scheme_of(a.scheme),
         quad_dominant: quad_dominant_flag(a.quad_dominant, a.no_quad_dominant),
         fit: FitOptions {
             sample_level: a.sample_level as usize,
@@ -94,17 +90,8 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             ..FitOptions::default()
         },
         stages: StageOptions {
-            lambda_start: a.lambda,
-            lambda_end: a.lambda_end.unwrap_or(a.lambda.min(1e-5)),
             iterations_per_stage: a.stage_iterations as usize,
             max_iterations: a.max_iterations as usize,
-            tolerance_rms: a.tolerance.unwrap_or(StageOptions::default().tolerance_rms),
-            tolerance_max: a.max_error.unwrap_or(0.0),
-            max_control_points: a
-                .max_control_points
-                .map_or(StageOptions::default().max_control_points, |n| n as usize),
-            refine: !a.no_refine,
-            edge_flips: !(a.no_refine || a.no_flips),
             max_depth: a.max_depth,
             local: a.local,
             local_rings: a.local_rings as usize,
@@ -124,21 +111,25 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
                 ..subfit::init::ContourOptions::default()
             },
             // A level given is the level used, one-sided or not.
-            one_sided_refine: a.contour_refine.map_or(
-                FitScanOptions::default().init_options.one_sided_refine,
-                usize::from,
-            ),
-            ..FitScanOptions::default().init_options
+            one_sided_refine: a
+                .contour_refine
+                .map_or(defaults.init_options.one_sided_refine, usize::from),
+            ..defaults.init_options.clone()
         },
-        target_tolerances: a.tolerance.is_none()
-            && a.max_error.is_none()
-            && a.max_control_points.is_none(),
         // An angle given is the angle used.
-        cad_feature_angle: FitScanOptions::default()
+        cad_feature_angle: defaults
             .cad_feature_angle
             .filter(|_| a.features.feature_angle.is_none()),
-        ..FitScanOptions::default()
-    })
+        ..defaults
+    };
+    o.set_limits(
+        a.tolerance,
+        a.max_error,
+        a.max_control_points.map(|n| n as usize),
+    );
+    o.set_lambda(a.lambda, a.lambda_end);
+    o.set_refinement(!a.no_refine, !a.no_flips);
+    Ok(o)
 }
 
 /// Runs the pipeline for `a` and writes its outputs; shared by `fit`, `demo` and `bench fit`.
@@ -283,11 +274,22 @@ pub fn blender_hint(fitted: &Fitted) {
 pub fn write_outputs(fitted: &mut Fitted, dir: &std::path::Path) -> anyhow::Result<()> {
     let stage = crate::interrupt::Staging::new(dir)
         .with_context(|| format!("{}: cannot create directory", dir.display()))?;
+    crate::progress::phase("writing the outputs");
     fitted.write_into(&stage.path(""))?;
     stage
         .commit(&OUTPUTS)
         .with_context(|| format!("{}: cannot move the outputs into place", dir.display()))?;
     Ok(())
+}
+
+/// The scheme asked by `--scheme` (`None`: automatic).
+pub(crate) fn scheme_of(s: SchemeArg) -> Option<Scheme> {
+    match s {
+        SchemeArg::Auto => None,
+        SchemeArg::Loop => Some(Scheme::Loop),
+        SchemeArg::CatmullClark => Some(Scheme::CatmullClark),
+        SchemeArg::QuadTri => Some(Scheme::QuadTriangle),
+    }
 }
 
 pub(crate) fn method_of(m: MethodArg) -> Method {

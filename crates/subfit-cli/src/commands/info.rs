@@ -27,6 +27,8 @@ struct Info {
     colors: bool,
     bbox: Option<BBox>,
     topology: Option<Topology>,
+    /// What the reader decided about the file (also printed on stderr).
+    warnings: Vec<String>,
 }
 
 #[derive(Serialize)]
@@ -198,6 +200,7 @@ fn describe(path: &Path, mesh: &PolyMesh, fi: &subfit::io::FileInfo) -> Info {
         colors: mesh.colors.is_some(),
         bbox,
         topology,
+        warnings: fi.warnings.clone(),
     }
 }
 
@@ -208,7 +211,9 @@ pub fn run(a: InfoArgs) -> anyhow::Result<ExitCode> {
             format: Some(f.into()),
             ..ReadOptions::default()
         };
-        subfit::io::read_bytes(&bytes, &a.file, &opts)?
+        let out = subfit::io::read_bytes(&bytes, &a.file, &opts)?;
+        crate::progress::print_read_warnings(&a.file, &out.1.warnings);
+        out
     } else {
         crate::progress::load(&a.file)?
     };

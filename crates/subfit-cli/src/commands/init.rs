@@ -1,24 +1,27 @@
 //! `subfit init TARGET [--control-points N] [--from-points] -o control.obj`: an initial control
 //! mesh with the target's topology (DESIGN.md §3.6), written in the target's coordinates.
 //!
-//! Mesh targets are simplified (topology-preserving QEM); point clouds, or any target with
-//! `--from-points`, are contoured (IMLS on an adaptive octree + marching tetrahedra) and then simplified. The default
-//! size is [`subfit::init::default_control_points`]: `clamp(round(1.5·√points), 200, 2000)`.
-//! `--quad-dominant` pairs the triangles into quads ([`subfit::init::pair_triangles`]).
-//! `--curvature-lines` builds Lavoué et al.'s cage instead ([`subfit::init::curvature_lines`]).
+//! It is the library's start ([`subfit::initialize`]): the input read, repaired and analysed as
+//! `subfit fit` does, and the first start `fit` would fit built with the same defaults — mesh
+//! targets simplified (topology-preserving QEM); point clouds, or any target with
+//! `--from-points`, contoured (IMLS on an adaptive octree + marching tetrahedra) and then
+//! simplified. The default size is [`subfit::init::default_control_points`]:
+//! `clamp(round(1.5·√points), 200, 2000)`. `--quad-dominant` pairs the triangles into quads
+//! ([`subfit::init::pair_triangles`]). `--curvature-lines` builds Lavoué et al.'s cage instead
+//! ([`subfit::init::curvature_lines`]).
 
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{bail, Context};
-use subfit::init::{
-    default_control_points, initial_control_mesh, InitOptions, InitReport, InitSource,
-};
+use anyhow::bail;
+use subfit::init::{InitReport, InitSource};
 use subfit::io::{Encoding, Format, WriteOptions};
-use subfit::mesh::{diagnose_mesh, PolyMesh};
-use subfit::target::{Target, TargetOptions};
+use subfit::mesh::PolyMesh;
+use subfit::pipeline_report::Topology;
+use subfit::target::Target;
+use subfit::{initialize, FitScanOptions, InitialCage, Initialized, Input, Progress, Step};
 
-use crate::cli::InitArgs;
+use crate::cli::{InitArgs, SchemeArg};
 
 pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     // Validate the flags before reading anything.
@@ -36,104 +39,142 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
     if a.output.is_dir() {
         bail!("{}: is a directory", a.output.display());
     }
-
-    let t0 = Instant::now();
-    let (mut input, _) = crate::progress::load(&a.target)?;
-    crate::commands::repair_target(&mut input, &a.target);
-    let read_time = t0.elapsed();
-    let use_mesh = !a.from_points && !input.faces.is_empty();
-    // The target's own topology, when it has faces.
-    let input_topology = (!input.faces.is_empty()).then(|| diagnose_mesh(&input));
-
-    let t = Instant::now();
-    let sp = crate::progress::spinner("analysing the target");
-    let built = if use_mesh {
-        let opts = TargetOptions {
-            mesh_closest_point: false,
-            cancel: crate::interrupt::token(),
-            ..TargetOptions::default()
-        };
-        Target::build(&input, &opts, None)
-    } else {
-        let cloud = PolyMesh::point_cloud(input.positions.clone(), input.normals.clone());
-        let opts = TargetOptions {
-            cancel: crate::interrupt::token(),
-            ..TargetOptions::default()
-        };
-        Target::build(&cloud, &opts, None)
-    };
-    sp.finish_and_clear();
-    let target =
-        built.with_context(|| format!("{}: cannot use as a target", a.target.display()))?;
-    let target_time = t.elapsed();
-
-    if a.curvature_lines {
-        return curvature_lines(&a, &input, &target, t0);
-    }
-    let n = a
-        .control_points
-        .map_or_else(|| default_control_points(target.len()), |n| n as usize);
-    let expected_genus = match (&input_topology, a.genus) {
-        (_, Some(g)) => Some(g),
-        (Some(d), None) => d.genus,
-        (None, None) => None,
-    };
-    if a.require_genus && !use_mesh && expected_genus.is_none() {
-        bail!("--require-genus on a point cloud needs --genus G (the genus it should have)");
-    }
-    if a.scheme == crate::cli::SchemeArg::Loop && a.quad_dominant {
+    if a.scheme == SchemeArg::Loop && a.quad_dominant {
         bail!("--quad-dominant makes quads, but Loop subdivision needs triangles: use --scheme catmull-clark or quad-tri");
     }
-    let options = InitOptions {
-        expected_genus,
-        expected_boundary_loops: input_topology.as_ref().map(|d| d.boundary_loops),
-        require_genus: a.require_genus,
-        quad_dominant: crate::cli::quad_dominant_flag(a.quad_dominant, a.no_quad_dominant)
-            .unwrap_or(matches!(
-                a.scheme,
-                crate::cli::SchemeArg::CatmullClark | crate::cli::SchemeArg::QuadTri
-            )),
-        cancel: crate::interrupt::token(),
-        features: a.features.options(),
-        semi_sharp: a.features.semi_sharp,
-        cloud_features: a.features.cloud_features,
-        contour: subfit::init::ContourOptions {
-            refine_levels: usize::from(a.contour_refine),
-            ..subfit::init::ContourOptions::default()
-        },
-        // Concave corners may add points, but not to a count asked for.
-        max_control_points: if a.control_points.is_some() {
-            n
-        } else {
-            usize::MAX
-        },
-        ..InitOptions::default()
+    let options = options(&a);
+    let t0 = Instant::now();
+    let (mesh, _) = crate::progress::load(&a.target)?;
+    if a.require_genus && a.genus.is_none() && mesh.faces.is_empty() {
+        bail!("--require-genus on a point cloud needs --genus G (the genus it should have)");
+    }
+    // A mesh that cannot be used as one may still be contoured from its vertices.
+    let hint = !a.from_points && !mesh.faces.is_empty();
+    let input = Input::Mesh {
+        mesh,
+        name: a.target.display().to_string(),
     };
-    let sp = crate::progress::spinner(if use_mesh {
-        "simplifying"
-    } else {
-        "contouring and simplifying"
-    });
-    let result = initial_control_mesh(&target, use_mesh.then_some(&input), n, &options);
-    sp.finish_and_clear();
-    let (cage, report) = result.map_err(|e| {
-        let hint = match e {
-            subfit::init::InitError::InvalidMesh(_) => {
-                " (use --from-points to contour its vertices instead)"
-            }
-            _ => "",
-        };
-        anyhow::anyhow!(
-            "{}: cannot build the initial control mesh: {e}{hint}",
-            a.target.display()
-        )
-    })?;
-
+    let built = initialize_with_progress(input, &options, &a, hint)?;
     let t = Instant::now();
-    let out = write_cage(&a, &target, &cage, &report.tags)?;
+    let out = write_cage(&a, &built.prepared.target, &built.start.cage, &built.tags)?;
     let write_time = t.elapsed();
+    if let Some(r) = &built.start.curvature_report {
+        print_curvature_lines(&a, r, &out, t0);
+        return Ok(ExitCode::SUCCESS);
+    }
+    if let Some(r) = &built.start.init_report {
+        let topology = built.prepared.topology.or(built.prepared.expected_topology);
+        let faces = built.prepared.mesh_faces();
+        let requested = built.start.summary.requested_control_points.unwrap_or(0);
+        print_summary(
+            &a,
+            &built.prepared.target,
+            topology.map(|t| (t, faces)),
+            r,
+            requested,
+            &out,
+        );
+        print_notes(r, &out, requested);
+        out!(
+            "time: read and analyse {:.3} s, contour {:.3} s, simplify {:.3} s, pair {:.3} s, write {:.3} s, total {:.3} s",
+            built.prepared.read_and_analyse_seconds(),
+            r.timings.contour.as_secs_f64(),
+            r.timings.simplify.as_secs_f64(),
+            r.timings.pair.as_secs_f64(),
+            write_time.as_secs_f64(),
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    out!("wrote {}", a.output.display());
+    Ok(ExitCode::SUCCESS)
+}
 
-    print_summary(&a, &target, input_topology.as_ref(), &report, n, &out);
+/// The library's options for `a`: those of `subfit fit` with its defaults, no budget beyond
+/// a count asked, and the flags of `init`.
+fn options(a: &InitArgs) -> FitScanOptions {
+    let defaults = FitScanOptions::default();
+    let mut o = FitScanOptions {
+        init: if a.curvature_lines {
+            InitialCage::CurvatureLines
+        } else {
+            InitialCage::Qem
+        },
+        control_points: a.control_points.map(|n| n as usize),
+        as_points: a.from_points,
+        scheme: crate::commands::fit::scheme_of(a.scheme),
+        quad_dominant: crate::cli::quad_dominant_flag(a.quad_dominant, a.no_quad_dominant),
+        // The fit's defaults decide as they do for `subfit fit` without a tolerance.
+        target_tolerances: true,
+        cad_feature_angle: defaults
+            .cad_feature_angle
+            .filter(|_| a.features.feature_angle.is_none()),
+        cancel: crate::interrupt::token(),
+        ..defaults
+    };
+    o.stages.max_control_points = usize::MAX;
+    o.target.mesh_closest_point = false;
+    o.init_options.expected_genus = a.genus;
+    o.init_options.require_genus = a.require_genus;
+    o.init_options.features = a.features.options();
+    o.init_options.semi_sharp = a.features.semi_sharp;
+    o.init_options.cloud_features = a.features.cloud_features;
+    o.init_options.contour.refine_levels = usize::from(a.contour_refine);
+    o.init_options.one_sided_refine = usize::from(a.contour_refine);
+    o
+}
+
+/// [`initialize`] with a spinner per step and warnings on stderr.
+fn initialize_with_progress(
+    input: Input,
+    options: &FitScanOptions,
+    a: &InitArgs,
+    contour_hint: bool,
+) -> anyhow::Result<Initialized> {
+    let mut spinner: Option<indicatif::ProgressBar> = None;
+    let building = if a.curvature_lines {
+        "fitting boundary curves and cutting along curvature lines"
+    } else {
+        "building the initial control mesh"
+    };
+    let mut on = |p: Progress<'_>| match p {
+        Progress::Step(s) => {
+            if let Some(sp) = spinner.take() {
+                sp.finish_and_clear();
+            }
+            match s {
+                Step::Analyse => spinner = Some(crate::progress::spinner("analysing the target")),
+                Step::Init => spinner = Some(crate::progress::spinner(building)),
+                Step::Read | Step::Fit => {}
+            }
+        }
+        Progress::Warning(w) => eprintln!("subfit: warning: {w}"),
+        Progress::Iteration { .. } | Progress::Stage(_) => {}
+    };
+    let built = initialize(input, options, Some(&mut on));
+    if let Some(sp) = spinner.take() {
+        sp.finish_and_clear();
+    }
+    built.map_err(|e| {
+        let unusable_mesh = matches!(
+            &e,
+            subfit::Error::Input { .. }
+                | subfit::Error::Init {
+                    source: subfit::init::InitError::InvalidMesh(_),
+                    ..
+                }
+        );
+        let hint = if contour_hint && unusable_mesh {
+            " (use --from-points to contour its vertices instead)"
+        } else {
+            ""
+        };
+        anyhow::anyhow!("cannot build the initial control mesh: {e}{hint}")
+    })
+}
+
+/// What the QEM or contour start noted: concave corners, the space-carving fallback, a count
+/// not reached, a genus missed.
+fn print_notes(report: &InitReport, out: &PolyMesh, requested: usize) {
     if report.concave.creases > 0 {
         out!(
             "note: {} concave corner sector(s) split by a crease so the limit surface does not fold there ({} control point(s) added)",
@@ -147,75 +188,21 @@ pub fn run(a: InitArgs) -> anyhow::Result<ExitCode> {
             report.genus_target
         );
     }
-    out!(
-        "time: read {:.3} s, target {:.3} s, contour {:.3} s, simplify {:.3} s, pair {:.3} s, write {:.3} s, total {:.3} s",
-        read_time.as_secs_f64(),
-        target_time.as_secs_f64(),
-        report.timings.contour.as_secs_f64(),
-        report.timings.simplify.as_secs_f64(),
-        report.timings.pair.as_secs_f64(),
-        write_time.as_secs_f64(),
-        t0.elapsed().as_secs_f64()
-    );
-    out!("wrote {}", a.output.display());
-    if report.simplify.smoothed {
-        eprintln!(
-            "subfit: warning: the mesh is too noisy to simplify as it is (crumpled triangles); \
-             the cage was simplified from a smoothed copy"
-        );
-    }
     if !report.simplify.reached_target {
         eprintln!(
-            "subfit: warning: no legal collapse left at {} vertices ({n} requested)",
+            "subfit: warning: no legal collapse left at {} vertices ({requested} requested)",
             out.num_vertices()
         );
     }
-    if !report.genus_matches {
-        eprintln!(
-            "subfit: warning: the cage has genus {}, the target {}",
-            report.genus_after, report.genus_target
-        );
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
-/// `--curvature-lines`: the cage of [`subfit::init::curvature_lines`], written with its
-/// corner tags.
-fn curvature_lines(
+/// `--curvature-lines`: what [`subfit::init::curvature_lines`] built.
+fn print_curvature_lines(
     a: &InitArgs,
-    input: &PolyMesh,
-    target: &Target,
+    r: &subfit::init::curvature_lines::CurvatureLineReport,
+    out: &PolyMesh,
     t0: Instant,
-) -> anyhow::Result<ExitCode> {
-    use subfit::init::curvature_lines::{curvature_line_cage, CurvatureLineOptions};
-    if input.faces.is_empty() {
-        bail!(
-            "{}: --curvature-lines needs a mesh (faces): a point cloud has no boundary loops to start from",
-            a.target.display()
-        );
-    }
-    let dense = PolyMesh::new(
-        input
-            .positions
-            .iter()
-            .map(|&p| target.to_normalized(p))
-            .collect(),
-        subfit::mesh::Polygons::from_triangles(&input.faces.triangulate_fan()),
-    );
-    let options = CurvatureLineOptions {
-        cancel: crate::interrupt::token(),
-        ..CurvatureLineOptions::default()
-    };
-    let sp = crate::progress::spinner("fitting boundary curves and cutting along curvature lines");
-    let result = curvature_line_cage(target, &dense, &options);
-    sp.finish_and_clear();
-    let (cage, tags, r) = result.map_err(|e| {
-        anyhow::anyhow!(
-            "{}: cannot build the curvature-line cage: {e}",
-            a.target.display()
-        )
-    })?;
-    let out = write_cage(a, target, &cage, &tags)?;
+) {
     let quads = out.faces.iter().filter(|f| f.len() == 4).count();
     out!(
         "boundary curves: {} loop(s), control points {:?}, {} corner(s), largest distance of a boundary vertex {:.2e} unit cube",
@@ -242,7 +229,6 @@ fn curvature_lines(
         t0.elapsed().as_secs_f64()
     );
     out!("wrote {}", a.output.display());
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Writes `cage` (normalized units) in the target's coordinates to `a.output`, with its tags
@@ -285,7 +271,7 @@ fn write_cage(
 fn print_summary(
     a: &InitArgs,
     target: &Target,
-    input: Option<&subfit::mesh::MeshReport>,
+    input: Option<(Topology, usize)>,
     r: &InitReport,
     requested: usize,
     out: &PolyMesh,
@@ -295,12 +281,12 @@ fn print_summary(
         None => format!("genus unknown (not a manifold), {loops} boundary loop(s)"),
     };
     match input {
-        Some(d) => out!(
+        Some((t, faces)) => out!(
             "target {}: {} points, {} faces, {}",
             a.target.display(),
             target.len(),
-            d.num_faces,
-            topo(d.genus, d.boundary_loops)
+            faces,
+            topo(Some(t.genus), t.boundary_loops)
         ),
         None => out!(
             "target {}: {} points (point cloud)",

@@ -2,6 +2,7 @@
 
 mod analyze;
 mod bench;
+mod bench_corpus;
 mod bench_fit;
 mod bench_sequence;
 mod compare;

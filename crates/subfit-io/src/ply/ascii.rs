@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::header::{Element, Header, Property, Slot, Ty};
-use super::read::{color8, Record, Sink};
+use super::read::{set_color, Record, Sink};
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{parse_f64, parse_i64, tokens, NumberedLines};
 
@@ -56,6 +56,7 @@ fn ascii_record(
     rec: &mut Record,
 ) -> Result<()> {
     let mut toks = tokens(text);
+    rec.nan_color = false;
     let name = &el.name;
     let missing = |p: &Property| {
         Error::at_line(
@@ -85,7 +86,7 @@ fn ascii_record(
                 match slot {
                     Slot::Coord(k) => rec.p[k] = v,
                     Slot::Normal(k) => rec.n[k] = v,
-                    Slot::Color(k) => rec.c[k] = color8(v, s),
+                    Slot::Color(k) => set_color(rec, k, v, s),
                     Slot::Skip | Slot::Indices => {}
                 }
             }

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::header::{Element, Header, Role, Scalar, Slot, Ty};
-use super::read::{color8, Record, Sink};
+use super::read::{set_color, Record, Sink};
 use crate::error::{Error, ErrorKind, Result};
 
 /// `N` bytes from the front of `b` in little-endian order. The caller guarantees `b.len() >= N`.
@@ -130,12 +130,13 @@ fn binary_fixed(
         return Ok(());
     }
     for (index, r) in block.chunks_exact(off).enumerate() {
+        rec.nan_color = false;
         for &(o, s, slot) in &used {
             let v = bin_f64(s, &r[o..], big);
             match slot {
                 Slot::Coord(k) => rec.p[k] = v,
                 Slot::Normal(k) => rec.n[k] = v,
-                Slot::Color(k) => rec.c[k] = color8(v, s),
+                Slot::Color(k) => set_color(rec, k, v, s),
                 Slot::Skip | Slot::Indices => {}
             }
         }
@@ -163,6 +164,7 @@ fn binary_record(
     rec: &mut Record,
 ) -> std::result::Result<usize, BinError> {
     let take = |pos: usize, n: usize| -> Option<&[u8]> { data.get(pos..pos.checked_add(n)?) };
+    rec.nan_color = false;
     for (p, &slot) in el.props.iter().zip(&el.slots) {
         match p.ty {
             Ty::Scalar(s) => {
@@ -177,7 +179,7 @@ fn binary_record(
                 match slot {
                     Slot::Coord(k) => rec.p[k] = v,
                     Slot::Normal(k) => rec.n[k] = v,
-                    Slot::Color(k) => rec.c[k] = color8(v, s),
+                    Slot::Color(k) => set_color(rec, k, v, s),
                     Slot::Skip | Slot::Indices => {}
                 }
             }

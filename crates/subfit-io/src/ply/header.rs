@@ -117,6 +117,8 @@ pub(super) struct Header {
     pub(super) has_normals: bool,
     pub(super) has_colors: bool,
     pub(super) vertex_count: u64,
+    /// Header lines with an unknown keyword, skipped: (1-based line, keyword).
+    pub(super) skipped: Vec<(u64, String)>,
 }
 
 pub(super) fn bad_header(path: &Path, line: u64, msg: impl Into<String>) -> Error {
@@ -129,12 +131,23 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
     let mut line_no = 0u64;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    let mut skipped = Vec::new();
     loop {
         if pos >= bytes.len() {
+            let unknown: Vec<String> = skipped
+                .iter()
+                .take(3)
+                .map(|(l, k)| format!("line {l} `{k}`"))
+                .collect();
+            let note = if unknown.is_empty() {
+                String::new()
+            } else {
+                format!(" (not understood: {})", unknown.join(", "))
+            };
             return Err(Error::at_line(
                 path,
                 line_no + 1,
-                ErrorKind::Truncated("the header ends without `end_header`".into()),
+                ErrorKind::Truncated(format!("the header ends without `end_header`{note}")),
             ));
         }
         let rest = &bytes[pos..];
@@ -144,6 +157,11 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         };
         pos = next;
         line_no += 1;
+        // Comments may hold any bytes (names in Latin-1 or a code page); every other header
+        // line is read as text.
+        if line_no > 1 && (raw.starts_with(b"comment") || raw.starts_with(b"obj_info")) {
+            continue;
+        }
         let text = std::str::from_utf8(raw)
             .map_err(|_| bad_header(path, line_no, "the header is not UTF-8 text"))?;
         let text = text.trim();
@@ -212,14 +230,10 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
                 el.props.push(prop);
             }
             "end_header" => break,
-            other => {
-                let shown: String = other.chars().take(40).collect();
-                return Err(bad_header(
-                    path,
-                    line_no,
-                    format!("unknown header keyword `{shown}`"),
-                ));
-            }
+            // Lines no PLY reader understands (stray `bye` lines of old Cyberware range scans):
+            // skipped and reported, since the elements and properties around them still say
+            // exactly how to read the data.
+            other => skipped.push((line_no, other.chars().take(40).collect())),
         }
     }
     let encoding = encoding
@@ -232,6 +246,7 @@ pub(super) fn parse_header(bytes: &[u8], path: &Path) -> Result<Header> {
         has_normals: false,
         has_colors: false,
         vertex_count: 0,
+        skipped,
     };
     plan(&mut header, path)?;
     Ok(header)

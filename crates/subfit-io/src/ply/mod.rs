@@ -3,14 +3,18 @@
 //!
 //! **Reading** accepts `format ascii 1.0`, `binary_little_endian 1.0` and
 //! `binary_big_endian 1.0`; header lines may end in `\n` or `\r\n`; `comment` and `obj_info`
-//! lines are ignored. Properties may come in any order and have any scalar type (`char`,
-//! `uchar`, `short`, `ushort`, `int`, `uint`, `float`, `double` and the aliases `int8` …
-//! `float64`). What is taken:
+//! lines are ignored (they may hold any bytes), and so are lines with an unknown keyword (old
+//! Cyberware range scans carry stray `bye` lines), with a warning naming them. Properties may
+//! come in any order and have any scalar type (`char`, `uchar`, `short`, `ushort`, `int`,
+//! `uint`, `float`, `double` and the aliases `int8` … `float64`). What is taken:
 //! - `element vertex`: `x`, `y`, `z` (required, any scalar type); `nx`, `ny`, `nz` when all three
 //!   are present; `red`, `green`, `blue` (or `diffuse_red` …) when all three are present —
-//!   integer colours are clamped to 0..=255, float colours in 0..1 are scaled by 255.
+//!   integer colours are clamped to 0..=255, float colours in 0..1 are scaled by 255; a NaN
+//!   colour component reads as 0 (with a warning counting such vertices). Other vertex
+//!   properties are skipped.
 //! - `element face`: a list property `vertex_indices` (or `vertex_index`) with any integer count
-//!   and index types; faces of every size are kept as they are.
+//!   and index types; faces of every size are kept as they are; other face properties (colours,
+//!   flags, texture coordinate lists) are skipped.
 //! - `element tristrips`: a list `vertex_indices`; `-1` ends a strip, every odd triangle of a
 //!   strip is flipped to keep the orientation, and triangles with two equal corners (the
 //!   "swap" triangles strip encoders insert) are dropped.

@@ -16,13 +16,22 @@ pub(super) struct Record {
     pub(super) p: [f64; 3],
     pub(super) n: [f64; 3],
     pub(super) c: [u8; 3],
+    /// Whether a colour component of this record is NaN (it reads as 0).
+    pub(super) nan_color: bool,
     /// The index list (face corners or strip indices, `-1` included).
     pub(super) list: Vec<i64>,
 }
 
+/// Stores colour component `k` of type `s` into `rec` (8 bits; NaN noted and read as 0).
+#[inline]
+pub(super) fn set_color(rec: &mut Record, k: usize, v: f64, s: Scalar) {
+    rec.c[k] = color8(v, s);
+    rec.nan_color |= v.is_nan();
+}
+
 /// Converts a colour value of type `s` to 8 bits.
 #[inline]
-pub(super) fn color8(v: f64, s: Scalar) -> u8 {
+fn color8(v: f64, s: Scalar) -> u8 {
     let v = if s.is_float() { (v * 255.0).round() } else { v };
     // `as` saturates (NaN → 0).
     v.clamp(0.0, 255.0) as u8
@@ -36,6 +45,8 @@ pub(super) struct Sink {
     pub(super) faces: Polygons,
     pub(super) vertex_count: u64,
     pub(super) face: Vec<u32>,
+    /// Vertices with a NaN colour component.
+    pub(super) nan_colors: u64,
 }
 
 /// `NonFinite` naming the first non-finite component of vertex `index`.
@@ -90,6 +101,7 @@ impl Sink {
                 }
                 if let Some(v) = &mut self.colors {
                     v.push(rec.c);
+                    self.nan_colors += rec.nan_color as u64;
                 }
             }
             Role::Face => {
@@ -162,14 +174,15 @@ impl Sink {
 /// Parses a whole PLY file (see the module doc for what is supported).
 ///
 /// Returns the mesh (positions, optional normals and colours, faces from `face` and/or
-/// `tristrips`) and the file's encoding. Cost: O(file size); memory O(mesh size).
+/// `tristrips`) and the file's encoding; header lines with an unknown keyword (skipped) and
+/// NaN colours (read as 0) are reported in `warnings`. Cost: O(file size); memory O(mesh size).
 ///
 /// Errors: [`ErrorKind::Empty`], [`ErrorKind::BadHeader`] (missing magic, bad `format`, unknown
 /// type, missing `x`/`y`/`z`, non-UTF-8 header…), [`ErrorKind::BadCount`] (negative counts, an
 /// element count the remaining bytes cannot hold, negative list counts),
 /// [`ErrorKind::Truncated`], [`ErrorKind::Syntax`] (ascii), [`ErrorKind::IndexOutOfRange`],
 /// [`ErrorKind::NonFinite`]. Never panics.
-pub fn read(bytes: &[u8], path: &Path) -> Result<(PolyMesh, Encoding)> {
+pub fn read(bytes: &[u8], path: &Path, warnings: &mut Vec<String>) -> Result<(PolyMesh, Encoding)> {
     if bytes.iter().all(|c| c.is_ascii_whitespace()) {
         return Err(Error::file(path, ErrorKind::Empty));
     }
@@ -182,11 +195,36 @@ pub fn read(bytes: &[u8], path: &Path) -> Result<(PolyMesh, Encoding)> {
         faces: Polygons::new(),
         vertex_count: header.vertex_count,
         face: Vec::new(),
+        nan_colors: 0,
     };
+    if !header.skipped.is_empty() {
+        let listed: Vec<String> = header
+            .skipped
+            .iter()
+            .take(5)
+            .map(|(l, k)| format!("line {l} `{k}`"))
+            .collect();
+        warnings.push(format!(
+            "{} header line(s) with an unknown keyword skipped: {}{}",
+            header.skipped.len(),
+            listed.join(", "),
+            if header.skipped.len() > 5 {
+                ", …"
+            } else {
+                ""
+            }
+        ));
+    }
     match header.encoding {
         Encoding::Ascii => read_ascii(&header, data, path, &mut sink)?,
         Encoding::BinaryLittleEndian => read_binary(&header, data, false, path, &mut sink)?,
         Encoding::BinaryBigEndian => read_binary(&header, data, true, path, &mut sink)?,
+    }
+    if sink.nan_colors > 0 {
+        warnings.push(format!(
+            "{} vertices have a NaN colour component, read as 0",
+            sink.nan_colors
+        ));
     }
     let mesh = PolyMesh {
         positions: sink.positions,

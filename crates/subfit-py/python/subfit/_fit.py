@@ -176,8 +176,10 @@ def fit(
         Subdivision scheme (``auto``, as ``subfit fit``: the quad/triangle scheme for an open
         mesh target, which is Loop on the automatic cage's triangles and gets quads from the
         curvature-line start; Loop for other all-triangle cages, Catmull-Clark otherwise).
-    method : {"sdm", "tdm", "pdm"}
-        Error term (Cheng et al. 2007): squared, tangent or point distance minimization.
+    method : {"sdm", "tdm", "pdm", "imls"}
+        Error term: squared, tangent or point distance minimization (Cheng et al. 2007), or
+        the IMLS distance (Xie et al. 2023; ``imls_radius`` sets its kernel radius, ``arap``
+        the weight of its as-rigid-as-possible regularizer, as ``subfit fit``).
     tolerance : float, optional
         Target E_rms (unit-cube units, in (0, 1)). Without ``tolerance``, ``max_error`` and
         ``max_control_points`` the tolerances are the target's, fractions of its bounding-box
@@ -206,8 +208,11 @@ def fit(
         ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),
         ``refine`` (True; ``--no-refine``), ``edge_flips`` (True; ``--no-flips``),
         ``max_depth`` (5), ``local`` (False), ``local_rings`` (2), ``local_field_peak`` (0.8),
-        ``local_field_share`` (0.5; 0 turns local enrichment off), ``error_scale``, ``name``
-        (used in messages).
+        ``local_field_share`` (0.5; 0 turns local enrichment off), ``error_scale``,
+        ``imls_radius`` (``method="imls"``: the kernel's support radius h, unit-cube units;
+        default half the point spacing, at least 4 × the noise level), ``arap`` (0: the weight
+        of the as-rigid-as-possible regularizer, Xie et al. 2023 eq. 5), ``name`` (used in
+        messages).
 
     Returns
     -------

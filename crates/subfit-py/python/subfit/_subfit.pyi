@@ -50,7 +50,11 @@ def fit(
     max_depth: int = 5,
     local: bool = False,
     local_rings: Optional[int] = None,
+    local_field_peak: float = 0.8,
+    local_field_share: float = 0.5,
     error_scale: Optional[float] = None,
+    imls_radius: Optional[float] = None,
+    arap: float = 0.0,
     name: Optional[str] = None,
     progress: Optional[Callable[[dict], Any]] = None,
 ) -> NativeFit: ...

@@ -2,7 +2,7 @@
 //! e.g. control points per stage or seconds per phase. Horizontal so that long category names
 //! (`"stage 3 (λ = 0.001)"`, `"closest points"`) read without rotation.
 
-use super::{esc, fmt_value, nice_ticks, Frame, COLORS};
+use super::frame::{esc, fmt_value, nice_ticks, Frame, COLORS};
 use std::fmt::Write as _;
 
 /// One category and its value.

@@ -9,7 +9,7 @@
 //! The y axis shows the fraction of each direction's samples (default), so directions with
 //! different sample counts compare, or raw counts.
 
-use super::{esc, fmt_tick, fmt_value, nice_ticks, Frame, COLORS};
+use super::frame::{esc, fmt_tick, fmt_value, nice_ticks, Frame, COLORS};
 use std::fmt::Write as _;
 
 /// How the x axis is cut into bins.

@@ -1,7 +1,7 @@
 //! Line charts with a linear x axis and a log10 y axis: error per iteration, one polyline per
 //! series, with dashed vertical stage boundaries and horizontal reference lines.
 
-use super::{esc, nice_ticks, Frame, Series, COLORS};
+use super::frame::{esc, nice_ticks, Frame, Series, COLORS};
 use std::fmt::Write as _;
 
 /// Reference lines and size of a [`log_chart_with`] chart. Default: none, 760 × 480.

@@ -1,6 +1,7 @@
 //! Tests of the SVG charts: well-formed XML, the series and labels present, no panic or
 //! non-finite coordinate on empty or non-finite input.
 
+use super::frame::{esc, fmt_value, nice_ticks, COLORS};
 use super::*;
 
 /// Parses `svg` as XML and checks that no attribute holds a non-finite number.

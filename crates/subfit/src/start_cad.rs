@@ -11,21 +11,27 @@
 //! default fit of a coarse export is the export itself, emptied of the vertices its planes do
 //! not need; a fine export's cylinders and fillets come out smooth.
 //!
-//! The hook is one call ([`cad_start`]) in [`crate::scan`]'s pipeline, before the QEM start:
-//! it returns `None` (the pipeline goes on as for any mesh) unless the start is automatic, no
-//! control-point count was asked, features are on, the target is a tessellation with creases
-//! and the cage fits the budget.
+//! The hook: [`crate::starts::starts`] lists this start ([`StartKind::Cad`]) first when
+//! [`cad_applies`] (the start is automatic, no control-point count asked, features on, not as
+//! points, and the target recognised as a tessellation, [`subfit_target::Target::facets`]);
+//! [`cad_start`] builds it, or fails with a budget error (no creases, or a cage over the budget)
+//! that leaves the QEM start listed after it to fit the input as any mesh. The fit of a CAD
+//! start is judged by [`ToleranceKind::Tessellation`] within at most the tessellation's vertices
+//! (`fit_start.rs`); the QEM start after it must then be more compact to win.
+
+use std::sync::Arc;
 
 use subfit_init::{cad_cage, CadOptions};
-use subfit_mesh::{PolyMesh, Tags};
 use subfit_target::tessellation::{classify_edges, EdgeClass, Facets, SmoothBudget};
-use subfit_target::Target;
 
 use crate::error::Error;
+use crate::options::{FitScanOptions, InitialCage};
 use crate::pipeline_report::{face_counts, BoundaryLoops, InitSummary, InitTimings};
-use crate::scan::topology;
-use crate::tolerance::{ToleranceKind, CAD_MAX, CAD_RMS};
-use crate::{FitScanOptions, InitialCage};
+use crate::prepare::{topology, Prepared};
+use crate::start::{Start, StartKind};
+#[cfg(doc)]
+use crate::tolerance::ToleranceKind;
+use crate::tolerance::{CAD_MAX, CAD_RMS};
 
 /// A smooth edge may sag by at most this share of the maximum tolerance: the smooth limit
 /// fitted to its facets lies within two thirds of the sag of them, so half the tolerance is
@@ -68,42 +74,31 @@ pub struct CadSummary {
     pub locked_corners: usize,
 }
 
-/// The CAD start of a tessellation ([`cad_start`]).
-#[derive(Clone, Debug)]
-pub struct CadStart {
-    /// The cage, in the target's normalized units.
-    pub cage: PolyMesh,
-    /// Its crease and corner tags.
-    pub tags: Tags,
-    /// Its summary for the report (`init`, with `init.cad`).
-    pub init: InitSummary,
-    /// The tolerances it is judged by, with the target's tolerances.
-    pub kind: ToleranceKind,
-    /// The control points the fit may reach: the budget, at most the tessellation's vertices.
-    pub max_control_points: usize,
-    /// The crease edges of the tessellation as segments (normalized units), for the fit's
-    /// crease-curve term.
-    pub feature_segments: Vec<[[f64; 3]; 2]>,
-}
-
-/// The CAD start of `target`, built from `mesh` (the repaired input, original coordinates;
-/// see the module docs), or `None` when it does not apply. Errors: the cage cannot be built
-/// (the mesh is no oriented manifold), or the run was cancelled.
-pub fn cad_start(
-    target: &Target,
-    mesh: &PolyMesh,
-    name: &str,
-    options: &FitScanOptions,
-) -> Result<Option<CadStart>, Error> {
-    let applies = matches!(options.init, InitialCage::Auto)
+/// Whether the CAD start applies to `prepared` under `options` (see the module docs). Cost:
+/// O(1).
+pub fn cad_applies(prepared: &Prepared, options: &FitScanOptions) -> bool {
+    matches!(options.init, InitialCage::Auto)
         && options.control_points.is_none()
         && !options.as_points
-        && options.init_options.features.is_some();
-    let Some(recognised) = target
-        .facets()
-        .filter(|_| applies && !mesh.faces.is_empty())
-    else {
-        return Ok(None);
+        && options.init_options.features.is_some()
+        && prepared.mesh_faces() > 0
+        && prepared.target.facets().is_some()
+}
+
+/// The CAD start of `prepared` within `budget` control points (see the module docs). Errors:
+/// [`Error::Budget`] when the tessellation has no crease or its cage exceeds the budget (the
+/// next start then fits it), [`Error::Init`] when the cage cannot be built,
+/// [`Error::Interrupted`].
+pub(crate) fn cad_start(
+    prepared: &Prepared,
+    options: &FitScanOptions,
+    budget: usize,
+) -> Result<Start, Error> {
+    let (target, mesh, name) = (&*prepared.target, &prepared.mesh, &prepared.name);
+    let Some(recognised) = target.facets() else {
+        return Err(Error::Budget(format!(
+            "{name}: not a CAD tessellation (no CAD start)"
+        )));
     };
     // The target merged coincident vertices again; the cage keeps the repaired mesh's own
     // (split non-manifold vertices stay split).
@@ -132,33 +127,38 @@ pub fn cad_start(
     } else {
         RMS_SHARE * rms / 0.3
     };
-    let budget = SmoothBudget {
+    let smooth_budget = SmoothBudget {
         max_sag,
         max_rms: RMS_SHARE * rms,
     };
-    let features = classify_edges(points, facets, &budget);
+    let features = classify_edges(points, facets, &smooth_budget);
     if features.count(EdgeClass::Crease) == 0 {
-        return Ok(None);
+        return Err(Error::Budget(format!(
+            "{name}: a tessellation without creases (no CAD start)"
+        )));
     }
     let cad_options = CadOptions {
         smooth_error: SMOOTH_CAGE_SAGS * features.threshold,
-        max_control_points: options.stages.max_control_points,
+        max_control_points: budget,
         cancel: options.cancel.clone(),
     };
     let (cage, tags, report) =
         cad_cage(points, facets, &features, &cad_options).map_err(|e| match e {
             subfit_init::InitError::Interrupted => Error::Interrupted,
             e => Error::Init {
-                name: name.to_string(),
+                name: name.clone(),
                 source: e,
             },
         })?;
-    if cage.num_vertices() > options.stages.max_control_points {
-        return Ok(None);
+    if cage.num_vertices() > budget {
+        return Err(Error::Budget(format!(
+            "{name}: the CAD cage keeps {} control points, more than the budget of {budget}",
+            cage.num_vertices()
+        )));
     }
     let topo = topology(&cage).map_err(|e| Error::input(name, e))?;
     let stats = facets.stats(points);
-    let feature_segments = facets
+    let feature_segments: Vec<[[f64; 3]; 2]> = facets
         .edges
         .iter()
         .zip(&features.class)
@@ -200,15 +200,15 @@ pub fn cad_start(
         }),
         ..InitSummary::default()
     };
-    Ok(Some(CadStart {
+    Ok(Start {
+        kind: StartKind::Cad,
         cage,
         tags,
-        init,
-        kind: ToleranceKind::Tessellation,
-        max_control_points: options
-            .stages
-            .max_control_points
-            .min(report.vertices_before),
-        feature_segments,
-    }))
+        summary: init,
+        feature_segments: Some(Arc::new(feature_segments)),
+        warnings: Vec::new(),
+        seconds: 0.0,
+        init_report: None,
+        curvature_report: None,
+    })
 }

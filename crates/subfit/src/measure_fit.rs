@@ -1,0 +1,120 @@
+//! The final measurement of a fitted cage (DESIGN.md decision 11): both ways, on the limit
+//! tessellation written with it (chordal error a tenth of the fitting error, reported), with
+//! the one measurer ([`subfit_measure`]): surface → data by the fitter's foot points, data →
+//! surface from the target's data samples to the tessellation. What a user measures on
+//! limit.ply. A quad/triangle cage also gets the distance to the surface USD declares for it.
+
+use subfit_fit::{DataTerm, FitOptions, FootPointTerm, StagesResult};
+use subfit_measure::{
+    data_samples, limit_tessellation, vertex_areas, DistanceStats, LimitTessellation, MeshDistance,
+    TwoSided,
+};
+use subfit_mesh::{PolyMesh, Tags};
+use subfit_subdiv::Scheme;
+use subfit_target::Target;
+
+use crate::error::Error;
+use crate::pipeline_report::UsdDifference;
+
+/// A fitted cage measured both ways on its limit tessellation.
+pub(crate) struct FinalMeasure {
+    /// The tessellation (normalized units) with its level and chordal error.
+    pub(crate) tessellation: LimitTessellation,
+    /// Distance of each tessellation vertex to the data (surface → data).
+    pub(crate) local: Vec<f64>,
+    /// Distance of each data sample to the tessellation (data → surface); the boundary
+    /// samples are the last `rim_samples`.
+    pub(crate) to_surface: Vec<f64>,
+    /// Data samples on the data's boundary, at the end of `to_surface`.
+    pub(crate) rim_samples: usize,
+    /// Both directions' statistics.
+    pub(crate) two_sided: TwoSided,
+}
+
+impl FinalMeasure {
+    /// The data → surface distances of the data's boundary samples.
+    pub(crate) fn rim(&self) -> &[f64] {
+        &self.to_surface[self.to_surface.len() - self.rim_samples.min(self.to_surface.len())..]
+    }
+}
+
+/// Measures the cage `result` of a fit of `target` with `fit`, `samples` data samples the way
+/// (see the module docs). Cost: the tessellation, one foot point per tessellation vertex, one
+/// BVH query per data sample.
+pub(crate) fn measure_final(
+    target: &Target,
+    result: &StagesResult,
+    fit: &FitOptions,
+    samples: usize,
+) -> Result<FinalMeasure, Error> {
+    let last = result.report.last;
+    let term = FootPointTerm::from_options(target, fit);
+    let tessellation = limit_tessellation(
+        &result.mesh.faces,
+        &result.mesh.positions,
+        &result.tags,
+        &fit.subdivision(),
+        last.e_rms,
+        last.e_max,
+    )
+    .map_err(|e| Error::Output(e.to_string()))?;
+    let local: Vec<f64> = term
+        .squared_errors(&tessellation.mesh.positions)
+        .into_iter()
+        .map(f64::sqrt)
+        .collect();
+    let data = data_samples(target, samples);
+    let to_surface: Vec<f64> =
+        MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces)
+            .distances(&data.points)
+            .iter()
+            .map(|p| p.distance)
+            .collect();
+    let two_sided = TwoSided {
+        surface_to_data: DistanceStats::of_weighted(
+            &local,
+            &vertex_areas(&tessellation.mesh.positions, &tessellation.mesh.faces),
+        ),
+        data_to_surface: DistanceStats::of(&to_surface),
+    };
+    Ok(FinalMeasure {
+        tessellation,
+        local,
+        to_surface,
+        rim_samples: data.boundary,
+        two_sided,
+    })
+}
+
+/// Both-way distances between the quad/triangle limit of `cage` and the Catmull-Clark limit
+/// (smooth triangle rule, what control.usda declares) at refinement `level`.
+pub(crate) fn usd_difference(
+    cage: &PolyMesh,
+    tags: &Tags,
+    options: &subfit_subdiv::Options,
+    level: usize,
+    diagonal: f64,
+    unit: f64,
+) -> Result<UsdDifference, Error> {
+    use subfit_subdiv::{sampling_operator, TriangleRule};
+    let cc = options
+        .with_triangles(TriangleRule::Smooth)
+        .with_scheme(Scheme::CatmullClark);
+    let surface = |o: &subfit_subdiv::Options| {
+        sampling_operator(&cage.faces, cage.num_vertices(), tags, o, level)
+            .map(|op| (op.position.apply(&cage.positions), op.faces))
+            .map_err(|e| Error::Output(e.to_string()))
+    };
+    let (pa, fa) = surface(options)?;
+    let (pb, fb) = surface(&cc)?;
+    let ab = MeshDistance::new(&pb, &fb).distances(&pa);
+    let ba = MeshDistance::new(&pa, &fa).distances(&pb);
+    let d: Vec<f64> = ab.iter().chain(&ba).map(|p| p.distance).collect();
+    let stats = DistanceStats::of(&d);
+    Ok(UsdDifference {
+        written_as: "catmullClark, triangleSubdivisionRule = smooth".into(),
+        rms_fraction_of_diagonal: stats.rms / diagonal,
+        max_fraction_of_diagonal: stats.max / diagonal,
+        max_original_units: stats.max * unit,
+    })
+}
