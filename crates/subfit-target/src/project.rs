@@ -287,7 +287,7 @@ impl Target {
         };
         if self.facets().is_some() && c.face_normal != [0.0; 3] {
             let tri = bvh.triangles()[c.triangle as usize];
-            return facet_foot_point(x, &c, tri[0]);
+            return facet_foot_point(x, c, tri[0]);
         }
         let tri = bvh.triangles()[c.triangle as usize];
         let normals = self.normals();

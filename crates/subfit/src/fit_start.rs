@@ -21,6 +21,7 @@ use crate::prepare::Prepared;
 use crate::progress::{Notify, Step};
 use crate::report_build::{build_report, Judgement, ReportParts};
 use crate::start::{Start, StartKind};
+use crate::start_cad::cad_applies;
 use crate::start_curvature_lines::coarse_sample_level;
 use crate::tolerance::{
     edge_count, noise_floored, target_tolerances, with_sampling_margin, ToleranceKind, Tolerances,
@@ -163,21 +164,25 @@ fn tolerances(
     budget: usize,
 ) -> Tolerances {
     let stats = prepared.target.stats();
-    let cad = start
-        .summary
-        .cad
-        .as_ref()
-        .filter(|_| start.kind == StartKind::Cad);
-    let kind = options.target_tolerances.then(|| match cad {
-        Some(_) => ToleranceKind::Tessellation,
-        None => ToleranceKind::of(stats, &fit.tags, edge_count(&start.cage.faces)),
+    // A CAD tessellation is judged as one whichever start fitted it (crate::start_cad).
+    let tessellation = cad_applies(prepared, options);
+    let kind = options.target_tolerances.then(|| {
+        if tessellation {
+            ToleranceKind::Tessellation
+        } else {
+            ToleranceKind::of(stats, &fit.tags, edge_count(&start.cage.faces))
+        }
     });
     let mut judged = match kind {
         Some(kind) => target_tolerances(&options.stages, kind, prepared.diagonal),
         None => options.stages.clone(),
     };
-    // A CAD start never has more control points than its tessellation has vertices.
-    judged.max_control_points = cad.map_or(budget, |c| budget.min(c.vertices));
+    // A tessellation's cage never grows past the tessellation's (distinct) vertices.
+    judged.max_control_points = if tessellation {
+        budget.min(prepared.target.len())
+    } else {
+        budget
+    };
     let (stages, noise_floor) = noise_floored(&judged, stats);
     Tolerances {
         kind,

@@ -27,6 +27,10 @@ pub enum StartKind {
     /// The cage of a CAD tessellation from its own creases and corners
     /// ([`crate::start_cad`], [`subfit_init::cad_cage`]).
     Cad,
+    /// The CAD tessellation's cage with every edge that turns an infinitely sharp crease: its
+    /// limit is the facets themselves (emptied planes aside), the fallback when the smooth
+    /// one misses the tolerances ([`crate::start_cad`]).
+    CadFaceted,
 }
 
 impl StartKind {
@@ -38,6 +42,7 @@ impl StartKind {
             Self::Qem { .. } => "Qem",
             Self::CurvatureLines => "CurvatureLines",
             Self::Cad => "CadTessellation",
+            Self::CadFaceted => "CadFaceted",
         }
     }
 }

@@ -93,6 +93,7 @@ pub(crate) fn cad_start(
     prepared: &Prepared,
     options: &FitScanOptions,
     budget: usize,
+    faceted: bool,
 ) -> Result<Start, Error> {
     let (target, mesh, name) = (&*prepared.target, &prepared.mesh, &prepared.name);
     let Some(recognised) = target.facets() else {
@@ -127,9 +128,13 @@ pub(crate) fn cad_start(
     } else {
         RMS_SHARE * rms / 0.3
     };
-    let smooth_budget = SmoothBudget {
-        max_sag,
-        max_rms: RMS_SHARE * rms,
+    let smooth_budget = if faceted {
+        SmoothBudget::FACETED
+    } else {
+        SmoothBudget {
+            max_sag,
+            max_rms: RMS_SHARE * rms,
+        }
     };
     let features = classify_edges(points, facets, &smooth_budget);
     if features.count(EdgeClass::Crease) == 0 {
@@ -167,7 +172,12 @@ pub(crate) fn cad_start(
         .collect();
     let (quads, triangles, quad_fraction) = face_counts(&cage.faces);
     let init = InitSummary {
-        source: "CadTessellation".into(),
+        source: if faceted {
+            "CadFaceted"
+        } else {
+            "CadTessellation"
+        }
+        .into(),
         control_points: cage.num_vertices(),
         faces: cage.faces.len(),
         quads,
@@ -201,7 +211,11 @@ pub(crate) fn cad_start(
         ..InitSummary::default()
     };
     Ok(Start {
-        kind: StartKind::Cad,
+        kind: if faceted {
+            StartKind::CadFaceted
+        } else {
+            StartKind::Cad
+        },
         cage,
         tags,
         summary: init,

@@ -138,7 +138,7 @@ pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
             // A CAD tessellation's own cage first: the starts after it win only with fewer
             // control points (crate::start_cad).
             if cad_applies(prepared, options) {
-                kinds.insert(0, StartKind::Cad);
+                kinds.splice(0..0, [StartKind::Cad, StartKind::CadFaceted]);
             }
             kinds
         }
@@ -172,7 +172,8 @@ pub fn build_start(
             budget_fraction.unwrap_or(BUDGET_STARTS[0]),
         ),
         StartKind::CurvatureLines => curvature_line_start(prepared, options, budget),
-        StartKind::Cad => cad_start(prepared, options, budget),
+        StartKind::Cad => cad_start(prepared, options, budget, false),
+        StartKind::CadFaceted => cad_start(prepared, options, budget, true),
     }?;
     start.seconds = t.elapsed().as_secs_f64();
     Ok(start)
