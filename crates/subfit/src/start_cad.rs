@@ -74,15 +74,44 @@ pub struct CadSummary {
     pub locked_corners: usize,
 }
 
-/// Whether the CAD start applies to `prepared` under `options` (see the module docs). Cost:
-/// O(1).
+/// Whether the CAD start applies to `prepared` under `options` (see the module docs): the
+/// target is a recognised tessellation with at least one crease at the smooth budget of the
+/// tolerances ([`smooth_budget`]) — a gridded surface of planar quads whose facets all turn
+/// a little (a geological horizon) is a tessellation but no CAD part. Cost: one edge
+/// classification, O(E).
 pub fn cad_applies(prepared: &Prepared, options: &FitScanOptions) -> bool {
-    matches!(options.init, InitialCage::Auto)
+    let asked = matches!(options.init, InitialCage::Auto)
         && options.control_points.is_none()
         && !options.as_points
         && options.init_options.features.is_some()
-        && prepared.mesh_faces() > 0
-        && prepared.target.facets().is_some()
+        && prepared.mesh_faces() > 0;
+    let Some(facets) = prepared.target.facets().filter(|_| asked) else {
+        return false;
+    };
+    let budget = smooth_budget(prepared, options);
+    classify_edges(prepared.target.points(), facets, &budget).count(EdgeClass::Crease) > 0
+}
+
+/// The smooth budget of the tolerances (see the module docs): a smooth edge may sag by
+/// [`SAG_SHARE`] of the maximum tolerance, the smooth faces' predicted RMS stay within
+/// [`RMS_SHARE`] of the RMS one; the CAD tolerances unless others were given.
+fn smooth_budget(prepared: &Prepared, options: &FitScanOptions) -> SmoothBudget {
+    let diagonal = prepared.diagonal;
+    let (rms, max) = if options.target_tolerances {
+        (CAD_RMS * diagonal, CAD_MAX * diagonal)
+    } else {
+        (options.stages.tolerance_rms, options.stages.tolerance_max)
+    };
+    // Without a maximum, the sag is bounded through the RMS (a strip deviates by 0.3 of it).
+    let max_sag = if max > 0.0 {
+        SAG_SHARE * max
+    } else {
+        RMS_SHARE * rms / 0.3
+    };
+    SmoothBudget {
+        max_sag,
+        max_rms: RMS_SHARE * rms,
+    }
 }
 
 /// The CAD start of `prepared` within `budget` control points (see the module docs). Errors:
@@ -114,27 +143,11 @@ pub(crate) fn cad_start(
         recognised.flat_tolerance,
     );
     let points = &points[..];
-    let diagonal = subfit_mesh::bounding_box(points).map_or(1.0, |(lo, hi)| {
-        subfit_mesh::vec3::norm(subfit_mesh::vec3::sub(hi, lo))
-    });
-    let (rms, max) = if options.target_tolerances {
-        (CAD_RMS * diagonal, CAD_MAX * diagonal)
-    } else {
-        (options.stages.tolerance_rms, options.stages.tolerance_max)
-    };
-    // Without a maximum, the sag is bounded through the RMS (a strip deviates by 0.3 of it).
-    let max_sag = if max > 0.0 {
-        SAG_SHARE * max
-    } else {
-        RMS_SHARE * rms / 0.3
-    };
+    let diagonal = prepared.diagonal;
     let smooth_budget = if faceted {
         SmoothBudget::FACETED
     } else {
-        SmoothBudget {
-            max_sag,
-            max_rms: RMS_SHARE * rms,
-        }
+        smooth_budget(prepared, options)
     };
     let features = classify_edges(points, facets, &smooth_budget);
     if features.count(EdgeClass::Crease) == 0 {

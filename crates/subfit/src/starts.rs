@@ -102,7 +102,8 @@ pub const BUDGET_STARTS: [f64; 3] = [0.6, 0.75, 0.9];
 /// [`BUDGET_STARTS`] fraction when the budget caps a quad scheme's default size — and, under
 /// `--init auto` for an open mesh target of genus 0 with at most [`BOTH_INITS_POINTS`] points
 /// (no count asked, not Loop, not as points), the curvature-line start; or the curvature-line
-/// start alone. Cost: O(1); nothing is built.
+/// start alone; a CAD tessellation ([`crate::start_cad::cad_applies`]) its CAD starts first.
+/// Cost: O(1) but the CAD test, one edge classification (O(E)); nothing is built.
 pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
     let budget = options.stages.max_control_points;
     match options.init {
