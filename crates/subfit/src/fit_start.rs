@@ -21,7 +21,7 @@ use crate::prepare::Prepared;
 use crate::progress::{Notify, Step};
 use crate::report_build::{build_report, Judgement, ReportParts};
 use crate::start::{Start, StartKind};
-use crate::start_cad::cad_applies;
+use crate::start_cad::{cad_applies, tessellation_budget};
 use crate::start_curvature_lines::coarse_sample_level;
 use crate::tolerance::{
     edge_count, noise_floored, target_tolerances, with_sampling_margin, ToleranceKind, Tolerances,
@@ -168,7 +168,7 @@ fn tolerances(
     let tessellation = cad_applies(prepared, options);
     let kind = options.target_tolerances.then(|| {
         if tessellation {
-            ToleranceKind::Tessellation
+            ToleranceKind::CadPart
         } else {
             ToleranceKind::of(stats, &fit.tags, edge_count(&start.cage.faces))
         }
@@ -179,7 +179,7 @@ fn tolerances(
     };
     // A tessellation's cage never grows past the tessellation's (distinct) vertices.
     judged.max_control_points = if tessellation {
-        budget.min(prepared.target.len())
+        tessellation_budget(prepared, options, budget)
     } else {
         budget
     };

@@ -16,7 +16,7 @@
 //! points, and the target recognised as a tessellation, [`subfit_target::Target::facets`]);
 //! [`cad_start`] builds it, or fails with a budget error (no creases, or a cage over the budget)
 //! that leaves the QEM start listed after it to fit the input as any mesh. The fit of a CAD
-//! start is judged by [`ToleranceKind::Tessellation`] within at most the tessellation's vertices
+//! start is judged by [`ToleranceKind::CadPart`] within at most the tessellation's vertices
 //! (`fit_start.rs`); the QEM start after it must then be more compact to win.
 
 use std::sync::Arc;
@@ -26,7 +26,7 @@ use subfit_target::tessellation::{classify_edges, EdgeClass, Facets, SmoothBudge
 
 use crate::error::Error;
 use crate::options::{FitScanOptions, InitialCage};
-use crate::pipeline_report::{face_counts, BoundaryLoops, InitSummary, InitTimings};
+use crate::pipeline_report::{face_counts, BoundaryLoops, CadSummary, InitSummary, InitTimings};
 use crate::prepare::{topology, Prepared};
 use crate::start::{Start, StartKind};
 #[cfg(doc)]
@@ -47,49 +47,46 @@ pub const RMS_SHARE: f64 = 0.5;
 /// polygon.
 pub const SMOOTH_CAGE_SAGS: f64 = 4.0;
 
-/// What the CAD start found and built (report.json `init.cad`).
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct CadSummary {
-    /// Share of the tessellation's interior edges that are flat (coplanar faces).
-    pub flat_edge_share: f64,
-    /// Planar regions of three faces or more.
-    pub planar_regions: usize,
-    /// Share of the triangles that are slivers.
-    pub sliver_share: f64,
-    /// The exporter's chord height read from the curved faces, fraction of the diagonal.
-    pub chord_height: f64,
-    /// Edges of the tessellation by class.
-    pub flat_edges: usize,
-    /// Edges a smooth limit may round.
-    pub smooth_edges: usize,
-    /// Edges tagged as creases.
-    pub crease_edges: usize,
-    /// Largest sag of a smooth edge, fraction of the diagonal.
-    pub smooth_sag: f64,
-    /// Predicted RMS deviation of the smooth faces from the facets, fraction of the diagonal.
-    pub predicted_rms: f64,
-    /// Vertices of the tessellation.
-    pub vertices: usize,
-    /// Corners locked before simplification.
-    pub locked_corners: usize,
-}
+/// A tessellation is a CAD part when at least one of its edges turns by this much (degrees),
+/// the default feature angle of scans (`subfit_target::FeatureOptions`): a designed edge (box
+/// edges, chamfers and hole rims turn by 45–90°). A smoothly curved surface tessellated for
+/// export (a half-cylinder of 24 strips turns by 7.5° per edge, a gridded geological horizon
+/// by less) is fitted as any mesh.
+pub const CAD_EDGE_DEG: f64 = 40.0;
 
 /// Whether the CAD start applies to `prepared` under `options` (see the module docs): the
-/// target is a recognised tessellation with at least one crease at the smooth budget of the
-/// tolerances ([`smooth_budget`]) — a gridded surface of planar quads whose facets all turn
-/// a little (a geological horizon) is a tessellation but no CAD part. Cost: one edge
-/// classification, O(E).
+/// target is a recognised tessellation with an edge that turns by [`CAD_EDGE_DEG`] or more.
+/// Cost: O(E).
 pub fn cad_applies(prepared: &Prepared, options: &FitScanOptions) -> bool {
     let asked = matches!(options.init, InitialCage::Auto)
         && options.control_points.is_none()
         && !options.as_points
         && options.init_options.features.is_some()
         && prepared.mesh_faces() > 0;
-    let Some(facets) = prepared.target.facets().filter(|_| asked) else {
-        return false;
-    };
-    let budget = smooth_budget(prepared, options);
-    classify_edges(prepared.target.points(), facets, &budget).count(EdgeClass::Crease) > 0
+    let min_angle = CAD_EDGE_DEG.to_radians();
+    prepared
+        .target
+        .facets()
+        .filter(|_| asked)
+        .is_some_and(|f| f.edges.iter().any(|e| !e.flat && e.angle >= min_angle))
+}
+
+/// The control points a fit of the tessellation `prepared` may reach, given the run's
+/// `budget`: never more than its (distinct) vertices; and, when the user set no limit (the
+/// target's tolerances) and no kept fit capped the budget, exactly that many — the faceted
+/// cage of a curved export keeps nearly every vertex, and the generic default budget is no
+/// reason to leave its tolerances unmet.
+pub(crate) fn tessellation_budget(
+    prepared: &Prepared,
+    options: &FitScanOptions,
+    budget: usize,
+) -> usize {
+    let vertices = prepared.target.len();
+    if options.target_tolerances && budget == options.stages.max_control_points {
+        vertices
+    } else {
+        budget.min(vertices)
+    }
 }
 
 /// The smooth budget of the tolerances (see the module docs): a smooth edge may sag by

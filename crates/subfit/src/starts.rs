@@ -81,7 +81,7 @@ use crate::error::Error;
 use crate::options::{FitScanOptions, InitialCage};
 use crate::prepare::Prepared;
 pub use crate::start::{Start, StartKind};
-use crate::start_cad::{cad_applies, cad_start};
+use crate::start_cad::{cad_applies, cad_start, tessellation_budget};
 use crate::start_curvature_lines::curvature_line_start;
 use crate::start_given::given_start;
 use crate::start_qem::{qem_start, start_control_points};
@@ -173,8 +173,18 @@ pub fn build_start(
             budget_fraction.unwrap_or(BUDGET_STARTS[0]),
         ),
         StartKind::CurvatureLines => curvature_line_start(prepared, options, budget),
-        StartKind::Cad => cad_start(prepared, options, budget, false),
-        StartKind::CadFaceted => cad_start(prepared, options, budget, true),
+        StartKind::Cad => cad_start(
+            prepared,
+            options,
+            tessellation_budget(prepared, options, budget),
+            false,
+        ),
+        StartKind::CadFaceted => cad_start(
+            prepared,
+            options,
+            tessellation_budget(prepared, options, budget),
+            true,
+        ),
     }?;
     start.seconds = t.elapsed().as_secs_f64();
     Ok(start)

@@ -64,13 +64,11 @@ pub const CAD_FEATURE_ANGLE: f64 = 20.0;
 pub enum ToleranceKind {
     /// [`SCAN_RMS`], [`SCAN_MAX`].
     Scan,
-    /// [`CAD_RMS`], [`CAD_MAX`]: the cage has sharp creases.
+    /// [`CAD_RMS`], [`CAD_MAX`]: the cage has sharp creases, or the target is a CAD
+    /// tessellation ([`crate::start_cad`]).
     CadPart,
     /// [`SCAN_RMS`] without a maximum: a noisy scan.
     NoisyScan,
-    /// [`CAD_RMS`], [`CAD_MAX`] from the facets of a CAD tessellation
-    /// ([`crate::start_cad`]): the export is the part.
-    Tessellation,
 }
 
 impl ToleranceKind {
@@ -100,7 +98,6 @@ impl ToleranceKind {
             Self::Scan => "a scan",
             Self::CadPart => "a CAD part (sharp creases)",
             Self::NoisyScan => "a noisy scan",
-            Self::Tessellation => "a CAD tessellation (from its facets)",
         };
         let max = match self {
             Self::Scan => format!(
@@ -121,7 +118,7 @@ impl ToleranceKind {
     pub fn fractions(self) -> (f64, f64) {
         match self {
             Self::Scan => (SCAN_RMS, SCAN_MAX),
-            Self::CadPart | Self::Tessellation => (CAD_RMS, CAD_MAX),
+            Self::CadPart => (CAD_RMS, CAD_MAX),
             Self::NoisyScan => (SCAN_RMS, 0.0),
         }
     }
