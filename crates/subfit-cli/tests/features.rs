@@ -354,6 +354,7 @@ fn a_cad_part_with_sharp_rims_meets_the_cad_tolerances_with_the_defaults() {
     assert!(usda.contains("creaseIndices") && usda.contains("cornerIndices"));
     // An angle given is the angle used.
     let out = d.path().join("forty");
-    let (report, _) = fit_and_compare(&prism, &out, &["--feature-angle", "40"], 1);
+    // (It reaches the tolerances too since a tessellation's foot points are on its facets.)
+    let (report, _) = fit_and_compare(&prism, &out, &["--feature-angle", "40"], 0);
     assert_eq!(report["init"]["features"]["angle_deg"], 40.0);
 }

@@ -55,13 +55,18 @@ pub const SMOOTH_CAGE_SAGS: f64 = 4.0;
 pub const CAD_EDGE_DEG: f64 = 40.0;
 
 /// Whether the CAD start applies to `prepared` under `options` (see the module docs): the
-/// target is a recognised tessellation with an edge that turns by [`CAD_EDGE_DEG`] or more.
+/// target is a recognised tessellation with an edge that turns by [`CAD_EDGE_DEG`] or more,
+/// and neither a feature angle nor semi-sharp creases were asked for (the feature detection
+/// of the QEM start gives those).
 /// Cost: O(E).
 pub fn cad_applies(prepared: &Prepared, options: &FitScanOptions) -> bool {
     let asked = matches!(options.init, InitialCage::Auto)
         && options.control_points.is_none()
         && !options.as_points
         && options.init_options.features.is_some()
+        // A feature angle or semi-sharp creases asked for are the feature detection's.
+        && options.cad_feature_angle.is_some()
+        && !options.init_options.semi_sharp
         && prepared.mesh_faces() > 0;
     let min_angle = CAD_EDGE_DEG.to_radians();
     prepared
