@@ -149,7 +149,15 @@ fn an_l_bracket_does_not_fold_at_its_concave_corners() {
             "L bracket, {scheme}: {} control points, {} creases ({} concave sectors split, {} points added), Hausdorff {hausdorff:.2e} of the diagonal",
             report["control_points"], report["tags"]["creases"], features["concave_sectors"], features["concave_points"]
         );
-        assert_eq!(features["concave_sectors"], 2, "{scheme}");
+        // A CAD tessellation's own cage (subfit::start_cad) splits its concave sectors to
+        // outline vertices; the QEM start reports its splits.
+        if !report["init"]["source"]
+            .as_str()
+            .unwrap_or_default()
+            .starts_with("Cad")
+        {
+            assert_eq!(features["concave_sectors"], 2, "{scheme}");
+        }
         assert!(hausdorff <= 1e-3, "{scheme}: Hausdorff {hausdorff}");
     }
 }
@@ -332,13 +340,21 @@ fn a_cad_part_with_sharp_rims_meets_the_cad_tolerances_with_the_defaults() {
         report["control_points"], report["init"]["features"]["angle_deg"]
     );
     assert_eq!(report["tolerance_kind"], "cad_part");
-    assert_eq!(report["init"]["features"]["angle_deg"], 20.0);
+    // A CAD tessellation's own cage (subfit::start_cad) when its facets say it is one;
+    // otherwise the features detected again from 20°.
+    let source = report["init"]["source"].as_str().unwrap_or_default();
+    if source.starts_with("Cad") {
+        assert!(report["init"]["cad"]["crease_edges"].as_u64().unwrap() > 0);
+    } else {
+        assert_eq!(report["init"]["features"]["angle_deg"], 20.0);
+    }
     assert!(rms <= 4e-4, "two-sided RMS {rms}");
     assert!(hausdorff <= 1e-3, "Hausdorff {hausdorff}");
     let usda = std::fs::read_to_string(out.join("control.usda")).unwrap();
     assert!(usda.contains("creaseIndices") && usda.contains("cornerIndices"));
     // An angle given is the angle used.
     let out = d.path().join("forty");
-    let (report, _) = fit_and_compare(&prism, &out, &["--feature-angle", "40"], 1);
+    // (It reaches the tolerances too since a tessellation's foot points are on its facets.)
+    let (report, _) = fit_and_compare(&prism, &out, &["--feature-angle", "40"], 0);
     assert_eq!(report["init"]["features"]["angle_deg"], 40.0);
 }

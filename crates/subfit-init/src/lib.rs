@@ -15,6 +15,8 @@
 //!   cloud (a single-view scan) gives an open surface with its boundary loops.
 //! * [`init`](mod@init): the entry point [`initial_control_mesh`]: mesh targets are simplified, point clouds
 //!   contoured then simplified; the genus is checked against the target's and reported.
+//! * [`cad_cage`](mod@cad_cage): the cage of a CAD tessellation from its own features (creases
+//!   and corners tagged, planes emptied, smooth faces coarsened within a bound).
 //! * [`snap`](mod@snap): a point cloud's crease curves traced on its contour, for
 //!   feature-aligned cages.
 //! * [`quads`](mod@quads): [`pair_triangles`] turns a triangle cage into a quad-dominant one,
@@ -25,6 +27,7 @@
 // `!(x > t)` is used deliberately: it is true for NaN, which must take the fallback branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod cad_cage;
 pub mod carve;
 pub mod contour;
 pub mod curvature_lines;
@@ -42,6 +45,7 @@ pub mod snap;
 pub mod specks;
 pub mod trim;
 
+pub use cad_cage::{cad_cage, CadOptions, CadReport};
 pub use carve::carve;
 pub use contour::{contour, ContourError, ContourOptions, ContourReport, MAX_RESOLUTION};
 pub use init::{

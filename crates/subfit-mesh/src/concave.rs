@@ -64,6 +64,20 @@ pub fn split_concave_corners(
     tags: &mut Tags,
     max_new_points: usize,
 ) -> ConcaveSplits {
+    split_concave_corners_with(cage, tags, max_new_points, &|_| false)
+}
+
+/// [`split_concave_corners`], where a sector may also take its crease to a vertex already on
+/// a crease when `may_corner` says so for it: a vertex whose crease curves are polygons on
+/// purpose (a faceted part's), which the new crease makes a corner (three sharp edges) without
+/// changing its surface. A tessellation's decimated planar faces have no vertex off their
+/// outlines, so a concave corner of one finds its crease this way without a new point.
+pub fn split_concave_corners_with(
+    cage: &mut PolyMesh,
+    tags: &mut Tags,
+    max_new_points: usize,
+    may_corner: &dyn Fn(u32) -> bool,
+) -> ConcaveSplits {
     let mut out = ConcaveSplits::default();
     if tags.is_empty() {
         return out;
@@ -73,7 +87,13 @@ pub fn split_concave_corners(
     };
     let mut plans = Vec::new();
     for vi in 0..he.num_vertices() {
-        plans.extend(concave_sectors(&he, cage, tags, VertexId(vi as u32)));
+        plans.extend(concave_sectors(
+            &he,
+            cage,
+            tags,
+            VertexId(vi as u32),
+            may_corner,
+        ));
     }
     out.sectors = plans.len();
     // Edges to split at their midpoints, with the faces they touch (each face split once).
@@ -167,7 +187,13 @@ struct Plan {
 }
 
 /// The concave sectors at `v` (none when `v` is no corner).
-fn concave_sectors(he: &HalfEdgeMesh, cage: &PolyMesh, tags: &Tags, v: VertexId) -> Vec<Plan> {
+fn concave_sectors(
+    he: &HalfEdgeMesh,
+    cage: &PolyMesh,
+    tags: &Tags,
+    v: VertexId,
+    may_corner: &dyn Fn(u32) -> bool,
+) -> Vec<Plan> {
     let mut plans = Vec::new();
     let k = he.outgoing(v).count();
     if k < 2 {
@@ -186,8 +212,10 @@ fn concave_sectors(he: &HalfEdgeMesh, cage: &PolyMesh, tags: &Tags, v: VertexId)
     if sharp_count == 0 || (corner_sharpness <= 0.0 && sharp_count < 3) {
         return plans;
     }
-    let on_crease =
-        |n: VertexId| he.is_boundary_vertex(n) || he.vertex_neighbors(n).any(|w| sharp(n, w));
+    let on_crease = |n: VertexId| {
+        (he.is_boundary_vertex(n) || he.vertex_neighbors(n).any(|w| sharp(n, w)))
+            && !may_corner(n.0)
+    };
     let p = cage.positions[v.idx()];
     let angle = |i: usize| {
         let a = sub(cage.positions[ring[i].idx()], p);

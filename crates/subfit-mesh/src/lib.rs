@@ -23,6 +23,7 @@ mod edges;
 pub mod halfedge;
 pub mod ids;
 pub mod nonmanifold;
+pub mod parts;
 pub mod polygons;
 pub mod range_scan;
 pub mod reorient;
@@ -36,7 +37,9 @@ pub mod weld;
 pub use bowtie::{split_bowties, BowtieReport};
 pub use cancel::{Cancel, Cancelled};
 pub use components::{euler_characteristic, face_components, genus, Components};
-pub use concave::{split_concave_corners, ConcaveSplits, CONCAVE_ANGLE};
+pub use concave::{
+    split_concave_corners, split_concave_corners_with, ConcaveSplits, CONCAVE_ANGLE,
+};
 pub use diagnose::{diagnose, diagnose_mesh, ComponentReport, IssueExamples, MeshReport};
 pub use edges::UnionFind;
 pub use halfedge::{HalfEdgeMesh, Outgoing, TopologyError};

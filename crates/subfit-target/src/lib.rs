@@ -51,6 +51,7 @@ pub mod project;
 pub mod quadric;
 mod regularize;
 mod target;
+pub mod tessellation;
 mod winding;
 
 pub use boundary_corners::{boundary_corners, boundary_vertices, BoundaryCorners};

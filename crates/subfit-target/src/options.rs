@@ -44,6 +44,10 @@ pub struct TargetOptions {
     pub imls_radius: Option<f64>,
     /// Build the triangle BVH for exact closest points when the input has faces. Default true.
     pub mesh_closest_point: bool,
+    /// Recognise a mesh that is a CAD tessellation ([`crate::tessellation`]): its noise level
+    /// is then 0 (the vertex spacing is the exporter's, not noise) and its foot points come from
+    /// the facets ([`crate::Target::mesh_foot_point`]). Default true.
+    pub recognise_tessellation: bool,
     /// Drop outliers of point clouds before estimation: points whose 16th neighbour is more
     /// than 4× the median distance away, or whose distance to the plane of their neighbours is
     /// more than 3× the largest of the neighbours' spread, the noise level and a quarter of that
@@ -80,6 +84,7 @@ impl Default for TargetOptions {
             ambiguity_ratio: 0.5,
             imls_radius: None,
             mesh_closest_point: true,
+            recognise_tessellation: true,
             remove_outliers: true,
             adapt_to_noise: true,
             normalization: None,
@@ -230,6 +235,9 @@ pub struct TargetStats {
     pub neighborhood_radius: (f64, f64, f64),
     /// IMLS kernel support radius `h` in use (normalized units).
     pub imls_radius: f64,
+    /// What the facets of a mesh target say ([`crate::tessellation`]); `None` for a point
+    /// cloud.
+    pub tessellation: Option<crate::tessellation::TessellationStats>,
     /// Phase durations.
     pub timings: TargetTimings,
 }

@@ -233,6 +233,9 @@ impl Target {
     /// than [`Self::foot_point`]'s: a quadric fitted to a handful of neighbours is off by more
     /// than a fitting tolerance. Falls back to [`Self::foot_point`] for point clouds, when the
     /// BVH was not built, or at a degenerate triangle. Cost: one BVH query (O(log #T)).
+    ///
+    /// On a CAD tessellation ([`Self::facets`]) the facets are the surface: see
+    /// [`facet_foot_point`].
     pub fn mesh_foot_point(&self, x: [f64; 3]) -> FootPoint {
         self.mesh_foot_point_near(x, u32::MAX).0
     }
@@ -282,6 +285,10 @@ impl Target {
         let Some(bvh) = self.mesh() else {
             return self.foot_point(x);
         };
+        if self.facets().is_some() && c.face_normal != [0.0; 3] {
+            let tri = bvh.triangles()[c.triangle as usize];
+            return facet_foot_point(x, c, tri[0]);
+        }
         let tri = bvh.triangles()[c.triangle as usize];
         let normals = self.normals();
         let mut n = [0.0; 3];
@@ -323,6 +330,43 @@ impl Target {
             alpha2: alpha_plus(distance, k2),
             nearest: corner,
         }
+    }
+}
+
+/// The foot point of `x` on a tessellation's facets, the closest point `c` (on a triangle
+/// whose first corner is `corner`): the facets are flat, so both curvatures are 0 (the SD
+/// term is the TD term), and the normal is the direction from the foot point to `x` — the
+/// gradient of the distance to the facets, which is the facet's normal over its inside and
+/// turns around its edges and corners, so that `Q (S − V) = S − V` holds there too (the
+/// blended vertex normals of a smooth mesh tilt across a box's edges). Its sign follows the
+/// facet's normal; `x` on the facets takes the facet's normal.
+pub fn facet_foot_point(x: [f64; 3], c: &MeshClosestPoint, corner: u32) -> FootPoint {
+    let d = sub(x, c.point);
+    let len = dot(d, d).sqrt();
+    let n = if len > 1e-14 {
+        let s = if dot(d, c.face_normal) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        d.map(|a| s * a / len)
+    } else {
+        c.face_normal
+    };
+    let (t1, t2) = tangent_frame(n, [1.0, 0.0, 0.0]);
+    FootPoint {
+        point: c.point,
+        distance: dot(d, n),
+        normal: n,
+        t1,
+        t2,
+        k1: 0.0,
+        k2: 0.0,
+        rho1: f64::INFINITY,
+        rho2: f64::INFINITY,
+        alpha1: 0.0,
+        alpha2: 0.0,
+        nearest: corner,
     }
 }
 

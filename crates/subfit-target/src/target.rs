@@ -21,6 +21,7 @@ use crate::options::{
 };
 use crate::orient::{orient_normals, KnnGraph, OrientInput, FIELD_MAX_NEIGHBORS};
 use crate::quadric::{sym3_eigen, FitQuality, LocalQuadric};
+use crate::tessellation::Facets;
 use subfit_mesh::vec3::{add, cross, dot, normalize, scale, sub};
 
 /// Fraction of the neighbourhood radius doubled into the foot-point shortcut diameter. 0 keeps
@@ -57,6 +58,9 @@ pub struct Target {
     nn_dist: Vec<f64>,
     imls_radius: f64,
     stats: TargetStats,
+    /// The facets of a mesh recognised as a CAD tessellation ([`crate::tessellation`]): its
+    /// foot points then come from the facets themselves.
+    facets: Option<Facets>,
     /// The cloud's boundary points at the default criterion ([`Self::cloud_rim`]), computed on
     /// first use: every fitter, contour and start borrows the one copy (STYLE.md rule 11).
     rim: std::sync::OnceLock<Vec<bool>>,
@@ -182,6 +186,24 @@ impl Target {
         stats.timings.merge = t.elapsed();
         report(Phase::Merge, n_in, n_in);
 
+        // A mesh's facets: is it a CAD tessellation?
+        let triangles: Vec<[u32; 3]> = mesh
+            .faces
+            .triangulate_fan()
+            .into_iter()
+            .map(|t| t.map(|v| input_to_point[v as usize]))
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        let facets = (options.recognise_tessellation && !triangles.is_empty())
+            .then(|| {
+                let magnitude = lo.iter().chain(&hi).fold(0.0f64, |m, c| m.max(c.abs()));
+                let tol = Facets::float32_tolerance(magnitude, 1.0 / normalization.scale);
+                let f = Facets::new(&points, &triangles, tol);
+                stats.tessellation = Some(f.stats(&points));
+                f
+            })
+            .filter(|_| stats.tessellation.is_some_and(|t| t.is_tessellation));
+
         // kd-tree.
         cancel.check()?;
         let t = Instant::now();
@@ -201,7 +223,8 @@ impl Target {
         let remove = options.remove_outliers && mesh.faces.is_empty();
         let scan = crate::outliers::detect(&points, &index, remove, cancel)?;
         let mut removed_inputs = Vec::new();
-        stats.noise_level = scan.noise;
+        // A tessellation's vertex spacing is the exporter's, not noise: its facets are exact.
+        stats.noise_level = if facets.is_some() { 0.0 } else { scan.noise };
         stats.point_spacing = scan.spacing;
         if scan.count > 0 && points.len() - scan.count >= MIN_POINTS {
             removed_inputs = (0..n_in as u32)
@@ -346,17 +369,10 @@ impl Target {
         let t = Instant::now();
         let bvh = if options.mesh_closest_point && !mesh.faces.is_empty() {
             report(Phase::MeshIndex, 0, 1);
-            let tris: Vec<[u32; 3]> = mesh
-                .faces
-                .triangulate_fan()
-                .into_iter()
-                .map(|t| t.map(|v| input_to_point[v as usize]))
-                .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-                .collect();
-            stats.triangles = tris.len();
+            stats.triangles = triangles.len();
             report(Phase::MeshIndex, 1, 1);
             // Built once, queried every iteration: SAH splits (CAD slivers).
-            Some(TriangleBvh::with_sah(points.clone(), tris))
+            Some(TriangleBvh::with_sah(points.clone(), triangles))
         } else {
             None
         };
@@ -381,6 +397,7 @@ impl Target {
             nn_dist,
             imls_radius,
             stats,
+            facets,
             rim: std::sync::OnceLock::new(),
         })
     }
@@ -458,6 +475,12 @@ impl Target {
     /// The triangle BVH (normalized coordinates, distinct-point indices) for mesh targets.
     pub fn mesh(&self) -> Option<&TriangleBvh> {
         self.bvh.as_ref()
+    }
+
+    /// The facets of a mesh recognised as a CAD tessellation (points of [`Self::points`],
+    /// triangles of [`Self::mesh`]), `None` otherwise.
+    pub fn facets(&self) -> Option<&Facets> {
+        self.facets.as_ref()
     }
 
     /// Construction statistics and timings.

@@ -21,6 +21,7 @@ use crate::prepare::Prepared;
 use crate::progress::{Notify, Step};
 use crate::report_build::{build_report, Judgement, ReportParts};
 use crate::start::{Start, StartKind};
+use crate::start_cad::{cad_applies, tessellation_budget};
 use crate::start_curvature_lines::coarse_sample_level;
 use crate::tolerance::{
     edge_count, noise_floored, target_tolerances, with_sampling_margin, ToleranceKind, Tolerances,
@@ -163,14 +164,25 @@ fn tolerances(
     budget: usize,
 ) -> Tolerances {
     let stats = prepared.target.stats();
-    let kind = options
-        .target_tolerances
-        .then(|| ToleranceKind::of(stats, &fit.tags, edge_count(&start.cage.faces)));
+    // A CAD tessellation is judged as one whichever start fitted it (crate::start_cad).
+    let tessellation = cad_applies(prepared, options);
+    let kind = options.target_tolerances.then(|| {
+        if tessellation {
+            ToleranceKind::CadPart
+        } else {
+            ToleranceKind::of(stats, &fit.tags, edge_count(&start.cage.faces))
+        }
+    });
     let mut judged = match kind {
         Some(kind) => target_tolerances(&options.stages, kind, prepared.diagonal),
         None => options.stages.clone(),
     };
-    judged.max_control_points = budget;
+    // A tessellation's cage never grows past the tessellation's (distinct) vertices.
+    judged.max_control_points = if tessellation {
+        tessellation_budget(prepared, options, budget)
+    } else {
+        budget
+    };
     let (stages, noise_floor) = noise_floored(&judged, stats);
     Tolerances {
         kind,

@@ -52,4 +52,10 @@ impl Fitted {
     pub fn target(&self) -> &Target {
         &self.target
     }
+
+    /// The subdivision rules the cage was fitted with (scheme, boundary and triangle rules):
+    /// with [`Self::cage`] and [`Self::tags`], what any evaluator needs for its limit surface.
+    pub fn subdivision(&self) -> subfit_subdiv::Options {
+        self.fit.subdivision()
+    }
 }

@@ -53,6 +53,7 @@ mod sequence;
 mod sequence_output;
 mod sequence_tracking;
 mod start;
+pub mod start_cad;
 mod start_curvature_lines;
 mod start_given;
 mod start_qem;

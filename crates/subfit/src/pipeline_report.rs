@@ -164,6 +164,9 @@ pub struct InitSummary {
     /// keeps as crease and corner tags (`subfit_target::detect_features`). `None` otherwise.
     #[serde(default)]
     pub features: Option<FeatureSummary>,
+    /// The CAD tessellation start ([`crate::start_cad`]), when it built the cage.
+    #[serde(default)]
+    pub cad: Option<CadSummary>,
     /// Seconds per step (contour, simplify, total).
     pub timings_s: InitTimings,
     /// The curvature-line cage (`subfit_init::curvature_lines`) when it was built or tried:
@@ -684,4 +687,31 @@ pub struct FinalErrors {
     pub objective: f64,
     /// Both ways.
     pub two_sided: TwoSidedErrors,
+}
+
+/// What the CAD start found and built (report.json `init.cad`, [`crate::start_cad`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CadSummary {
+    /// Share of the tessellation's interior edges that are flat (coplanar faces).
+    pub flat_edge_share: f64,
+    /// Planar regions of three faces or more.
+    pub planar_regions: usize,
+    /// Share of the triangles that are slivers.
+    pub sliver_share: f64,
+    /// The exporter's chord height read from the curved faces, fraction of the diagonal.
+    pub chord_height: f64,
+    /// Edges of the tessellation by class.
+    pub flat_edges: usize,
+    /// Edges a smooth limit may round.
+    pub smooth_edges: usize,
+    /// Edges tagged as creases.
+    pub crease_edges: usize,
+    /// Largest sag of a smooth edge, fraction of the diagonal.
+    pub smooth_sag: f64,
+    /// Predicted RMS deviation of the smooth faces from the facets, fraction of the diagonal.
+    pub predicted_rms: f64,
+    /// Vertices of the tessellation.
+    pub vertices: usize,
+    /// Corners locked before simplification.
+    pub locked_corners: usize,
 }

@@ -76,7 +76,10 @@ pub fn fit_scan(
     let mut notify = Notify::new(progress);
     let prepared = prepare(input, options, &mut notify)?;
     let mut kept: Option<Fitted> = None;
-    for group in kinds_in_groups(starts(&prepared, options)) {
+    let mut first_error = None;
+    let groups = kinds_in_groups(starts(&prepared, options));
+    let last = groups.len().saturating_sub(1);
+    for (g, group) in groups.into_iter().enumerate() {
         let budget = budget_against(kept.as_ref(), options);
         let fitted = match fit_group(&prepared, &group, options, budget, &mut notify) {
             Ok(f) => f,
@@ -88,7 +91,13 @@ pub fn fit_scan(
                     note_failed(&mut k.report, group[0], &e);
                     continue;
                 }
-                None => return Err(e),
+                // A start that cannot be built leaves the next one (a CAD start over the
+                // budget, the QEM start); the first error is returned when none is left.
+                None if g < last => {
+                    first_error.get_or_insert(e);
+                    continue;
+                }
+                None => return Err(first_error.unwrap_or(e)),
             },
         };
         kept = Some(match kept {

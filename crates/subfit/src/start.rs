@@ -24,6 +24,13 @@ pub enum StartKind {
     },
     /// The curvature-line cage of Lavoué et al. 2007 §4 ([`subfit_init::curvature_lines`]).
     CurvatureLines,
+    /// The cage of a CAD tessellation from its own creases and corners
+    /// ([`crate::start_cad`], [`subfit_init::cad_cage`]).
+    Cad,
+    /// The CAD tessellation's cage with every edge that turns an infinitely sharp crease: its
+    /// limit is the facets themselves (emptied planes aside), the fallback when the smooth
+    /// one misses the tolerances ([`crate::start_cad`]).
+    CadFaceted,
 }
 
 impl StartKind {
@@ -34,6 +41,8 @@ impl StartKind {
             Self::Given => "File",
             Self::Qem { .. } => "Qem",
             Self::CurvatureLines => "CurvatureLines",
+            Self::Cad => "CadTessellation",
+            Self::CadFaceted => "CadFaceted",
         }
     }
 }

@@ -92,6 +92,7 @@ pub(crate) fn given_start(
             ..InitTimings::default()
         },
         curvature_lines: None,
+        cad: None,
     };
     Ok(Start {
         kind: StartKind::Given,
@@ -154,5 +155,6 @@ pub(crate) fn init_summary(
             total: r.timings.total.as_secs_f64(),
         },
         curvature_lines: None,
+        cad: None,
     }
 }

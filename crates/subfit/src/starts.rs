@@ -18,6 +18,9 @@
 //!   cage of Lavoué et al. 2007 §4 whose vertices are the control points of the boundary
 //!   curves, joined along the target's lines of curvature, fitted with the quad/triangle scheme
 //!   unless another is asked. Open mesh targets of genus 0 only.
+//! * **CAD tessellation** (listed first under `--init auto` when the target's facets say it is
+//!   a CAD export): [`crate::start_cad`], the tessellation's own creases and corners tagged,
+//!   its planes emptied, judged by the tessellation's tolerances within its vertex count.
 //!
 //! `--init auto` (the default) fits from QEM, and for an open mesh target of genus 0 with at
 //! most [`BOTH_INITS_POINTS`] points (CAD-like patches, not scans) from the curvature lines as
@@ -78,6 +81,7 @@ use crate::error::Error;
 use crate::options::{FitScanOptions, InitialCage};
 use crate::prepare::Prepared;
 pub use crate::start::{Start, StartKind};
+use crate::start_cad::{cad_applies, cad_start, tessellation_budget};
 use crate::start_curvature_lines::curvature_line_start;
 use crate::start_given::given_start;
 use crate::start_qem::{qem_start, start_control_points};
@@ -98,7 +102,8 @@ pub const BUDGET_STARTS: [f64; 3] = [0.6, 0.75, 0.9];
 /// [`BUDGET_STARTS`] fraction when the budget caps a quad scheme's default size — and, under
 /// `--init auto` for an open mesh target of genus 0 with at most [`BOTH_INITS_POINTS`] points
 /// (no count asked, not Loop, not as points), the curvature-line start; or the curvature-line
-/// start alone. Cost: O(1); nothing is built.
+/// start alone; a CAD tessellation ([`crate::start_cad::cad_applies`]) its CAD starts first.
+/// Cost: O(1) but the CAD test, one edge classification (O(E)); nothing is built.
 pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
     let budget = options.stages.max_control_points;
     match options.init {
@@ -130,6 +135,11 @@ pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
                 && prepared.target.len() <= BOTH_INITS_POINTS;
             if both {
                 kinds.push(StartKind::CurvatureLines);
+            }
+            // A CAD tessellation's own cage first: the starts after it win only with fewer
+            // control points (crate::start_cad).
+            if cad_applies(prepared, options) {
+                kinds.splice(0..0, [StartKind::Cad, StartKind::CadFaceted]);
             }
             kinds
         }
@@ -163,6 +173,18 @@ pub fn build_start(
             budget_fraction.unwrap_or(BUDGET_STARTS[0]),
         ),
         StartKind::CurvatureLines => curvature_line_start(prepared, options, budget),
+        StartKind::Cad => cad_start(
+            prepared,
+            options,
+            tessellation_budget(prepared, options, budget),
+            false,
+        ),
+        StartKind::CadFaceted => cad_start(
+            prepared,
+            options,
+            tessellation_budget(prepared, options, budget),
+            true,
+        ),
     }?;
     start.seconds = t.elapsed().as_secs_f64();
     Ok(start)

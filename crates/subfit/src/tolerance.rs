@@ -64,7 +64,8 @@ pub const CAD_FEATURE_ANGLE: f64 = 20.0;
 pub enum ToleranceKind {
     /// [`SCAN_RMS`], [`SCAN_MAX`].
     Scan,
-    /// [`CAD_RMS`], [`CAD_MAX`]: the cage has sharp creases.
+    /// [`CAD_RMS`], [`CAD_MAX`]: the cage has sharp creases, or the target is a CAD
+    /// tessellation ([`crate::start_cad`]).
     CadPart,
     /// [`SCAN_RMS`] without a maximum: a noisy scan.
     NoisyScan,
