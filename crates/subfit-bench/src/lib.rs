@@ -71,6 +71,10 @@ pub struct Scoreboard {
     /// Against the baseline, when one was given.
     #[serde(default)]
     pub regressions: Vec<Regression>,
+    /// Where the rows came from when they were taken from earlier scoreboards rather than
+    /// fitted in this run: one line per source (its file and the rows it gave).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<String>,
 }
 
 impl Scoreboard {

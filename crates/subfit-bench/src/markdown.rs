@@ -272,6 +272,12 @@ pub fn render(board: &Scoreboard) -> String {
         board.seconds,
         100.0 * DISAGREEMENT_FLAG,
     );
+    for source in &board.sources {
+        let _ = writeln!(s, "- rows from {source}");
+    }
+    if !board.sources.is_empty() {
+        s.push('\n');
+    }
     s.push_str("## Per category\n\n");
     s.push_str(&summary_table(&board.categories));
     let of = |k: &[&str]| -> Vec<&Row> {

@@ -189,11 +189,12 @@ pub struct BenchCorpusArgs {
     /// same way and set beside ours.
     #[arg(long)]
     pub peers: Option<PathBuf>,
-    /// Take the rows of an earlier scoreboard (its JSON) instead of fitting again: to add
-    /// `--peers` or compare with another baseline without re-running the fits. The entry
-    /// filters apply to its rows.
+    /// Take the rows of earlier scoreboards (their JSON) instead of fitting again: to add
+    /// `--peers`, compare with another baseline, or refresh some rows of a scoreboard with a
+    /// later run (repeat the flag: a later file's row replaces an earlier one's). The entry
+    /// filters apply; the scoreboard lists where its rows came from.
     #[arg(long, value_name = "FILE.json")]
-    pub rows: Option<PathBuf>,
+    pub rows: Vec<PathBuf>,
     /// Seconds one run may take before it is stopped (a row `timeout`).
     #[arg(long, default_value_t = 900)]
     pub timeout: u64,

@@ -68,14 +68,14 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
         settings.work.display()
     );
     let t0 = Instant::now();
-    let (mut rows, earlier_seconds) = match &a.rows {
-        Some(p) => earlier_rows(p, &entries)?,
-        None => {
-            let rows = subfit_bench::score_all(&entries, &settings, &|row, n, total| {
-                eprintln!("[{n}/{total}] {}", line(row));
-            });
-            (rows, None)
-        }
+    let (mut rows, sources, earlier_seconds) = if a.rows.is_empty() {
+        let rows = subfit_bench::score_all(&entries, &settings, &|row, n, total| {
+            eprintln!("[{n}/{total}] {}", line(row));
+        });
+        (rows, Vec::new(), None)
+    } else {
+        let (rows, sources, seconds) = earlier_rows(&a.rows, &entries)?;
+        (rows, sources, Some(seconds))
     };
     if let Some(p) = &a.peers {
         let peers = subfit_bench::peers::read_peers(p).map_err(anyhow::Error::msg)?;
@@ -90,6 +90,7 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
         seconds: earlier_seconds.unwrap_or_else(|| t0.elapsed().as_secs_f64()),
         judge_surface_samples: a.surface_samples,
         rows,
+        sources,
         ..Scoreboard::default()
     };
     board.finish(baseline.as_ref());
@@ -126,28 +127,51 @@ fn runs_dir(out: &Path) -> PathBuf {
     out.with_file_name(format!("{stem}-runs"))
 }
 
-/// The rows of an earlier scoreboard for `entries`, in their order, without its peers (those
-/// are judged again from `--peers`), and the seconds that scoreboard took. Errors: an
-/// unreadable file, or an entry it does not hold.
+/// The rows of earlier scoreboards `paths` for `entries`, in the entries' order (a later
+/// file's row replaces an earlier one's), without their peers (those are judged again from
+/// `--peers`); one line per file saying which rows it gave; the seconds of the scoreboard that
+/// gave the most rows. Errors: an unreadable file, or an entry none of them holds.
 fn earlier_rows(
-    path: &Path,
+    paths: &[PathBuf],
     entries: &[subfit_bench::Entry],
-) -> anyhow::Result<(Vec<Row>, Option<f64>)> {
-    let earlier = Scoreboard::read(path).map_err(anyhow::Error::msg)?;
+) -> anyhow::Result<(Vec<Row>, Vec<String>, f64)> {
+    let boards = paths
+        .iter()
+        .map(|p| Scoreboard::read(p).map_err(anyhow::Error::msg))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut given = vec![Vec::new(); boards.len()];
     let rows = entries
         .iter()
         .map(|e| {
-            let mut row = earlier
-                .rows
+            let (k, row) = boards
                 .iter()
-                .find(|r| r.entry == e.name)
-                .cloned()
-                .with_context(|| format!("{}: no row for entry `{}`", path.display(), e.name))?;
+                .enumerate()
+                .rev()
+                .find_map(|(k, b)| b.rows.iter().find(|r| r.entry == e.name).map(|r| (k, r)))
+                .with_context(|| format!("no row for entry `{}` in --rows", e.name))?;
+            given[k].push(e.name.clone());
+            let mut row = row.clone();
             row.peers.clear();
             Ok(row)
         })
         .collect::<anyhow::Result<Vec<Row>>>()?;
-    Ok((rows, Some(earlier.seconds)))
+    let sources = paths
+        .iter()
+        .zip(&given)
+        .filter(|(_, g)| !g.is_empty())
+        .map(|(p, g)| {
+            let name = p
+                .file_name()
+                .map_or(p.display().to_string(), |n| n.to_string_lossy().into());
+            format!("`{name}` ({} rows: {})", g.len(), g.join(", "))
+        })
+        .collect();
+    let most = given
+        .iter()
+        .enumerate()
+        .max_by_key(|(_, g)| g.len())
+        .map_or(0.0, |(k, _)| boards[k].seconds);
+    Ok((rows, sources, most))
 }
 
 fn baseline(a: &BenchCorpusArgs) -> anyhow::Result<Option<Scoreboard>> {
