@@ -260,16 +260,28 @@ fn read_table(s: &mut String, rows: &[&Row]) {
 /// The whole scoreboard as Markdown.
 pub fn render(board: &Scoreboard) -> String {
     let mut s = String::new();
+    let how = if board.sources.is_empty() {
+        format!(
+            "{} at once ({} thread(s) per run, {} cores), {:.0} s",
+            board.jobs,
+            board
+                .threads_per_run
+                .map_or("all".into(), |t| t.to_string()),
+            board.cores,
+            board.seconds
+        )
+    } else {
+        format!(
+            "rows taken from the runs listed below, whose wall times add up to {:.0} s",
+            board.seconds
+        )
+    };
     let _ = writeln!(
         s,
-        "# Corpus scoreboard\n\n`{}`{}: {} entries, {} at once ({} thread(s) per run, {} cores), {:.0} s. Errors are two-sided (the worse direction), judged independently, as % of the input's bounding-box diagonal; `report` is the fit's own measure (⚑: more than {:.0}% apart).\n",
+        "# Corpus scoreboard\n\n`{}`{}: {} entries, {how}. Errors are two-sided (the worse direction), judged independently, as % of the input's bounding-box diagonal; `report` is the fit's own measure (⚑: more than {:.0}% apart).\n",
         board.corpus,
         if board.quick { " (quick subset)" } else { "" },
         board.rows.len(),
-        board.jobs,
-        board.threads_per_run.map_or("all".into(), |t| t.to_string()),
-        board.cores,
-        board.seconds,
         100.0 * DISAGREEMENT_FLAG,
     );
     for source in &board.sources {

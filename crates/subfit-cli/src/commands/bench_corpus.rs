@@ -129,8 +129,8 @@ fn runs_dir(out: &Path) -> PathBuf {
 
 /// The rows of earlier scoreboards `paths` for `entries`, in the entries' order (a later
 /// file's row replaces an earlier one's), without their peers (those are judged again from
-/// `--peers`); one line per file saying which rows it gave; the seconds of the scoreboard that
-/// gave the most rows. Errors: an unreadable file, or an entry none of them holds.
+/// `--peers`); one line per file saying which rows it gave; the wall seconds of the runs that
+/// gave rows, added. Errors: an unreadable file, or an entry none of them holds.
 fn earlier_rows(
     paths: &[PathBuf],
     entries: &[subfit_bench::Entry],
@@ -166,12 +166,13 @@ fn earlier_rows(
             format!("`{name}` ({} rows: {})", g.len(), g.join(", "))
         })
         .collect();
-    let most = given
+    let seconds = boards
         .iter()
-        .enumerate()
-        .max_by_key(|(_, g)| g.len())
-        .map_or(0.0, |(k, _)| boards[k].seconds);
-    Ok((rows, sources, most))
+        .zip(&given)
+        .filter(|(_, g)| !g.is_empty())
+        .map(|(b, _)| b.seconds)
+        .sum();
+    Ok((rows, sources, seconds))
 }
 
 fn baseline(a: &BenchCorpusArgs) -> anyhow::Result<Option<Scoreboard>> {
