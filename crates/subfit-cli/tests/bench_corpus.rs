@@ -1,0 +1,102 @@
+//! `subfit bench corpus` on a plain folder of model files (no manifest): every file is fitted
+//! with the defaults by the subfit binary and judged independently; `--rows` takes those rows
+//! back without fitting, and a baseline whose error was much lower is an error regression.
+#![allow(clippy::print_stdout)]
+
+mod common;
+
+use common::subfit;
+use subfit::mesh::shapes::torus_mesh;
+
+fn board(path: &std::path::Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+#[test]
+fn a_plain_folder_is_scored_and_its_rows_reused() {
+    let d = tempfile::tempdir().unwrap();
+    let models = d.path().join("models");
+    std::fs::create_dir(&models).unwrap();
+    let torus = torus_mesh(0.35, 0.15, 48, 24, true);
+    subfit::io::write_file(&models.join("torus.ply"), &torus, &Default::default()).unwrap();
+    let out = d.path().join("board.json");
+    let args = [
+        "bench",
+        "corpus",
+        models.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--surface-samples",
+        "20000",
+    ];
+    let r = subfit(&args);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let b = board(&out);
+    let rows = b["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 1);
+    let row = &rows[0];
+    assert_eq!(row["kind"], "mesh");
+    let (rms, haus) = (
+        row["judge"]["rms_fraction"].as_f64().unwrap(),
+        row["judge"]["hausdorff_fraction"].as_f64().unwrap(),
+    );
+    println!("torus: RMS {rms:.3e}, Hausdorff {haus:.3e} of the diagonal");
+    // A smooth torus is fitted within the scan tolerances, and the judge agrees with them.
+    assert!(rms > 0.0 && rms <= 7.5e-4 && haus <= 7e-3, "{rms} {haus}");
+    assert!(out.with_extension("md").is_file());
+
+    // The same rows taken back: no fit runs (no new run folder), the figures are the same.
+    let again = d.path().join("again.json");
+    let work = d.path().join("again-work");
+    let r = subfit(&[
+        "bench",
+        "corpus",
+        models.to_str().unwrap(),
+        "--rows",
+        out.to_str().unwrap(),
+        "--work",
+        work.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert!(!work.join("torus").exists(), "--rows must not fit again");
+    let a = board(&again);
+    assert_eq!(a["rows"][0]["judge"], row["judge"]);
+    assert!(a["sources"][0].as_str().unwrap().contains("board.json"));
+
+    // Against a baseline ten times better, the row is an error regression: exit 1.
+    let mut base = b.clone();
+    base["rows"][0]["judge"]["rms_fraction"] = serde_json::json!(rms / 10.0);
+    let base_path = d.path().join("base.json");
+    std::fs::write(&base_path, serde_json::to_vec(&base).unwrap()).unwrap();
+    let r = subfit(&[
+        "bench",
+        "corpus",
+        models.to_str().unwrap(),
+        "--rows",
+        out.to_str().unwrap(),
+        "--baseline",
+        base_path.to_str().unwrap(),
+        "--fail-on-regression",
+        "--out",
+        d.path().join("third.json").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        r.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&r.stdout)
+    );
+    assert!(String::from_utf8_lossy(&r.stdout).contains("regression: torus rms"));
+}
