@@ -5,11 +5,27 @@
 
 mod common;
 
+use std::path::Path;
+use std::process::Output;
+
 use common::subfit;
 use subfit::mesh::shapes::torus_mesh;
 
-fn board(path: &std::path::Path) -> serde_json::Value {
+fn board(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// `subfit bench corpus MODELS --out OUT EXTRA...`.
+fn bench(models: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "bench",
+        "corpus",
+        models.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    subfit(&args)
 }
 
 #[test]
@@ -20,16 +36,7 @@ fn a_plain_folder_is_scored_and_its_rows_reused() {
     let torus = torus_mesh(0.35, 0.15, 48, 24, true);
     subfit::io::write_file(&models.join("torus.ply"), &torus, &Default::default()).unwrap();
     let out = d.path().join("board.json");
-    let args = [
-        "bench",
-        "corpus",
-        models.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--surface-samples",
-        "20000",
-    ];
-    let r = subfit(&args);
+    let r = bench(&models, &out, &["--surface-samples", "20000"]);
     assert_eq!(
         r.status.code(),
         Some(0),
@@ -53,17 +60,16 @@ fn a_plain_folder_is_scored_and_its_rows_reused() {
     // The same rows taken back: no fit runs (no new run folder), the figures are the same.
     let again = d.path().join("again.json");
     let work = d.path().join("again-work");
-    let r = subfit(&[
-        "bench",
-        "corpus",
-        models.to_str().unwrap(),
-        "--rows",
-        out.to_str().unwrap(),
-        "--work",
-        work.to_str().unwrap(),
-        "--out",
-        again.to_str().unwrap(),
-    ]);
+    let r = bench(
+        &models,
+        &again,
+        &[
+            "--rows",
+            out.to_str().unwrap(),
+            "--work",
+            work.to_str().unwrap(),
+        ],
+    );
     assert_eq!(
         r.status.code(),
         Some(0),
@@ -80,18 +86,18 @@ fn a_plain_folder_is_scored_and_its_rows_reused() {
     base["rows"][0]["judge"]["rms_fraction"] = serde_json::json!(rms / 10.0);
     let base_path = d.path().join("base.json");
     std::fs::write(&base_path, serde_json::to_vec(&base).unwrap()).unwrap();
-    let r = subfit(&[
-        "bench",
-        "corpus",
-        models.to_str().unwrap(),
-        "--rows",
-        out.to_str().unwrap(),
-        "--baseline",
-        base_path.to_str().unwrap(),
-        "--fail-on-regression",
-        "--out",
-        d.path().join("third.json").to_str().unwrap(),
-    ]);
+    let third = d.path().join("third.json");
+    let r = bench(
+        &models,
+        &third,
+        &[
+            "--rows",
+            out.to_str().unwrap(),
+            "--baseline",
+            base_path.to_str().unwrap(),
+            "--fail-on-regression",
+        ],
+    );
     assert_eq!(
         r.status.code(),
         Some(1),
