@@ -161,18 +161,16 @@ fn igea_as_a_point_cloud_reaches_table_iv_within_its_control_point_budget() {
 }
 
 /// Cheng 2007 Table IV's rocker arm row (genus 1): E_rms ≤ 0.0003, E_max ≤ 0.0029 with ≤ 950
-/// control points (surface → data, as the paper), the genus kept; both ways within 3.5e-4 and
-/// 0.0029.
+/// control points, the genus kept — reached both ways (the default), the data → surface
+/// maximum taken over every input vertex as well as the area samples.
 #[test]
 fn rocker_arm_reaches_table_iv_within_its_control_point_budget() {
     let Some(data) = data_dir() else { return };
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("rocker");
-    // Table IV's figures are Cheng's surface → data measure: judged so here (`--one-sided`),
-    // as for Igea above; both directions are reported and bounded. Both ways, with the
-    // surface → data RMS weighted by area (what a measurement uniform by area sees), the
-    // default fit ends at 949 control points with a two-sided RMS of 3.02e-4, just above
-    // Table IV's 3e-4.
+    // Fitted one-sided (`--one-sided`, Cheng's measure) the fit stops at 780 control points
+    // with surface → data within Table IV but an input vertex 4.2e-3 from the surface: the
+    // two-sided fit is the one that reaches the table's figures as a user measures them.
     let flags = [
         "--tolerance",
         "0.0003",
@@ -180,7 +178,6 @@ fn rocker_arm_reaches_table_iv_within_its_control_point_budget() {
         "0.0029",
         "--max-control-points",
         "950",
-        "--one-sided",
     ];
     let (rep, e_rms, e_max, n) = fit_ok(&data.join("rocker-arm.off"), &flags, &out);
     let two = &rep["final"]["two_sided"];
@@ -192,7 +189,7 @@ fn rocker_arm_reaches_table_iv_within_its_control_point_budget() {
     assert!(e_rms <= 0.0003, "{e_rms}");
     assert!(e_max <= 0.0029, "{e_max}");
     assert!(n <= 950, "{n}");
-    assert!(r2 <= 0.00035, "two-sided {r2}");
+    assert!(r2 <= 0.0003, "two-sided {r2}");
     assert!(m2 <= 0.0029, "two-sided {m2}");
     let topo = cage_topology(&out);
     assert_eq!(topo["genus"], 1, "{topo}");
