@@ -22,7 +22,9 @@
 //!    surface overhanging the data's edge is far).
 //! 3. **Data → surface.** Every reference vertex (or point) and, for a mesh,
 //!    [`JudgeOptions::data_samples`] area-uniform samples of its triangles, to the closest point
-//!    on the tessellation (parry): within the deviation of exact. The
+//!    on the tessellation (parry): within the deviation of exact. A mesh's RMS, mean and 95th
+//!    percentile are the samples' (uniform by area, as Metro measures), its maximum is over
+//!    vertices and samples; a cloud's figures are over its points. The
 //!    [`JudgeOptions::polished_points`] farthest are then polished on the exact surface (module
 //!    `polish`: Newton steps from the tessellation's foot point, mapped back to its patch's
 //!    parameters through the refinement's child order, module `walk`): exact where the polish
@@ -135,7 +137,10 @@ fn judge_here(
             triangles,
         } => judge_mesh(positions, triangles, &data, options)?,
     };
-    let data_to_surface = stats::direction(&measured.data_to_surface);
+    let data_to_surface = match &data.weights {
+        Some(w) => stats::weighted(&measured.data_to_surface, w),
+        None => stats::direction(&measured.data_to_surface),
+    };
     let surface_to_data = match &measured.surface_weights {
         Some(w) => stats::weighted(&measured.surface_to_data, w),
         None => stats::direction(&measured.surface_to_data),
@@ -191,6 +196,11 @@ impl Surface<'_> {
 /// The validated reference: its points measured to the candidate, its diagonal, its surface.
 struct Data<'a> {
     points: Vec<[f64; 3]>,
+    /// What each point stands for in the data → surface RMS, mean and 95th percentile (`None`:
+    /// equal shares). A mesh's vertices stand for nothing there (they are measured for the
+    /// maximum: a vertex is where a scan's sharpest detail sits), its area-uniform samples for
+    /// equal areas, so that the RMS is the one uniform by area that a user would measure.
+    weights: Option<Vec<f64>>,
     /// Points of a cloud left out as isolated returns.
     isolated: usize,
     diagonal: f64,
@@ -221,12 +231,16 @@ impl<'a> Data<'a> {
                     .collect();
                 let diagonal = diagonal(&points)?;
                 // Degenerate (zero-area) triangles only: the vertices are the data.
+                let mut weights = None;
                 if let Some(s) = area_samples(
                     positions,
                     triangles,
                     options.data_samples,
                     stream(options.seed, 2),
                 ) {
+                    let mut w = vec![0.0; points.len()];
+                    w.resize(points.len() + s.len(), 1.0);
+                    weights = Some(w);
                     points.extend(
                         s.iter()
                             .map(|x| x.position(positions, triangles[x.triangle as usize])),
@@ -234,6 +248,7 @@ impl<'a> Data<'a> {
                 }
                 Ok(Self {
                     points,
+                    weights,
                     isolated: 0,
                     diagonal,
                     surface: Surface::Triangles(Triangles::new(positions, triangles)),
@@ -260,6 +275,7 @@ impl<'a> Data<'a> {
                 Ok(Self {
                     isolated: positions.len() - points.len(),
                     points,
+                    weights: None,
                     diagonal,
                     surface: Surface::Discs(discs),
                 })

@@ -245,10 +245,18 @@ fn read_table(s: &mut String, rows: &[&Row]) {
             s,
             "| {} | {} | {} | {} | {} | {} |",
             r.entry,
-            if c.read { "yes" } else { "refused" },
+            match (c.read, c.cut_short) {
+                (true, _) => "yes",
+                (false, true) => "refused: cut short",
+                (false, false) => "refused",
+            },
             c.vertices.map_or("–".into(), |v| v.to_string()),
             c.faces.map_or("–".into(), |v| v.to_string()),
-            pass_mark(c.counts_match),
+            if c.cut_short {
+                "– (right to refuse)"
+            } else {
+                pass_mark(c.counts_match)
+            },
             truncate(
                 &c.message.clone().unwrap_or_default().replace('|', "/"),
                 160

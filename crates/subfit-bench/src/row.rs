@@ -59,6 +59,11 @@ pub struct ReadCheck {
     pub counts_match: Option<bool>,
     /// The error, when refused.
     pub message: Option<String>,
+    /// Refused because the file is cut short (its data ends before a point, a face or a count
+    /// it announces is complete): a damaged copy, whose refusal with the place named is the
+    /// right answer rather than a reader's gap.
+    #[serde(default)]
+    pub cut_short: bool,
 }
 
 /// One scoreboard row.
@@ -171,7 +176,8 @@ pub enum Criteria {
         /// Drift 95th percentile / diagonal.
         drift_p95_fraction: f64,
     },
-    /// A file variant: it reads with the manifest's counts (or is refused with a message).
+    /// A file variant: it reads with the manifest's counts, or, when the file is cut short, is
+    /// refused with the line where its data ends.
     Reads,
 }
 
@@ -246,6 +252,9 @@ pub fn passes(row: &Row, criteria: Criteria) -> Option<bool> {
                     }),
             )
         }
-        Criteria::Reads => row.read.as_ref().map(|r| r.counts_match == Some(true)),
+        Criteria::Reads => row
+            .read
+            .as_ref()
+            .map(|r| r.counts_match == Some(true) || r.cut_short),
     }
 }

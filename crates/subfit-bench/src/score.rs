@@ -8,7 +8,9 @@ use subfit::mesh::{PolyMesh, Tags};
 use subfit::subdiv::Scheme;
 
 use crate::cage_stats::{cage_stats, topology, Topology};
-use crate::inputs::{disagreement, fans, read_cage, read_model, reference_of, scheme_named};
+use crate::inputs::{
+    disagreement, fans, read_cage, read_model, read_model_typed, reference_of, scheme_named,
+};
 use crate::judge::{judge, Candidate, JudgeOptions};
 use crate::manifest::{Entry, Job};
 use crate::row::{criteria, passes, Judged, ReadCheck, ReportFigures, Row};
@@ -210,7 +212,7 @@ fn read_row(entry: &Entry, input: &Path) -> Row {
         "read",
         input.display().to_string(),
     );
-    row.read = Some(match read_model(input) {
+    row.read = Some(match read_model_typed(input) {
         Ok(m) => {
             let (v, f) = (m.num_vertices(), m.faces.len());
             let counts_match = match (entry.vertices, entry.faces) {
@@ -224,6 +226,7 @@ fn read_row(entry: &Entry, input: &Path) -> Row {
                 faces: Some(f),
                 counts_match,
                 message: None,
+                cut_short: false,
             }
         }
         Err(e) => ReadCheck {
@@ -231,7 +234,8 @@ fn read_row(entry: &Entry, input: &Path) -> Row {
             vertices: None,
             faces: None,
             counts_match: Some(false),
-            message: Some(e),
+            cut_short: matches!(e.kind, subfit::io::ErrorKind::Truncated(_)),
+            message: Some(e.to_string()),
         },
     });
     row
@@ -311,6 +315,52 @@ mod tests {
             tolerance_reached: true,
         };
         assert!((disagreement(1e-3, 1e-2, &r) - 0.1).abs() < 1e-12);
+        // Two exact fits (round-off apart) agree.
+        let exact = ReportFigures {
+            rms_fraction: 2e-9,
+            hausdorff_fraction: 1e-8,
+            tolerance_reached: true,
+        };
+        assert!(disagreement(1e-9, 3e-8, &exact) < 0.01);
+    }
+
+    /// A file variant passes when it reads with the manifest's counts, or when it is cut short
+    /// and refused for it; any other refusal fails.
+    #[test]
+    fn a_cut_short_file_is_rightly_refused_and_a_syntax_error_is_not() {
+        let d = tempfile::tempdir().unwrap();
+        let entry = |name: &str| Entry {
+            name: name.into(),
+            category: "refused".into(),
+            job: Job::Read {
+                input: d.path().join(name),
+            },
+            vertices: Some(2),
+            faces: None,
+            genus: None,
+            boundary_loops: None,
+            bytes: 0,
+        };
+        let cases = [
+            ("whole.xyz", "0 0 0\n1 0 0\n", true, false),
+            ("cut.xyz", "0 0 0\n1 0 0\n0.5 0.", true, true),
+            ("words.xyz", "0 0 0\nx y z\n", false, false),
+        ];
+        for (name, text, pass, cut) in cases {
+            std::fs::write(d.path().join(name), text).unwrap();
+            let e = entry(name);
+            let Job::Read { input } = &e.job else {
+                unreachable!()
+            };
+            let row = read_row(&e, input);
+            let read = row.read.as_ref().unwrap();
+            assert_eq!(read.cut_short, cut, "{name}: {read:?}");
+            assert_eq!(
+                passes(&row, criteria("refused")),
+                Some(pass),
+                "{name}: {read:?}"
+            );
+        }
     }
 
     #[test]

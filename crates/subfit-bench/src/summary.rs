@@ -83,6 +83,7 @@ fn summarize_category(category: &str, rows: &[&Row]) -> CategorySummary {
         let label = match (&r.run, &r.read) {
             (Some(run), _) => run.exit.label(),
             (None, Some(read)) if read.read => "read".into(),
+            (None, Some(read)) if read.cut_short => "refused: cut short".into(),
             (None, Some(_)) => "refused".into(),
             (None, None) => "not run".into(),
         };

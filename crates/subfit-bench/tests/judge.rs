@@ -154,6 +154,42 @@ fn heights_over_a_plane_are_exact() {
     }
 }
 
+/// A ramp z = a·(x − 2.5) over [2.5, 7.5]² above the dished grid's plane, tessellated with most
+/// of its vertices in a strip at its high end: the data → surface RMS is uniform by area
+/// (a·5/√3, as Metro measures), not pulled up by where the vertices crowd; the maximum (5a) is
+/// at those vertices.
+#[test]
+fn the_data_to_surface_rms_is_uniform_by_area_wherever_the_vertices_crowd() {
+    let a = 0.02;
+    let mut xs = vec![2.5, 3.75, 5.0, 6.25, 7.0];
+    xs.extend((1..=40).map(|i| 7.0 + 0.5 * i as f64 / 40.0));
+    let ys: Vec<f64> = (0..=10).map(|j| 2.5 + 0.5 * j as f64).collect();
+    let mut positions = Vec::new();
+    for &y in &ys {
+        for &x in &xs {
+            positions.push([x, y, a * (x - 2.5)]);
+        }
+    }
+    let at = |i: usize, j: usize| (j * xs.len() + i) as u32;
+    let mut triangles = Vec::new();
+    for j in 0..ys.len() - 1 {
+        for i in 0..xs.len() - 1 {
+            triangles.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    let reference = Reference::Mesh {
+        positions,
+        triangles,
+    };
+    let cage = Candidate::limit(dished_grid(), Tags::new(), Scheme::CatmullClark);
+    let j = judge(&reference, &cage, &small()).unwrap();
+    let d = j.data_to_surface;
+    let (rms, max) = (a * 5.0 / 3f64.sqrt(), a * 5.0);
+    assert!((d.rms - rms).abs() < 0.03 * rms, "RMS {} vs {rms}", d.rms);
+    assert!((d.max - max).abs() < 1e-9, "max {} vs {max}", d.max);
+}
+
 /// Corner parameters of the grid of resolution `n` on a triangle or unit-square patch, and its
 /// triangles.
 fn grid(n: usize, triangle: bool) -> (Vec<(f64, f64)>, Vec<[u32; 3]>) {
