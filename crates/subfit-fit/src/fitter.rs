@@ -281,13 +281,14 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
     /// from fresh projections of the data term (RMS and mean weighted by the area each sample
     /// stands for in the sample tessellation) and the distance of every point of `data` to
     /// that tessellation (the level-`l` limit points; within its chordal error of the limit
-    /// surface). Also returns the per-sample squared errors and the data points' closest points,
-    /// for per-face statistics. Cost: one projection of the samples, one BVH over the sample
+    /// surface; the RMS over the area samples, the maximum over the rim as well:
+    /// [`subfit_measure::DistanceStats::of_samples`]). Also returns the per-sample squared
+    /// errors and the data points' closest points, for per-face statistics. Cost: one projection of the samples, one BVH over the sample
     /// tessellation and one query per data point.
     pub fn measure_two_sided(
         &self,
         control: &[[f64; 3]],
-        data: &[[f64; 3]],
+        data: &subfit_measure::DataSamples,
     ) -> (
         subfit_measure::TwoSided,
         Vec<f64>,
@@ -302,14 +303,14 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 (samples, err2)
             }
         };
-        let to_surface = MeshDistance::new(&samples, &self.op.faces).distances(data);
+        let to_surface = MeshDistance::new(&samples, &self.op.faces).distances(&data.points);
         let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
         let two = TwoSided {
             surface_to_data: DistanceStats::of_weighted(
                 &err2.iter().map(|x| x.max(0.0).sqrt()).collect::<Vec<_>>(),
                 &vertex_areas(&samples, &self.op.faces),
             ),
-            data_to_surface: DistanceStats::of(&d),
+            data_to_surface: DistanceStats::of_samples(&d, data.boundary),
         };
         (two, err2, to_surface)
     }

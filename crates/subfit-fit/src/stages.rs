@@ -501,7 +501,7 @@ pub(crate) fn measure(
     stages: &StageOptions,
 ) -> Measurement {
     let op = topo.fitter.sampling_operator();
-    let (two_sided, err2, to_surface) = topo.fitter.measure_two_sided(positions, &data.points);
+    let (two_sided, err2, to_surface) = topo.fitter.measure_two_sided(positions, data);
     let surface_faces = face_errors(faces, op, &err2);
     let mut data_faces = vec![FaceError::default(); faces.len()];
     let rim_from = to_surface.len() - data.boundary.min(to_surface.len());

@@ -66,6 +66,22 @@ impl DistanceStats {
         }
     }
 
+    /// Statistics of data → surface distances `d` whose last `extremes` values are measured
+    /// for the maximum only (a mesh's boundary vertices, [`crate::DataSamples::boundary`]):
+    /// RMS and mean over the others (uniform by area), the maximum and the count over all.
+    /// All of them when `extremes` leaves none.
+    pub fn of_samples(d: &[f64], extremes: usize) -> Self {
+        let area = &d[..d.len() - extremes.min(d.len())];
+        if area.is_empty() {
+            return Self::of(d);
+        }
+        Self {
+            samples: d.len(),
+            max: d.iter().fold(0.0, |m, &x| m.max(x)),
+            ..Self::of(area)
+        }
+    }
+
     /// Statistics from squared distances.
     pub fn of_squared(d2: &[f64]) -> Self {
         let d: Vec<f64> = d2.iter().map(|x| x.max(0.0).sqrt()).collect();
@@ -176,5 +192,11 @@ mod tests {
         assert!(t.within(0.0, 5.0));
         assert!(!t.within(0.0, 0.0), "no tolerance set is never reached");
         assert_eq!(t.scaled(2.0).data_to_surface.max, 10.0);
+        // Rim points count for the maximum only.
+        let r = DistanceStats::of_samples(&[3.0, 4.0, 9.0], 1);
+        assert_eq!((r.samples, r.max), (3, 9.0));
+        assert_eq!((r.rms, r.mean), (a.rms, a.mean));
+        assert_eq!(DistanceStats::of_samples(&[3.0, 4.0], 2), a);
+        assert_eq!(DistanceStats::of_samples(&[3.0, 4.0], 0), a);
     }
 }

@@ -82,7 +82,13 @@ pub(crate) fn fit_start(
 
     options.cancel.check().map_err(|_| Error::Interrupted)?;
     let t_measure = Instant::now();
-    let measured = measure_final(&prepared.target, &result, &fit, options.stages.data_samples)?;
+    let measured = measure_final(
+        &prepared.target,
+        &prepared.file_vertices,
+        &result,
+        &fit,
+        options.stages.data_samples,
+    )?;
     let usd = quad_triangle_difference(prepared, &result, &fit, &measured, notify, &mut warnings)?;
     let measure_time = t_measure.elapsed().as_secs_f64();
     let judgement = judge(&result, &measured, &tolerances.stages);

@@ -39,11 +39,13 @@ impl FinalMeasure {
     }
 }
 
-/// Measures the cage `result` of a fit of `target` with `fit`, `samples` data samples the way
+/// Measures the cage `result` of a fit of `target` with `fit`, `samples` data samples and the
+/// file's vertices `file_vertices` (normalized units) the way
 /// (see the module docs). Cost: the tessellation, one foot point per tessellation vertex, one
 /// BVH query per data sample.
 pub(crate) fn measure_final(
     target: &Target,
+    file_vertices: &[[f64; 3]],
     result: &StagesResult,
     fit: &FitOptions,
     samples: usize,
@@ -71,11 +73,12 @@ pub(crate) fn measure_final(
         .iter()
         .map(|p| p.distance)
         .collect();
-    // The RMS is the area samples'; the largest distance is also taken over the vertices.
-    let mut data_to_surface = DistanceStats::of(&to_surface);
-    let from_vertices = surface
-        .distances(mesh_vertices(target))
+    // The RMS is the area samples' (not the rim's); the largest distance is also taken over
+    // the rim and every vertex.
+    let mut data_to_surface = DistanceStats::of_samples(&to_surface, data.boundary);
+    let from_vertices = [mesh_vertices(target), file_vertices]
         .iter()
+        .flat_map(|v| surface.distances(v))
         .map(|p| p.distance)
         .fold(0.0, f64::max);
     data_to_surface.max = data_to_surface.max.max(from_vertices);

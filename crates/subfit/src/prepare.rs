@@ -29,6 +29,10 @@ pub struct Prepared {
     /// The repaired input in its own coordinates; no faces for a point cloud or with
     /// [`FitScanOptions::as_points`].
     pub(crate) mesh: PolyMesh,
+    /// Every vertex a face of the file uses, as read and before any repair, in the target's
+    /// normalized units (empty for points): the final measure's largest data → surface
+    /// distance is taken over them too, the figure a user measures against the file.
+    pub(crate) file_vertices: Vec<[f64; 3]>,
     /// Faces turned to agree with their neighbours by the repair, if any.
     pub reoriented: Option<Reorientation>,
     /// Genus and boundary loops of a mesh target; `None` for a point cloud.
@@ -104,10 +108,14 @@ pub(crate) fn prepare(
     let mut warnings = Vec::new();
     let t0 = Instant::now();
     notify.step(Step::Read);
-    let (mut mesh, name, reoriented) =
-        crate::repair::read_input(input, options.as_points, &mut |m| {
-            notify.warn(&mut warnings, m)
-        })?;
+    let crate::repair::ReadInput {
+        mut mesh,
+        name,
+        reoriented,
+        vertices: file_vertices,
+    } = crate::repair::read_input(input, options.as_points, &mut |m| {
+        notify.warn(&mut warnings, m)
+    })?;
     let read_seconds = t0.elapsed().as_secs_f64();
     options.cancel.check().map_err(|_| Error::Interrupted)?;
 
@@ -141,9 +149,14 @@ pub(crate) fn prepare(
         notify.warn(&mut warnings, msg);
     }
     let diagonal = bbox_diagonal(target.points());
+    let file_vertices = file_vertices
+        .into_iter()
+        .map(|p| target.to_normalized(p))
+        .collect();
     Ok(Prepared {
         name,
         mesh,
+        file_vertices,
         reoriented,
         topology: target_topology,
         expected_topology,

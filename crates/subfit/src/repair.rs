@@ -256,7 +256,7 @@ pub(crate) fn read_input(
     input: Input,
     as_points: bool,
     warn: &mut dyn FnMut(String),
-) -> Result<(PolyMesh, String, Option<Reorientation>), Error> {
+) -> Result<ReadInput, Error> {
     let (mut mesh, name) = match input {
         Input::File(path) => {
             let (m, info) = subfit_io::read_file(&path, &subfit_io::ReadOptions::default())?;
@@ -267,10 +267,48 @@ pub(crate) fn read_input(
         }
         Input::Mesh { mesh, name } => (mesh, name),
     };
-    let reoriented = if as_points {
-        None
+    let (reoriented, vertices) = if as_points {
+        (None, Vec::new())
     } else {
-        repair_or_points(&mut mesh, &name, warn).map_err(|e| Error::input(&name, e))?
+        let vertices = face_vertices(&mesh);
+        let r = repair_or_points(&mut mesh, &name, warn).map_err(|e| Error::input(&name, e))?;
+        (r, vertices)
     };
-    Ok((mesh, name, reoriented))
+    Ok(ReadInput {
+        mesh,
+        name,
+        reoriented,
+        vertices,
+    })
+}
+
+/// An input read and repaired ([`read_input`]).
+pub(crate) struct ReadInput {
+    /// The repaired mesh (or points).
+    pub(crate) mesh: PolyMesh,
+    /// Its name for messages (the file).
+    pub(crate) name: String,
+    /// Faces the repair turned, if any.
+    pub(crate) reoriented: Option<Reorientation>,
+    /// Every vertex a face of the file uses, as read (before the repair dropped flaps or
+    /// duplicates): where the final measure takes its largest data → surface distance from, so
+    /// that the figure is the one a user measures against the file. Empty for points.
+    pub(crate) vertices: Vec<[f64; 3]>,
+}
+
+/// The positions of the vertices some face of `mesh` uses, in index order.
+fn face_vertices(mesh: &PolyMesh) -> Vec<[f64; 3]> {
+    let mut used = vec![false; mesh.positions.len()];
+    for f in mesh.faces.iter() {
+        for &v in f {
+            if let Some(u) = used.get_mut(v as usize) {
+                *u = true;
+            }
+        }
+    }
+    mesh.positions
+        .iter()
+        .zip(&used)
+        .filter_map(|(p, &u)| u.then_some(*p))
+        .collect()
 }

@@ -492,7 +492,12 @@ type ReadFrame = (PolyMesh, String, Option<Reorientation>, f64);
 
 fn read_frame(input: Input, warn: &mut dyn FnMut(String)) -> Result<ReadFrame, Error> {
     let t = Instant::now();
-    let (mesh, name, reoriented) = read_input(input, false, warn)?;
+    let crate::repair::ReadInput {
+        mesh,
+        name,
+        reoriented,
+        ..
+    } = read_input(input, false, warn)?;
     Ok((mesh, name, reoriented, t.elapsed().as_secs_f64()))
 }
 
@@ -569,7 +574,7 @@ fn fit_frame(
         iterations += r.iterations.len();
     }
     let data = data_samples(&target, options.data_samples);
-    let (two, _, _) = fitter.measure_two_sided(&positions, &data.points);
+    let (two, _, _) = fitter.measure_two_sided(&positions, &data);
     let fit_time = t.elapsed().as_secs_f64();
     let unit = carry.normalization.length_to_original(1.0);
     let diagonal = subfit_fit::DataTerm::bbox_diagonal(&subfit_fit::FootPointTerm::from_options(
