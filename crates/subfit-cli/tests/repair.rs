@@ -221,6 +221,42 @@ fn a_moebius_strip_is_fitted_as_its_points_with_a_warning() {
     assert!(d.path().join("fit/control.obj").exists());
 }
 
+/// The repair drops a small Möbius strip lying apart from a sphere (debris it cannot orient),
+/// but the report's largest data → surface distance is still measured against the file as
+/// written: the strip's vertices, a unit and more from the sphere, are in it.
+#[test]
+fn the_reported_maximum_covers_what_the_repair_dropped() {
+    let d = tempfile::tempdir().unwrap();
+    let mut mesh = sphere_with_sheet(32, 15, 0, 0);
+    let strip = moebius(8, 1);
+    let offset = mesh.positions.len() as u32;
+    mesh.positions.extend(
+        strip
+            .positions
+            .iter()
+            .map(|p| [2.5 + 0.1 * p[0], 0.1 * p[1], 0.1 * p[2]]),
+    );
+    for f in strip.faces.iter() {
+        mesh.faces
+            .push(&f.iter().map(|&v| v + offset).collect::<Vec<_>>());
+    }
+    let path = write(d.path(), "debris.obj", &mesh);
+    let (err, report) = quick_fit(&path, &d.path().join("fit"));
+    assert!(
+        err.contains("non-orientable pieces"),
+        "the strip is dropped: {err}"
+    );
+    assert_eq!(report["target_topology"]["genus"], 0, "{report}");
+    // The strip's nearest vertex is 2.5 − 0.13 − 1 from the unit sphere.
+    let max = report["final"]["two_sided"]["e_max_original_units"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        max > 1.3,
+        "largest distance {max}: the dropped strip is not measured"
+    );
+}
+
 #[test]
 fn the_decimated_dragon_and_buddha_are_repaired_and_get_an_initial_cage() {
     let Some(corpus) = corpus_dir() else { return };
