@@ -76,20 +76,47 @@ class Fit:
         """The fitted limit surface as a :class:`subfit.Surface`."""
         return Surface(self.vertices, self.faces, self.scheme, self.tags)
 
-    def save(self, directory: PathLike) -> Path:
+    def save(self, directory: PathLike, *, limit_quads: bool = False) -> Path:
         """Writes the outputs of ``subfit fit`` into ``directory`` (created if missing).
 
         control.obj, control.usda (scheme and creases, for Blender/USD), control.tags.json (the
         creases for OBJ readers that skip OpenSubdiv's tags), limit.ply (the limit
-        tessellation with normals), error.ply (coloured by the distance to the scan), log.csv
-        and report.json. A Fit that was pickled into another process no longer holds the scan:
-        there only control.obj, control.usda and report.json are written (with a warning).
-        Returns the directory.
+        tessellation with normals), error.ply (coloured by the distance to the scan), log.csv,
+        preview.png, report.html and report.json. A Fit that was pickled into another process
+        no longer holds the scan: there only control.obj, control.usda and report.json are
+        written (with a ``RuntimeWarning``).
+
+        Parameters
+        ----------
+        directory : str or os.PathLike
+            Where to write (created with its parents if missing; files in it are replaced).
+        limit_quads : bool
+            Keep the limit tessellation's quads in limit.ply and error.ply (a Catmull-Clark or
+            quad/triangle cage's refinement), as ``subfit fit --limit-quads``. Default
+            ``False``: each quad is split into two triangles along the diagonal the errors
+            were measured on, so every face has three corners (trimesh refuses a PLY whose
+            faces differ in size). A Loop fit's tessellation is triangles either way.
+
+        Returns
+        -------
+        pathlib.Path
+            ``directory``.
+
+        Raises
+        ------
+        OSError
+            A file that cannot be written.
+
+        Examples
+        --------
+        >>> f = subfit.fit("scan.ply", scheme="catmull-clark")  # doctest: +SKIP
+        >>> f.save("out", limit_quads=True)  # doctest: +SKIP
+        PosixPath('out')
         """
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
         if self._native is not None:
-            self._native.write_into(str(d))
+            self._native.write_into(str(d), limit_quads=bool(limit_quads))
             self.report = json.loads(self._native.report_json())
             return d
         warnings.warn(
