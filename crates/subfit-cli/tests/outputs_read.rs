@@ -1,6 +1,6 @@
 //! Every kind of file subfit writes opens in the readers users reach for first — trimesh,
-//! Open3D and meshio (`tests/checks/open_outputs.py`) — with the vertex and face counts we
-//! wrote (read back with our own reader). The fit is a quad/triangle one, whose limit
+//! Open3D, meshio and MeshLab's (pymeshlab) (`tests/checks/open_outputs.py`) — with the vertex
+//! and face counts we wrote (read back with our own reader). The fit is a quad/triangle one, whose limit
 //! tessellation has quads and triangles: `limit.ply` is triangles by default (trimesh refuses
 //! a PLY whose faces differ in size: "PLY is unexpected length"), and `--limit-quads` keeps
 //! the quads for the readers that take them. Without the Python packages
@@ -41,7 +41,9 @@ fn s(p: &Path) -> &str {
 
 /// Whether `reader` is meant to read files ending in `ext`: meshio has no XYZ format and its
 /// OFF reader takes plain `OFF` files of triangles only (ours may say `NOFF`, with normals, or
-/// have quads); docs/outputs.md says so.
+/// have quads); docs/outputs.md says so. MeshLab reads every kind checked here (PLY, OBJ, OFF,
+/// STL, and XYZ as a point cloud); it has no USD importer, and `control.usda` is not among
+/// these files (USD's own bindings and Blender open it: `tests/report_checks.rs`).
 fn reads(reader: &str, ext: &str) -> bool {
     !(reader == "meshio" && (ext == "xyz" || ext == "off"))
 }
@@ -78,7 +80,9 @@ fn check_readers(files: &[PathBuf], readers: &[&str]) {
                 "{reader}, {}: triangles",
                 f.display()
             );
-            if reader == "meshio" {
+            // meshio keeps polygons; MeshLab triangulates them on load (its "triangles" are
+            // compared above) and gives them back from the diagonals it marked.
+            if reader == "meshio" || reader == "meshlab" {
                 assert_eq!(count("faces"), faces, "{reader}, {}: faces", f.display());
             }
         }
@@ -86,8 +90,8 @@ fn check_readers(files: &[PathBuf], readers: &[&str]) {
 }
 
 #[test]
-fn every_output_kind_opens_in_trimesh_open3d_and_meshio() {
-    if !available("trimesh, open3d, meshio", None) {
+fn every_output_kind_opens_in_trimesh_open3d_meshio_and_meshlab() {
+    if !available("trimesh, open3d, meshio, pymeshlab", None) {
         return;
     }
     let d = tempfile::tempdir().unwrap();
@@ -177,9 +181,9 @@ fn every_output_kind_opens_in_trimesh_open3d_and_meshio() {
     ] {
         files.push(fit.join(f));
     }
-    check_readers(&files, &["trimesh", "open3d", "meshio"]);
+    check_readers(&files, &["trimesh", "open3d", "meshio", "meshlab"]);
     // Quads and triangles in one PLY: trimesh refuses it (the reason for the default).
-    check_readers(&[quads.join("limit.ply")], &["open3d", "meshio"]);
+    check_readers(&[quads.join("limit.ply")], &["open3d", "meshio", "meshlab"]);
 }
 
 /// `--json` prints one JSON object whose figures are the report's, and the files it lists exist.

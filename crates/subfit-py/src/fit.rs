@@ -16,7 +16,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use subfit::fit::{FitOptions, StageOptions, StepControl};
 use subfit::mesh::{Cancel, PolyMesh, Tags};
-use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, Progress, Step};
+use subfit::{fit_scan, FitScanOptions, Fitted, InitialCage, Input, OutputOptions, Progress, Step};
 
 use crate::arrays::{
     polygons, polygons_to_py, scheme, scheme_name, tags_to_py, vec3s, vec3s_to_py,
@@ -392,13 +392,21 @@ impl NativeFit {
 
     /// Writes every output into the existing directory `dir` (`subfit::OUTPUTS`: control.obj,
     /// control.usda, control.tags.json, limit.ply, error.ply, log.csv, preview.png, report.html,
-    /// report.json), interpreter detached.
-    fn write_into(&self, py: Python<'_>, dir: std::path::PathBuf) -> PyResult<()> {
+    /// report.json), interpreter detached. `limit_quads` keeps the limit tessellation's quads
+    /// in limit.ply and error.ply ([`OutputOptions::limit_quads`], `subfit fit --limit-quads`).
+    #[pyo3(signature = (dir, limit_quads=false))]
+    fn write_into(
+        &self,
+        py: Python<'_>,
+        dir: std::path::PathBuf,
+        limit_quads: bool,
+    ) -> PyResult<()> {
+        let options = OutputOptions { limit_quads };
         py.detach(|| {
             self.fitted
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
-                .write_into(&dir)
+                .write_into_with(&dir, &options)
         })
         .map_err(fit_error)
     }

@@ -151,3 +151,56 @@ def test_imls_method_as_the_cli():
         subfit.fit(points, method="nope")
     with pytest.raises(ValueError, match="imls-radius"):
         subfit.fit(points, imls_radius=0.02)
+
+
+_PLY_TYPES = {"char": "i1", "uchar": "u1", "short": "i2", "ushort": "u2", "int": "i4", "uint": "u4",
+              "float": "f4", "double": "f8", "int8": "i1", "uint8": "u1", "int16": "i2", "uint16": "u2",
+              "int32": "i4", "uint32": "u4", "float32": "f4", "float64": "f8"}
+
+
+def ply_face_sizes(path):
+    """``{corners: faces}`` of a binary little-endian PLY, read here from its header and bytes
+    (independently of ``subfit.read``, which turns uniform faces into an array)."""
+    data = path.read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode("ascii").splitlines()
+    assert "format binary_little_endian 1.0" in header, header[:2]
+    elements = []  # (name, count, [("scalar", type) | ("list", count_type, item_type)])
+    for line in header:
+        w = line.split()
+        if w[0] == "element":
+            elements.append((w[1], int(w[2]), []))
+        elif w[0] == "property":
+            elements[-1][2].append(("list", w[2], w[3]) if w[1] == "list" else ("scalar", w[1]))
+    pos, sizes = end, {}
+    for name, count, props in elements:
+        if all(p[0] == "scalar" for p in props):  # fixed-size rows
+            pos += count * sum(np.dtype(_PLY_TYPES[p[1]]).itemsize for p in props)
+            continue
+        assert name == "face" and len(props) == 1, (name, props)
+        count_t = np.dtype("<" + _PLY_TYPES[props[0][1]])
+        item_size = np.dtype(_PLY_TYPES[props[0][2]]).itemsize
+        for _ in range(count):
+            k = int(np.frombuffer(data, count_t, 1, pos)[0])
+            sizes[k] = sizes.get(k, 0) + 1
+            pos += count_t.itemsize + k * item_size
+    assert pos == len(data), f"{path.name}: {len(data) - pos} bytes left after the elements"
+    return sizes
+
+
+def test_save_limit_quads_keeps_quads_only_when_asked(fitted, tmp_path):
+    # A Catmull-Clark fit's limit tessellation is quads: split into triangles by default (the
+    # CLI's default), kept with limit_quads=True (`subfit fit --limit-quads`).
+    points, normals = ellipsoid_cloud(4000, seed=5)
+    cc = subfit.fit(points, normals=normals, scheme="catmull-clark", tolerance=2e-3,
+                    max_control_points=400, max_iterations=10)
+    tri = ply_face_sizes(cc.save(tmp_path / "tri") / "limit.ply")
+    quad = ply_face_sizes(cc.save(tmp_path / "quad", limit_quads=True) / "limit.ply")
+    assert set(tri) == {3}, tri
+    assert 4 in quad and set(quad) <= {3, 4}, quad
+    # The same surface: every quad became two triangles.
+    assert tri[3] == 2 * quad[4] + quad.get(3, 0)
+    assert ply_face_sizes(tmp_path / "quad" / "error.ply") == quad
+    assert ply_face_sizes(tmp_path / "tri" / "error.ply") == tri
+    # A Loop fit's tessellation is triangles whatever is asked.
+    assert set(ply_face_sizes(fitted.save(tmp_path / "loop", limit_quads=True) / "limit.ply")) == {3}

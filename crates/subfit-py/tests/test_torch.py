@@ -112,3 +112,17 @@ def test_adam_imls_arap_loop_lowers_loss_tenfold(torch):
     losses = torch_imls_arap.run(steps=300, verbose=False)
     assert min(losses) >= 0.0
     assert losses[-1] * 10 <= losses[0], (losses[0], losses[-1])
+
+
+def test_docstring_examples_run(st, tmp_path, monkeypatch):
+    # The examples of subfit.torch's docstrings (docs/python.md shows them) run as written.
+    import doctest
+
+    monkeypatch.chdir(tmp_path)
+    tests = [t for t in doctest.DocTestFinder().find(st) if t.examples]
+    assert len(tests) >= 6, [t.name for t in tests]
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    for t in tests:
+        runner.run(t)
+    result = runner.summarize(verbose=False)
+    assert result.failed == 0, f"{result.failed} of {result.attempted} examples failed (printed above)"

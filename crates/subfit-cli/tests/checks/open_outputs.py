@@ -1,6 +1,6 @@
-"""Opens files that subfit wrote with the readers users reach for first -- trimesh, Open3D
-and meshio -- and prints what each reader saw: one JSON line
-{"FILE": {"trimesh": {...}, "open3d": {...}, "meshio": {...}}, ...}, each entry the counts
+"""Opens files that subfit wrote with the readers users reach for first -- trimesh, Open3D,
+meshio and MeshLab's (pymeshlab) -- and prints what each reader saw: one JSON line
+{"FILE": {"trimesh": {...}, "open3d": {...}, "meshio": {...}, "meshlab": {...}}, ...}, each entry the counts
 the reader found ("vertices", "faces" (polygons as the reader keeps them) and "triangles"
 (after its own triangulation)) or {"error": "..."} when it refused the file. JSON and CSV
 files are parsed with the standard library ("json": keys, "csv": rows). The caller compares
@@ -8,7 +8,8 @@ the counts with what it wrote.
 
 Readers are asked as a script would: trimesh.load(process=False) (no merging of vertices);
 Open3D's mesh reader for meshes (the tensor API for OBJ, whose legacy reader skips faces
-that are not triangles) and its point-cloud reader for files without faces; meshio.read.
+that are not triangles) and its point-cloud reader for files without faces; meshio.read;
+pymeshlab.MeshSet().load_new_mesh (MeshLab's importers, chosen by the extension).
 
 Usage: python3 open_outputs.py FILE...   (exit 2 when a reader is not installed)
 """
@@ -87,7 +88,20 @@ def with_meshio(path):
     return mesh_counts(len(mesh.points), faces, triangles)
 
 
-READERS = {"trimesh": with_trimesh, "open3d": with_open3d, "meshio": with_meshio}
+def with_meshlab(path):
+    import pymeshlab
+
+    meshes = pymeshlab.MeshSet()
+    meshes.load_new_mesh(path)
+    mesh = meshes.current_mesh()
+    # MeshLab keeps triangles only: it triangulates polygons on load, so face_number() is the
+    # triangle count, and marks the diagonals it added as "faux" edges, from which
+    # polygonal_face_list() gives back the polygons as the file had them.
+    polygons = len(mesh.polygonal_face_list()) if mesh.face_number() else 0
+    return mesh_counts(mesh.vertex_number(), polygons, mesh.face_number())
+
+
+READERS = {"trimesh": with_trimesh, "open3d": with_open3d, "meshio": with_meshio, "meshlab": with_meshlab}
 
 
 def read(path):
@@ -111,6 +125,7 @@ def main():
     try:
         import meshio  # noqa: F401
         import open3d  # noqa: F401
+        import pymeshlab  # noqa: F401
         import trimesh  # noqa: F401
     except ImportError as e:
         print(f"{e.name} is not installed (tools/output-checks/requirements.txt)", file=sys.stderr)

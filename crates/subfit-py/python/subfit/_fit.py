@@ -23,7 +23,8 @@ class Fit:
 
     Plain data — numpy arrays, strings and a dict — so it pickles (Dask, multiprocessing)
     and compares by value. The process that ran the fit also keeps the analysed scan, so
-    :meth:`save` there writes every output of ``subfit fit``.
+    :meth:`save` there writes every output of ``subfit fit``. A Fit is returned by
+    :func:`subfit.fit`; its constructor is not part of the API.
 
     Attributes
     ----------
@@ -40,6 +41,9 @@ class Fit:
         The report, equal to ``report.json`` (``report["final"]["two_sided"]["e_rms"]``, …).
     reached : bool
         Whether the requested tolerances were met (both ways unless ``one_sided=True``).
+    summary : str
+        One line: control points, stages, iterations, errors both ways (the CLI's closing
+        line); empty for a Fit made by hand.
     """
 
     def __init__(self, vertices: npt.NDArray[np.float64], faces: Faces, scheme: str, tags: dict,
@@ -73,23 +77,57 @@ class Fit:
         return len(self.vertices)
 
     def surface(self) -> Surface:
-        """The fitted limit surface as a :class:`subfit.Surface`."""
+        """The fitted limit surface as a :class:`subfit.Surface` (the cage's vertices, faces,
+        scheme and tags): sample it, evaluate it, project points onto it."""
         return Surface(self.vertices, self.faces, self.scheme, self.tags)
 
-    def save(self, directory: PathLike) -> Path:
+    def save(self, directory: PathLike, *, limit_quads: bool = False) -> Path:
         """Writes the outputs of ``subfit fit`` into ``directory`` (created if missing).
 
         control.obj, control.usda (scheme and creases, for Blender/USD), control.tags.json (the
         creases for OBJ readers that skip OpenSubdiv's tags), limit.ply (the limit
-        tessellation with normals), error.ply (coloured by the distance to the scan), log.csv
-        and report.json. A Fit that was pickled into another process no longer holds the scan:
-        there only control.obj, control.usda and report.json are written (with a warning).
-        Returns the directory.
+        tessellation with normals), error.ply (coloured by the distance to the scan), log.csv,
+        preview.png, report.html and report.json. A Fit that was pickled into another process
+        no longer holds the scan: there only control.obj, control.usda and report.json are
+        written (with a ``RuntimeWarning``).
+
+        Parameters
+        ----------
+        directory : str or os.PathLike
+            Where to write (created with its parents if missing; files in it are replaced).
+        limit_quads : bool
+            Keep the limit tessellation's quads in limit.ply and error.ply (a Catmull-Clark or
+            quad/triangle cage's refinement), as ``subfit fit --limit-quads``. Default
+            ``False``: each quad is split into two triangles along the diagonal the errors
+            were measured on, so every face has three corners (trimesh refuses a PLY whose
+            faces differ in size). A Loop fit's tessellation is triangles either way.
+
+        Returns
+        -------
+        pathlib.Path
+            ``directory``.
+
+        Raises
+        ------
+        OSError
+            A file that cannot be written.
+
+        Examples
+        --------
+        >>> import numpy as np, subfit
+        >>> d = np.random.default_rng(0).normal(size=(2000, 3))
+        >>> f = subfit.fit(d / np.linalg.norm(d, axis=1, keepdims=True), scheme="catmull-clark",
+        ...                tolerance=2e-3, max_control_points=200)
+        >>> out = f.save("sphere-fit", limit_quads=True)
+        >>> sorted(p.name for p in out.iterdir())[:4]
+        ['control.obj', 'control.tags.json', 'control.usda', 'error.ply']
+        >>> subfit.read(out / "limit.ply").faces.shape[1]  # quads: a Catmull-Clark tessellation
+        4
         """
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
         if self._native is not None:
-            self._native.write_into(str(d))
+            self._native.write_into(str(d), limit_quads=bool(limit_quads))
             self.report = json.loads(self._native.report_json())
             return d
         warnings.warn(
@@ -107,7 +145,8 @@ class Fit:
 
     def release_scan(self) -> None:
         """Drops the analysed scan this Fit keeps for :meth:`save` (its kd-tree, normals and
-        limit tessellation: memory of the order of the scan's size), as pickling does."""
+        limit tessellation: memory of the order of the scan's size), as pickling does; a later
+        :meth:`save` writes control.obj, control.usda and report.json only."""
         self._native = None
 
     def __getstate__(self) -> dict:
@@ -237,6 +276,20 @@ def fit(
     also uses the library's own rayon thread pool, sized by ``RAYON_NUM_THREADS``, default
     one thread per core). Warnings (e.g. re-oriented faces) are issued
     as ``RuntimeWarning`` and kept in ``report["warnings"]``.
+
+    Examples
+    --------
+    >>> import numpy as np, subfit
+    >>> d = np.random.default_rng(0).normal(size=(2000, 3))
+    >>> points = d / np.linalg.norm(d, axis=1, keepdims=True)  # a unit sphere
+    >>> f = subfit.fit(points, tolerance=2e-3, max_control_points=200)
+    >>> f.reached, f.num_control_points <= 200, f.scheme
+    (True, True, 'loop')
+    >>> f.report["final"]["two_sided"]["e_rms"] <= 2e-3  # unit-cube units
+    True
+    >>> s = f.surface()  # subfit.Surface: sample, evaluate, closest points
+    >>> bool(np.abs(np.linalg.norm(s.sample(2), axis=1) - 1).max() < 0.02)
+    True
     """
     name = options.pop("name", None)
     if isinstance(points, (str, os.PathLike)):

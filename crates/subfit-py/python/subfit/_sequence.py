@@ -22,6 +22,9 @@ FrameLike = Union[PathLike, npt.ArrayLike, Tuple[npt.ArrayLike, Optional[FacesLi
 class Sequence:
     """One cage fitted to every frame of a deforming scan.
 
+    Returned by :func:`subfit.fit_sequence`; ``len(sequence)`` is the number of frames. It
+    holds native data and does not pickle (save it instead).
+
     Attributes
     ----------
     vertices : (frames, n, 3) float64
@@ -50,12 +53,35 @@ class Sequence:
         return len(self.vertices)
 
     def surface(self, frame: int) -> Surface:
-        """Frame ``frame``'s limit surface as a :class:`subfit.Surface`."""
+        """Frame ``frame``'s limit surface as a :class:`subfit.Surface` (0 is the first frame;
+        negative indices count from the end, as for ``vertices``). Raises ``IndexError`` for a
+        frame out of range."""
         return Surface(self.vertices[frame], self.faces, self.scheme, self.tags)
 
     def save(self, directory: PathLike, fps: float = 24.0) -> Path:
-        """Writes ``frame_0000.obj`` …, ``sequence.usda`` (time-sampled points at ``fps``)
-        and ``report.json`` into ``directory`` (created if missing); returns it."""
+        """Writes the outputs of ``subfit sequence`` into ``directory`` (created if missing).
+
+        ``frame_0000.obj`` … (each frame's cage), ``sequence.usda`` (one mesh with time-sampled
+        points at ``fps`` frames per second, scheme and creases: an animated cage for Blender or
+        usdview) and ``report.json``.
+
+        Parameters
+        ----------
+        directory : str or os.PathLike
+            Where to write (created with its parents if missing; files in it are replaced).
+        fps : float
+            Frames per second of ``sequence.usda``'s time samples (default 24).
+
+        Returns
+        -------
+        pathlib.Path
+            ``directory``.
+
+        Raises
+        ------
+        OSError
+            A file that cannot be written.
+        """
         d = Path(directory)
         d.mkdir(parents=True, exist_ok=True)
         self._native.write_into(str(d), float(fps))
@@ -136,6 +162,11 @@ def fit_sequence(
         marker must be in frame 0); the tracking pulls them there, which pins what the
         surfaces leave free, sliding along them.
 
+    Returns
+    -------
+    Sequence
+        Every frame's cage (one connectivity), the scheme, tags and the report.
+
     Raises
     ------
     ValueError
@@ -144,6 +175,19 @@ def fit_sequence(
         Numerical failure.
     KeyboardInterrupt
         Ctrl-C (checked once per frame).
+
+    Examples
+    --------
+    >>> import numpy as np, subfit
+    >>> d = np.random.default_rng(0).normal(size=(2000, 3))
+    >>> sphere = d / np.linalg.norm(d, axis=1, keepdims=True)
+    >>> frames = (sphere * [1.0, 1.0, 1.0 + 0.1 * t] for t in range(3))  # stretching along z
+    >>> seq = subfit.fit_sequence(frames, control_points=100)
+    >>> len(seq), seq.vertices.shape[1] <= 100  # (frames, control points, 3)
+    (3, True)
+    >>> top = seq.vertices[:, :, 2].max(axis=1)  # the cage follows the stretch
+    >>> bool(top[0] < top[1] < top[2])
+    True
     """
     if "scheme" in options:
         options["scheme_name"] = options.pop("scheme")

@@ -30,51 +30,83 @@ I64 = npt.NDArray[np.int64]
 
 
 class Evaluation(NamedTuple):
-    """Exact limit values at parameters ``(face, u, v)``; ``k`` rows (or one row, squeezed,
-    for scalar parameters)."""
+    """Exact limit values at parameters ``(face, u, v)``, returned by :meth:`Surface.evaluate`:
+    ``k`` rows, or one row squeezed (``(3,)``, ``(3, 3)``) for scalar parameters. Lengths are
+    in the control points' units.
 
-    #: ``(k, 3)`` float64 limit positions.
+    Attributes
+    ----------
+    position : (k, 3) float64
+        Limit positions ``S(u, v)``.
+    du : (k, 3) float64
+        First derivatives ``∂S/∂u``.
+    dv : (k, 3) float64
+        First derivatives ``∂S/∂v``.
+    normal : (k, 3) float64
+        Unit normals ``du × dv / |du × dv|`` (zero where degenerate).
+    second : (k, 3, 3) float64
+        Second derivatives ``S_uu, S_uv, S_vv`` (NaN where unavailable).
+    """
+
     position: F64
-    #: ``(k, 3)`` float64 ``∂S/∂u``.
     du: F64
-    #: ``(k, 3)`` float64 ``∂S/∂v``.
     dv: F64
-    #: ``(k, 3)`` float64 unit normals ``du × dv / |du × dv|`` (zero where degenerate).
     normal: F64
-    #: ``(k, 3, 3)`` float64 second derivatives ``S_uu, S_uv, S_vv`` (NaN where unavailable).
     second: F64
 
 
 class ClosestPoints(NamedTuple):
-    """Closest points on the limit surface, one row per query (``k`` queries)."""
+    """Closest points on the limit surface, one row per query (``k`` queries), returned by
+    :meth:`Surface.closest_point`; ``(face, u, v)`` can be passed to :meth:`Surface.evaluate`.
 
-    #: ``(k, 3)`` float64 closest points.
+    Attributes
+    ----------
+    points : (k, 3) float64
+        The closest points ``S``.
+    face : (k,) int64
+        The control-mesh face of each.
+    u : (k,) float64
+        First parameter in the face's domain.
+    v : (k,) float64
+        Second parameter.
+    distance : (k,) float64
+        Distance ``|q − S|`` (the control points' units).
+    """
+
     points: F64
-    #: ``(k,)`` int64 control-mesh face of each.
     face: I64
-    #: ``(k,)`` float64 first parameter.
     u: F64
-    #: ``(k,)`` float64 second parameter.
     v: F64
-    #: ``(k,)`` float64 distance ``|q − S|``.
     distance: F64
 
 
 class ClosestPointDetails(NamedTuple):
-    """:class:`ClosestPoints` with the sub-patch, normal, signed distance and convergence."""
+    """:class:`ClosestPoints` with the sub-patch, normal, signed distance and convergence,
+    returned by ``Surface.closest_point(points, full=True)``.
+
+    Attributes
+    ----------
+    points, face, u, v, distance
+        As :class:`ClosestPoints`.
+    sub : (k,) int64
+        Sub-patch: the corner of a Catmull-Clark ``n``-gon (``n ≠ 4``), else 0 (pass it to
+        :meth:`Surface.evaluate` with ``face, u, v``).
+    signed_distance : (k,) float64
+        ``(q − S)·n``, positive on the side the normal points to.
+    normal : (k, 3) float64
+        Unit normals at the closest points.
+    converged : (k,) bool
+        Whether the Newton search reached its tolerance.
+    """
 
     points: F64
     face: I64
     u: F64
     v: F64
     distance: F64
-    #: ``(k,)`` int64 sub-patch: the corner of a Catmull-Clark ``n``-gon (``n ≠ 4``), else 0.
     sub: I64
-    #: ``(k,)`` float64 ``(q − S)·n``, positive on the side the normal points to.
     signed_distance: F64
-    #: ``(k, 3)`` float64 unit normals at the closest points.
     normal: F64
-    #: ``(k,)`` bool, whether the Newton search reached its tolerance.
     converged: npt.NDArray[np.bool_]
 
 
@@ -114,6 +146,20 @@ class Surface:
     Immutable. The sampling operator of each level is built on first use and kept, so
     ``sample``/``operator`` at the same level are cheap afterwards. Pickling keeps the
     arrays (operators are rebuilt).
+
+    Examples
+    --------
+    A unit cube as a Catmull-Clark cage (vertex ``4x + 2y + z`` at ``(x, y, z)``):
+
+    >>> import numpy as np, subfit
+    >>> cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+    >>> quads = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
+    >>> s = subfit.Surface(cube, quads, scheme="catmull-clark")
+    >>> s.sample(2).shape  # the limit positions of the twice-refined cube's 98 vertices
+    (98, 3)
+    >>> e = s.evaluate(0, 0.5, 0.5)  # the middle of face 0 (the side x = 0)
+    >>> bool(np.allclose(e.position[1:], 0.5)), bool(np.allclose(e.normal, [-1, 0, 0]))
+    (True, True)
     """
 
     def __init__(
@@ -167,7 +213,8 @@ class Surface:
         return len(self._counts)
 
     def with_vertices(self, vertices: npt.ArrayLike) -> "Surface":
-        """The same faces, scheme and tags with new control points ``(n, 3)``."""
+        """The same faces, scheme and tags with new control points ``(n, 3)`` (a deformed
+        cage); raises ``ValueError`` when the shape differs from :attr:`vertices`."""
         v = as_float_rows("vertices", vertices)
         if v.shape != self._vertices.shape:
             raise ValueError(f"vertices must have shape {self._vertices.shape}, got {v.shape}")
@@ -177,10 +224,28 @@ class Surface:
     def sample(self, level: int = 3, *, normals: bool = False) -> Union[F64, Tuple[F64, F64]]:
         """Limit positions of the vertices of the ``level``-times refined mesh.
 
-        Returns ``(s, 3)`` float64 positions, or ``(positions, unit_normals)`` with
-        ``normals=True``. ``level`` 0 gives the limit positions of the control points
-        themselves; each level multiplies ``s`` by about 4. Cost: building the operator once
-        per level (sparse, O(s)), then one sparse product.
+        Parameters
+        ----------
+        level : int
+            Refinement level in ``[0, 8]`` (default 3): 0 gives the limit positions of the
+            control points themselves; each level multiplies the ``s`` samples by about 4.
+        normals : bool
+            Also return the unit limit normals (default ``False``).
+
+        Returns
+        -------
+        (s, 3) float64, or a pair of them
+            Positions, or ``(positions, unit_normals)`` with ``normals=True``. Row ``i`` is
+            vertex ``i`` of :meth:`tessellation`.
+
+        Raises
+        ------
+        ValueError
+            ``level`` out of range.
+
+        Notes
+        -----
+        Cost: building the operator once per level (sparse, O(s)), then one sparse product.
         """
         pos, nrm = self._native.sample(int(level), bool(normals))
         return (pos, nrm) if normals else pos
@@ -188,16 +253,40 @@ class Surface:
     def operator(self, level: int = 3, *, which: str = "position") -> Any:
         """The sampling operator ``C`` as a ``scipy.sparse.csr_matrix`` of shape ``(s, n)``.
 
-        ``C @ vertices == sample(level)`` (to round-off); rows sum to 1. ``which`` selects
-        the limit positions (``"position"``) or the two limit tangent operators
-        (``"tangent1"``, ``"tangent2"``; rows sum to 0). Row ``i`` is vertex ``i`` of
-        :meth:`tessellation`.
+        ``C @ vertices == sample(level)`` (to round-off); rows sum to 1. Row ``i`` is vertex
+        ``i`` of :meth:`tessellation`. The operator depends on the faces, scheme and tags only,
+        so it serves any positions of the control points (a least-squares fit, a PyTorch
+        layer: :class:`subfit.torch.LimitSurface`).
+
+        Parameters
+        ----------
+        level : int
+            Refinement level in ``[0, 8]`` (default 3), as :meth:`sample`.
+        which : {"position", "tangent1", "tangent2"}
+            The limit positions (default) or one of the two limit tangent operators (rows
+            sum to 0).
+
+        Raises
+        ------
+        ValueError
+            ``level`` out of range or an unknown ``which``.
+
+        Examples
+        --------
+        >>> import numpy as np, subfit
+        >>> tetrahedron = subfit.Surface(np.eye(4, 3), [[0, 1, 2], [3, 2, 1], [3, 0, 2], [3, 1, 0]])
+        >>> C = tetrahedron.operator(2)
+        >>> C.shape, bool(np.allclose(C.sum(axis=1), 1))
+        ((34, 4), True)
+        >>> bool(np.allclose(C @ tetrahedron.vertices, tetrahedron.sample(2)))
+        True
         """
         return _csr(self._native.operator(int(level), which))
 
     def tessellation(self, level: int = 3) -> Tuple[F64, Faces]:
         """The limit surface as a mesh: ``(sample(level) (s, 3), faces)`` with the faces of
-        the refined mesh (triangles for Loop, quads for Catmull-Clark) — e.g. for
+        the ``level``-times refined mesh (triangles for Loop, quads for Catmull-Clark; ``level``
+        in ``[0, 8]``, default 3, else ``ValueError``) — e.g. for
         ``trimesh.Trimesh(*surface.tessellation(3))``."""
         pos = self.sample(level)
         offsets, indices = self._native.level_faces(int(level))
@@ -221,8 +310,8 @@ class Surface:
         ``(k, 3)`` arrays, scalars give ``(3,)``. The domain of a triangle (Loop) is
         ``u, v ≥ 0, u + v ≤ 1``, of a quad ``[0, 1]²``, with ``(0, 0)`` at the face's first
         vertex; a Catmull-Clark ``n``-gon (``n ≠ 4``) has ``n`` quad sub-patches selected by
-        ``sub`` (its corner). Raises ``ValueError`` for a face, sub-patch or ``(u, v)`` out of
-        range.
+        ``sub`` (its corner; default 0). Returns an :class:`Evaluation`. Raises ``ValueError``
+        for a face, sub-patch or ``(u, v)`` out of range.
         """
         (f, uu, vv, ss), scalar = self._params(face, u, v, sub)
         out = Evaluation(*self._native.evaluate(f, uu, vv, ss))
@@ -231,20 +320,32 @@ class Surface:
     def evaluation_operator(self, face: npt.ArrayLike, u: npt.ArrayLike, v: npt.ArrayLike, *,
                             sub: Optional[npt.ArrayLike] = None) -> Any:
         """Weights of the limit positions at ``k`` parameters over the control points: a
-        ``scipy.sparse.csr_matrix`` ``(k, n)`` with ``W @ vertices == evaluate(...).position``."""
+        ``scipy.sparse.csr_matrix`` ``(k, n)`` with ``W @ vertices == evaluate(...).position``
+        (arguments and errors as :meth:`evaluate`)."""
         (f, uu, vv, ss), _ = self._params(face, u, v, sub)
         return _csr(self._native.evaluation_operator(f, uu, vv, ss))
 
     def closest_point(self, points: npt.ArrayLike, *, full: bool = False
                       ) -> Union[ClosestPoints, ClosestPointDetails]:
-        """Closest points on the limit surface to ``points (k, 3)``.
+        """Closest points on the limit surface to ``points (k, 3)`` (the control points' units).
 
         Returns ``(points (k, 3), face (k,), u (k,), v (k,), distance (k,))`` as
         :class:`ClosestPoints`; ``full=True`` adds the sub-patch, signed distance, normal and
         convergence flag (:class:`ClosestPointDetails`). A BVH over a tessellation gives the
         start, Newton's method on the exact surface refines it across patch boundaries.
         Cost: building the tessellation once per call, then a few exact evaluations per query
-        (parallel).
+        (parallel). Raises ``ValueError`` for points that are not ``(k, 3)`` finite numbers.
+
+        Examples
+        --------
+        >>> import numpy as np, subfit
+        >>> tetrahedron = subfit.Surface(np.eye(4, 3), [[0, 1, 2], [3, 2, 1], [3, 0, 2], [3, 1, 0]])
+        >>> q = np.array([[1.0, 1.0, 1.0], [0.25, 0.25, 0.25]])  # one outside, one inside
+        >>> c = tetrahedron.closest_point(q, full=True)
+        >>> c.points.shape, bool(c.signed_distance[0] > 0), bool(c.signed_distance[1] < 0)
+        ((2, 3), True, True)
+        >>> bool(np.allclose(tetrahedron.evaluate(c.face, c.u, c.v).position, c.points))
+        True
         """
         q = as_float_rows("points", points)
         p, face, sub, u, v, d, sd, n, conv = self._native.closest_point(q)

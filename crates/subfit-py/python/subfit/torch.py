@@ -98,6 +98,25 @@ class LimitSurface(torch.nn.Module):
     -----
     ``forward`` is ``C @ control``; backward is ``Cᵀ @ grad`` (sparse CSR on CPU; any device
     with sparse CSR matmul support). Cost O(nnz(C)) ≈ 12–15 · s multiply-adds per column.
+
+    Raises
+    ------
+    ValueError
+        Unusable faces (indices out of range, non-manifold, non-triangles for Loop), an
+        unknown scheme, a level out of ``[0, 8]``.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from subfit.torch import LimitSurface
+    >>> layer = LimitSurface([[0, 1, 2], [3, 2, 1], [3, 0, 2], [3, 1, 0]], scheme="loop", level=2)
+    >>> control = torch.eye(4, 3, dtype=torch.float64, requires_grad=True)  # a tetrahedron
+    >>> samples = layer(control)
+    >>> tuple(samples.shape), tuple(layer.sample_faces.shape)
+    ((34, 3), (64, 3))
+    >>> samples.square().sum().backward()  # gradients reach the control points through Cᵀ
+    >>> tuple(control.grad.shape)
+    (4, 3)
     """
 
     def __init__(self, faces: FacesLike, scheme: str = "loop", level: int = 3, *,
@@ -162,7 +181,9 @@ class LimitSurface(torch.nn.Module):
                              shape=(self.num_samples, self.num_vertices))
 
     def forward(self, control: Tensor) -> Tensor:
-        """Limit samples of ``control`` (``(n, 3)`` or ``(b, n, 3)``)."""
+        """Limit samples ``(s, 3)`` of ``control (n, 3)``, or ``(b, s, 3)`` of ``(b, n, 3)``, in
+        ``control``'s dtype and device. Raises ``TypeError`` for a non-tensor, ``ValueError``
+        for another shape or a dtype other than float32/float64."""
         if not isinstance(control, torch.Tensor):
             raise TypeError("LimitSurface expects a torch.Tensor of control points")
         if control.dtype not in (torch.float32, torch.float64):
@@ -182,6 +203,7 @@ class LimitSurface(torch.nn.Module):
         return _SparseApply.apply(control.contiguous(), a, at)
 
     def extra_repr(self) -> str:
+        """The module's line in ``repr``: scheme, level, control points and samples."""
         return f"scheme={self.scheme!r}, level={self.level}, control_points={self.num_vertices}, samples={self.num_samples}"
 
 
@@ -251,6 +273,37 @@ class IMLS(torch.nn.Module):
     require grad, the values are instead computed in torch over the native neighbour lists, so
     gradients reach them too (exact; slower). The kd-tree is built here, over the points as
     they are now: if they move, build a new ``IMLS`` (or call :func:`imls`) each step.
+
+    Parameters
+    ----------
+    points : (p, 3) tensor or array_like of float
+        The scan's points.
+    normals : (p, 3) tensor or array_like of float
+        Their normals (any length, not zero; normalized here), oriented outwards: ``f`` is
+        positive outside.
+    h : float
+        The kernel's support radius, in the points' units (a few point spacings; Xie et al.
+        use about twice the mean spacing).
+
+    Raises
+    ------
+    ValueError
+        Arrays that are not ``(p, 3)``, a zero normal, ``h ≤ 0``; in ``forward``, samples
+        that are not a float32/float64 tensor of shape ``(..., 3)``.
+
+    Examples
+    --------
+    >>> import numpy as np, torch
+    >>> from subfit.torch import IMLS
+    >>> d = np.random.default_rng(0).normal(size=(5000, 3))
+    >>> sphere = d / np.linalg.norm(d, axis=1, keepdims=True)  # unit sphere, normals = points
+    >>> f = IMLS(sphere, sphere, h=0.2)
+    >>> x = torch.tensor([[0.0, 0.0, 1.1], [0.0, 0.0, 0.9]], requires_grad=True)
+    >>> values = f(x)  # about +0.1 (outside) and -0.1 (inside)
+    >>> bool(torch.allclose(values, torch.tensor([0.1, -0.1]), atol=0.01))
+    True
+    >>> values.sum().backward(); bool(x.grad[0, 2] > 0.9)  # the gradient is about the normal
+    True
     """
 
     def __init__(self, points: ArrayOrTensor, normals: ArrayOrTensor, h: float) -> None:
@@ -265,7 +318,7 @@ class IMLS(torch.nn.Module):
         return self.field.h
 
     def forward(self, samples: Tensor) -> Tensor:
-        """IMLS values at ``samples (..., 3)``."""
+        """IMLS values ``(...)`` at ``samples (..., 3)``, in the samples' dtype and device."""
         if not isinstance(samples, torch.Tensor) or samples.shape[-1:] != (3,):
             raise ValueError(f"samples must be a tensor of shape (..., 3), got {getattr(samples, 'shape', type(samples))}")
         if samples.dtype not in (torch.float32, torch.float64):
@@ -278,9 +331,23 @@ class IMLS(torch.nn.Module):
 
 def imls(samples: Tensor, points: ArrayOrTensor, normals: ArrayOrTensor, h: float) -> Tensor:
     """IMLS distance of ``samples (..., 3)`` to the scan ``points (p, 3)``, ``normals (p, 3)``
-    with support radius ``h`` (see :class:`IMLS`, which keeps the kd-tree between calls; this
-    builds it each call, O(p log p)). Returns ``(...)``; differentiable in ``samples``, and in
-    ``points`` and ``normals`` when they are tensors that require grad."""
+    with support radius ``h`` (the points' units).
+
+    :class:`IMLS` keeps the kd-tree between calls; this builds it each call (O(p log p)).
+    Returns ``(...)`` values; differentiable in ``samples``, and in ``points`` and
+    ``normals`` when they are tensors that require grad. Arguments and errors as
+    :class:`IMLS`.
+
+    Examples
+    --------
+    >>> import numpy as np, torch
+    >>> from subfit.torch import imls
+    >>> d = np.random.default_rng(0).normal(size=(5000, 3))
+    >>> sphere = d / np.linalg.norm(d, axis=1, keepdims=True)
+    >>> v = imls(torch.tensor([[0.0, 1.05, 0.0]]), sphere, sphere, h=0.2)
+    >>> bool(abs(v.item() - 0.05) < 0.01)
+    True
+    """
     return IMLS(points, normals, h)(samples)
 
 
@@ -306,6 +373,34 @@ def cotangent_weights(rest: ArrayOrTensor, faces: FacesLike, *, clamp: bool = Tr
     nothing. With ``clamp`` (default) negative weights (edges opposite obtuse angles) are set
     to 0, so the ARAP energy is ≥ 0 — unclamped, an optimizer can drive it below zero.
     float64 on the rest shape's device.
+
+    Parameters
+    ----------
+    rest : (n, 3) tensor or array_like of float
+        The rest shape (the cage's vertices).
+    faces : (m, k) array_like of int or list of polygons
+        Its faces.
+    clamp : bool
+        Set negative weights to 0 (default ``True``).
+
+    Returns
+    -------
+    (i, j, w)
+        Two ``(e,)`` int64 tensors of vertex indices and an ``(e,)`` float64 tensor of
+        weights, one entry per directed edge (``e`` is twice the number of edges).
+
+    Raises
+    ------
+    ValueError
+        ``rest`` not ``(n, 3)``, faces referring to vertices out of range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from subfit.torch import cotangent_weights
+    >>> i, j, w = cotangent_weights(np.eye(4, 3), [[0, 1, 2], [3, 2, 1], [3, 0, 2], [3, 1, 0]])
+    >>> len(i), bool((w >= 0).all())  # 6 edges, both directions
+    (12, True)
     """
     r = rest.detach().to(torch.float64) if isinstance(rest, torch.Tensor) else torch.as_tensor(np.asarray(rest, dtype=np.float64))
     if r.dim() != 2 or r.shape[1] != 3:
@@ -346,6 +441,33 @@ class ARAP(torch.nn.Module):
     any rigid motion of the rest shape.
 
     ``forward(control)``: ``(n, 3)`` → scalar, ``(b, n, 3)`` → ``(b,)``; float32 or float64.
+
+    Parameters
+    ----------
+    rest : (n, 3) tensor or array_like of float
+        The rest shape (the cage the energy keeps the deformation close to, up to rotations).
+    faces : (m, k) array_like of int or list of polygons
+        Its faces (fan-triangulated for the weights).
+    clamp : bool
+        Set negative cotangent weights to 0 (default ``True``; see :func:`cotangent_weights`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`cotangent_weights`; in ``forward``, control points of another shape.
+
+    Examples
+    --------
+    >>> import math, numpy as np, torch
+    >>> from subfit.torch import ARAP
+    >>> rest = torch.eye(4, 3, dtype=torch.float64)
+    >>> energy = ARAP(rest, [[0, 1, 2], [3, 2, 1], [3, 0, 2], [3, 1, 0]])
+    >>> c, s = math.cos(0.3), math.sin(0.3)
+    >>> turn = torch.tensor([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], dtype=torch.float64)
+    >>> bool(energy(rest @ turn.T + 5.0) < 1e-20)  # a rigid motion costs nothing
+    True
+    >>> bool(energy(rest * torch.tensor([1.0, 1.0, 1.5], dtype=torch.float64)) > 0)  # a stretch does
+    True
     """
 
     def __init__(self, rest: ArrayOrTensor, faces: FacesLike, *, clamp: bool = True) -> None:
@@ -387,6 +509,20 @@ class ARAP(torch.nn.Module):
 
 
 def arap(control: Tensor, rest: ArrayOrTensor, faces: FacesLike, *, clamp: bool = True) -> Tensor:
-    """The ARAP energy of ``control`` (``(n, 3)`` or ``(b, n, 3)``) against ``rest (n, 3)``
-    with ``faces`` (see :class:`ARAP`, which keeps the weights between calls)."""
+    """The ARAP energy of ``control`` (``(n, 3)`` → scalar, or ``(b, n, 3)`` → ``(b,)``)
+    against ``rest (n, 3)`` with ``faces``, differentiable in ``control``.
+
+    :class:`ARAP` keeps the weights between calls; this computes them each call. Arguments
+    and errors as :class:`ARAP`.
+
+    Examples
+    --------
+    >>> import torch
+    >>> from subfit.torch import arap
+    >>> rest = torch.eye(4, 3, dtype=torch.float64)
+    >>> x = (rest * 1.2).requires_grad_()  # a scaled copy: not rigid
+    >>> e = arap(x, rest, [[0, 1, 2], [3, 2, 1], [3, 0, 2], [3, 1, 0]])
+    >>> e.backward(); bool(e > 0), tuple(x.grad.shape)
+    (True, (4, 3))
+    """
     return ARAP(rest, faces, clamp=clamp).to(control.device)(control)
