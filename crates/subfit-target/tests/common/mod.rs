@@ -200,16 +200,26 @@ pub fn fraction<T>(v: &[T], pred: impl Fn(&T) -> bool) -> f64 {
 
 /// `$SUBFIT_DATA` (the directory of shared/data), for the tests on real models. Without it:
 /// fails when `CI=true` (CI must run them), else prints a notice naming `what` and skips.
-#[allow(clippy::print_stdout)]
 pub fn data_dir(what: &str) -> Option<PathBuf> {
-    match std::env::var_os("SUBFIT_DATA") {
+    env_dir("SUBFIT_DATA", "shared/data", what)
+}
+
+/// `$SUBFIT_CORPUS` (the directory of shared/corpus), as [`data_dir`].
+#[allow(dead_code, reason = "not every test file reads the corpus")]
+pub fn corpus_dir(what: &str) -> Option<PathBuf> {
+    env_dir("SUBFIT_CORPUS", "shared/corpus", what)
+}
+
+#[allow(clippy::print_stdout)]
+fn env_dir(var: &str, dir: &str, what: &str) -> Option<PathBuf> {
+    match std::env::var_os(var) {
         Some(d) => Some(PathBuf::from(d)),
         None => {
             assert!(
                 std::env::var("CI").as_deref() != Ok("true"),
-                "SUBFIT_DATA is not set (needed on CI: the directory of shared/data)"
+                "{var} is not set (needed on CI: the directory of {dir})"
             );
-            println!("notice: SUBFIT_DATA not set, skipping {what}");
+            println!("notice: {var} not set, skipping {what}");
             None
         }
     }
