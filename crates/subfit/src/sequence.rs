@@ -199,6 +199,35 @@ struct Carry {
 /// not suit the first frame, an interruption, the callback's error. Cost per frame: one target
 /// analysis (near-linear in its points), the silhouette's target images, one fitter set-up and
 /// at most [`SequenceOptions::iterations`] LM iterations, one two-sided measurement.
+///
+/// ```
+/// use subfit::mesh::shapes::Shape;
+/// use subfit::{fit_sequence, FitScanOptions, Input, SequenceOptions, SilhouetteOptions};
+///
+/// // Three frames of the papers' ellipsoid (1,500 points each) moving along x.
+/// let frames = (0..3).map(|t| {
+///     let mut mesh = Shape::PAPER_ELLIPSOID.sample(1_500, 0.0, 1 + t);
+///     mesh.positions.iter_mut().for_each(|p| p[0] += 0.05 * t as f64);
+///     Input::Mesh { mesh, name: format!("frame {t}") }
+/// });
+/// let mut template_fit = FitScanOptions { control_points: Some(60), ..Default::default() };
+/// template_fit.stages.max_iterations = 5;
+/// let options = SequenceOptions {
+///     template_fit,
+///     silhouette: SilhouetteOptions { views: 0, ..Default::default() },
+///     ..Default::default()
+/// };
+/// let mut written = 0;
+/// let seq = fit_sequence(frames, &options, &mut |_frame| { written += 1; Ok(()) }, &mut |_| {})?;
+/// assert_eq!((written, seq.positions.len()), (3, 3));
+/// // One connectivity, every frame: the cage follows the motion.
+/// let n = seq.positions[0].len();
+/// assert!(seq.positions.iter().all(|p| p.len() == n));
+/// let mean_x = |p: &[[f64; 3]]| p.iter().map(|q| q[0]).sum::<f64>() / p.len() as f64;
+/// let moved = mean_x(&seq.positions[2]) - mean_x(&seq.positions[0]);
+/// assert!((moved - 0.1).abs() < 0.02, "moved {moved}");
+/// # Ok::<(), subfit::Error>(())
+/// ```
 pub fn fit_sequence<I>(
     frames: I,
     options: &SequenceOptions,
