@@ -113,6 +113,12 @@ pub struct StageOptions {
     /// while it misses its tolerance, end the stages ([`StageStop::Diminishing`]). Default
     /// [`REFINE_PAYOFF`]; 0 turns the rule off.
     pub refine_payoff: f64,
+    /// The fit is of use only if it meets its tolerances within
+    /// [`Self::max_control_points`] (a later start that can win only so): once `λ` is at
+    /// its end, a stage from which even the best rate of approximation
+    /// ([`Self::points_to_reach`]) needs more control points than the budget ends the
+    /// stages ([`StageStop::Hopeless`]). Default off.
+    pub must_reach: bool,
     /// Local enrichment ([`crate::enrich`], Lavoué et al. 2005 §5.2): an error field of which
     /// fewer than [`Self::local_field_share`] of the error points are at least this fraction
     /// of its maximum is local. Default [`crate::enrich::LOCAL_FIELD_PEAK`] (0.8).
@@ -148,6 +154,7 @@ impl Default for StageOptions {
             data_samples: 0,
             polish_power: 3.0,
             refine_payoff: REFINE_PAYOFF,
+            must_reach: false,
             local_field_peak: crate::enrich::LOCAL_FIELD_PEAK,
             local_field_share: crate::enrich::LOCAL_FIELD_SHARE,
         }
@@ -253,6 +260,19 @@ impl StageOptions {
     /// for it: the best cage and the stall rule ignored the RMS, and a simulated scan of the
     /// bunny ended at its initial 271 control points with a two-sided RMS of 1.3e-3 of the
     /// diagonal where refinement reached 9.8e-4 two stages later.
+    /// The control points a cage of `n` with errors `e`, `two` would need to meet the
+    /// tolerances set at the best rate a subdivision surface approximates a smooth shape: the
+    /// error falls as `h⁴` in the spacing `h ∝ n^−½` (Loop and Catmull-Clark surfaces are
+    /// cubic box splines away from extraordinary vertices, whose approximation order is 4),
+    /// so `n · ratio^½` for the larger ratio of error over tolerance. Creases, noise and detail only slow it down, so fewer points
+    /// than this never suffice. `n` when the tolerances are met or none is set.
+    pub fn points_to_reach(&self, e: &ErrorStats, two: &TwoSided, n: usize) -> f64 {
+        let (rms, max) = self.judged(e, two);
+        let ratio = |x: f64, t: f64| if t > 0.0 { x / t } else { 0.0 };
+        let r = ratio(rms, self.tolerance_rms).max(ratio(max, self.tolerance_max));
+        n as f64 * r.max(1.0).sqrt()
+    }
+
     pub(crate) fn badness(&self, e: &ErrorStats, two: &TwoSided) -> f64 {
         let (rms, max) = self.judged(e, two);
         let r = (self.tolerance_rms > 0.0).then(|| rms / self.tolerance_rms);
@@ -362,6 +382,9 @@ pub enum StageStop {
     Diminishing,
     /// `max_stages` or `max_iterations` reached.
     Limit,
+    /// With [`StageOptions::must_reach`], the tolerances cannot be met within the budget even
+    /// at the best rate of approximation.
+    Hopeless,
 }
 
 /// Stages in a row without a better cage after which [`fit_stages`] gives up
@@ -820,12 +843,18 @@ pub fn fit_stages(
         // otherwise end after the `λ` schedule, two or three stages short of convergence.
         let going = since_best == 0 && ran_out;
         let diminishing = unpaid >= UNPAID_REFINEMENTS;
+        let hopeless = stages.must_reach
+            && next_lambda >= lambda
+            && stages.points_to_reach(&last, &m.judged, n) > stages.max_control_points as f64;
         if (!changed && !going)
             || (spent && since_best > 0)
             || since_best >= STALL_STAGES
             || diminishing
+            || hopeless
         {
-            stop = if mesh.num_vertices() >= stages.max_control_points {
+            stop = if hopeless {
+                StageStop::Hopeless
+            } else if mesh.num_vertices() >= stages.max_control_points {
                 StageStop::Budget
             } else if diminishing {
                 StageStop::Diminishing

@@ -226,6 +226,37 @@ fn stages_end_when_refinement_stops_paying() {
     assert!(last < stages.max_control_points / 4, "{summary:?}");
 }
 
+/// A fit that is of use only if it meets its tolerance within the budget
+/// ([`StageOptions::must_reach`]: a start after one that did) stops at the first stage with `λ`
+/// at its end from which even the best rate of approximation needs more points than the
+/// budget ([`StageStop::Hopeless`]), before it spends the budget; a tolerance it can reach is
+/// reached as without the rule.
+#[test]
+fn a_fit_that_must_reach_its_tolerance_stops_when_it_cannot() {
+    // The noisy ellipsoid under a tolerance far below its noise (1e-5 against 2e-3).
+    let (plain, _, _) = noisy_ellipsoid_stages(20_000, 0.002, 150);
+    let (out, _, stages) = noisy_ellipsoid_stages_with(20_000, 0.002, 150, |s| s.must_reach = true);
+    let r = &out.report;
+    assert_eq!(r.stop, StageStop::Hopeless);
+    assert!(r.stages.len() < plain.report.stages.len());
+    let last = r.stages.last().unwrap();
+    assert!(last.lambda <= stages.lambda_end);
+    let n = last.num_control_points;
+    assert!(n < stages.max_control_points, "stopped at {n} points");
+    let need = stages.points_to_reach(&last.fit.last(), &last.two_sided, n);
+    assert!(need > stages.max_control_points as f64, "{need}");
+    // A tolerance within reach: the same fit with and without the rule.
+    let loose = |s: &mut StageOptions| s.tolerance_rms = 4e-3;
+    let (a, _, _) = noisy_ellipsoid_stages_with(20_000, 0.002, 150, loose);
+    let (b, _, _) = noisy_ellipsoid_stages_with(20_000, 0.002, 150, |s| {
+        loose(s);
+        s.must_reach = true;
+    });
+    assert_eq!(a.report.stop, StageStop::Tolerance);
+    assert_eq!(a.report.stages.len(), b.report.stages.len());
+    assert_eq!(a.mesh.positions, b.mesh.positions);
+}
+
 /// With the control-point budget spent and `λ` at its end, a stage only flips edges: the first
 /// such stage that does not gain more than [`STALL_GAIN`] over the last stage that did ends the
 /// fit ([`StageStop::Budget`]), where before it went on as long as any stage gained at all (the
@@ -269,7 +300,7 @@ fn noisy_ellipsoid_stages(
     noise: f64,
     budget: usize,
 ) -> (subfit_fit::StagesResult, Vec<f64>, StageOptions) {
-    noisy_ellipsoid_stages_paying(points, noise, budget, 0.0)
+    noisy_ellipsoid_stages_with(points, noise, budget, |_| {})
 }
 
 /// [`noisy_ellipsoid_stages`] with [`StageOptions::refine_payoff`] `payoff`.
@@ -279,6 +310,16 @@ fn noisy_ellipsoid_stages_paying(
     budget: usize,
     payoff: f64,
 ) -> (subfit_fit::StagesResult, Vec<f64>, StageOptions) {
+    noisy_ellipsoid_stages_with(points, noise, budget, |s| s.refine_payoff = payoff)
+}
+
+/// [`noisy_ellipsoid_stages`] with its stage options changed by `change`.
+fn noisy_ellipsoid_stages_with(
+    points: usize,
+    noise: f64,
+    budget: usize,
+    change: impl FnOnce(&mut StageOptions),
+) -> (subfit_fit::StagesResult, Vec<f64>, StageOptions) {
     let cloud = Shape::PAPER_ELLIPSOID.sample(points, noise, 5);
     let target = Target::from_points(
         &cloud.positions,
@@ -287,18 +328,19 @@ fn noisy_ellipsoid_stages_paying(
     )
     .unwrap();
     let mesh = normalized(&target, &fourteen_vertex_mesh());
-    let stages = StageOptions {
+    let mut stages = StageOptions {
         tolerance_rms: 1e-5,
         max_control_points: budget,
         max_stages: 40,
         // The stall rules are the stage loop's; the polish after it has its own test.
         polish_power: 2.0,
-        refine_payoff: payoff,
+        refine_payoff: 0.0,
         // The figures in the tests' docs were taken at this depth (at 5 the 150-point budget
         // is not quite spent: the fit stalls at 148).
         max_depth: 4,
         ..StageOptions::default()
     };
+    change(&mut stages);
     let out = fit_stages(&target, &mesh, &FitOptions::default(), &stages, None).unwrap();
     let rms = out
         .report

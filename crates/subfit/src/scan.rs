@@ -81,6 +81,18 @@ pub fn fit_scan(
     let last = groups.len().saturating_sub(1);
     for (g, group) in groups.into_iter().enumerate() {
         let budget = budget_against(kept.as_ref(), options);
+        // A start after a kept fit that met the tolerances can win only by meeting them with
+        // fewer points: it stops as soon as it cannot.
+        let must_reach = kept.as_ref().is_some_and(|k| k.measurement.reached);
+        let reaching;
+        let options = if must_reach {
+            let mut o = options.clone();
+            o.stages.must_reach = true;
+            reaching = o;
+            &reaching
+        } else {
+            options
+        };
         let fitted = match fit_group(&prepared, &group, options, budget, &mut notify) {
             Ok(f) => f,
             Err(Error::Interrupted) => return Err(Error::Interrupted),
