@@ -258,6 +258,35 @@ fn a_range_scan_of_a_torus_gives_an_annulus() {
     check_open("torus scan", &points, 0, 2);
 }
 
+/// A range image of a height field seen from above (issue 48, "a single view is one sheet"):
+/// the unit sphere's cap `z = √(1 − x² − y²)` sampled on a regular 120 × 120 grid of rays along
+/// −z (sparse where the surface turns away, as a scanner sees it) out to `r = 0.97`, where the
+/// surface is 76° from the view — the silhouette edge of the view —, with two occlusion holes
+/// (discs of radius 11 and 10 grid steps with no returns, about 3.5 and 3 local spacings; holes
+/// of 10 and 9 steps are still bridged as sampling gaps, see [`subfit_init::TrimOptions`]),
+/// range noise 0.1 grid step, no normals. The cage is one sheet of genus 0 with one boundary
+/// loop per hole plus the silhouette's, near the data.
+#[test]
+fn a_height_field_view_with_holes_is_one_sheet() {
+    let m = 120;
+    let step = 2.0 / (m - 1) as f64;
+    let holes = [([-0.35, 0.1], 11.0 * step), ([0.4, -0.3], 10.0 * step)];
+    let mut rng = Rng(48);
+    let mut points = Vec::new();
+    for i in 0..m * m {
+        let (x, y) = (-1.0 + (i % m) as f64 * step, -1.0 + (i / m) as f64 * step);
+        let in_hole = holes
+            .iter()
+            .any(|(c, r)| (x - c[0]).powi(2) + (y - c[1]).powi(2) < r * r);
+        if x * x + y * y > 0.97 * 0.97 || in_hole {
+            continue;
+        }
+        let z = (1.0 - x * x - y * y).sqrt() + 0.1 * step * rng.normal();
+        points.push([x, y, z]);
+    }
+    check_open("height field with holes", &points, 0, holes.len() + 1);
+}
+
 /// Closed clouds (normals estimated, as for a scan) are not trimmed at all and give closed cages
 /// of their genus, with and without noise.
 #[test]

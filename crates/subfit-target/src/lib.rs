@@ -35,6 +35,7 @@ pub mod boundary_corners;
 pub mod closest;
 pub mod cloud_features;
 pub mod cloud_rim;
+pub mod consistency;
 mod error;
 pub mod estimate;
 pub mod features;

@@ -203,6 +203,13 @@ pub struct TargetStats {
     /// Estimated normals negated by orientation (relative to the arbitrary PCA sign, or to agree
     /// with neighbouring input/face normals).
     pub flipped_normals: usize,
+    /// Input normals only: the fraction of clearly (anti)parallel neighbour pairs whose input
+    /// normals point opposite ways ([`crate::consistency`]; 0 for other normal origins).
+    pub opposed_input_normals: f64,
+    /// Whether the input normals were found inconsistently oriented (`opposed_input_normals`
+    /// above [`crate::consistency::MAX_OPPOSED_FRACTION`]) and re-oriented: their directions
+    /// kept, their signs chosen by [`crate::orient`].
+    pub reoriented_input_normals: bool,
     /// Points whose smallest two covariance eigenvalues are nearly equal (see
     /// [`TargetOptions::ambiguity_ratio`]): normal direction unreliable.
     pub ambiguous_normals: usize,

@@ -289,14 +289,24 @@ impl Target {
             .zip(&prescribed)
             .map(|(q, p)| p.unwrap_or_else(|| q.frame_at(0.0, 0.0).normal))
             .collect();
-        let fixed: Vec<bool> = prescribed.iter().map(Option::is_some).collect();
-        let n_fixed = fixed.iter().filter(|&&f| f).count();
+        let mut fixed: Vec<bool> = prescribed.iter().map(Option::is_some).collect();
+        let mut n_fixed = fixed.iter().filter(|&&f| f).count();
         stats.normal_origin = match (origin, n_fixed) {
             (_, 0) => NormalOrigin::Estimated,
             (o, f) if f == np => o,
             _ => NormalOrigin::Mixed,
         };
         let stride = graph_stride(&params);
+        if origin == NormalOrigin::Input && n_fixed > 0 {
+            // Input normals with inconsistent signs are oriented like estimated ones.
+            let opposed = crate::consistency::opposed_fraction(&normals, &fixed, &graph, stride);
+            stats.opposed_input_normals = opposed;
+            if opposed > crate::consistency::MAX_OPPOSED_FRACTION {
+                stats.reoriented_input_normals = true;
+                fixed.fill(false);
+                n_fixed = 0;
+            }
+        }
         if n_fixed < np {
             let k = options.orientation_k;
             let orient_graph = prefix_rows(&graph, stride, k);

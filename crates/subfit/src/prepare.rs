@@ -148,6 +148,13 @@ pub(crate) fn prepare(
         );
         notify.warn(&mut warnings, msg);
     }
+    if target.stats().reoriented_input_normals {
+        let msg = format!(
+            "the normals of {name} are not consistently oriented ({:.0}% of neighbouring normals point opposite ways): their directions kept, their signs chosen again",
+            100.0 * target.stats().opposed_input_normals
+        );
+        notify.warn(&mut warnings, msg);
+    }
     let diagonal = bbox_diagonal(target.points());
     let file_vertices = file_vertices
         .into_iter()
