@@ -18,7 +18,9 @@
 //! occur across a part thinner than the neighbourhood (the two sheets of a thin plate): a few
 //! percent at most. With signs independent of the surface the fraction is near one half (0.45
 //! on the dragon view above, whose signs are 65 % / 35 % along its mean view direction). The
-//! threshold [`MAX_OPPOSED_FRACTION`] sits between the two.
+//! threshold [`MAX_OPPOSED_FRACTION`] sits between the two. Point clouds only: a mesh is
+//! oriented by its faces, and a coarse one has many neighbours across thin parts (20 % of the
+//! pairs on a 398-vertex cat).
 
 use subfit_mesh::vec3::dot;
 

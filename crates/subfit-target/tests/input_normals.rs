@@ -89,3 +89,29 @@ fn consistent_input_normals_are_kept_either_sign() {
         assert!(t.normals().iter().all(|v| sign * v[2] > 0.0));
     }
 }
+
+/// A mesh's vertex normals are never re-oriented by the neighbour test: its faces orient it,
+/// and on a coarse mesh neighbours across a thin part rightly face away from each other.
+#[test]
+fn a_mesh_keeps_its_vertex_normals() {
+    let (p, n) = sheet();
+    let flips = signs(p.len());
+    let given: Vec<[f64; 3]> = n
+        .iter()
+        .zip(&flips)
+        .map(|(v, &f)| if f { v.map(|c| -c) } else { *v })
+        .collect();
+    let m = 60u32;
+    let mut faces = subfit_mesh::Polygons::new();
+    for j in 0..m - 1 {
+        for i in 0..m - 1 {
+            let v = j * m + i;
+            faces.push(&[v, v + 1, v + m + 1]);
+            faces.push(&[v, v + m + 1, v + m]);
+        }
+    }
+    let mut mesh = subfit_mesh::PolyMesh::new(p, faces);
+    mesh.normals = Some(given);
+    let t = Target::build(&mesh, &TargetOptions::default(), None).unwrap();
+    assert!(!t.stats().reoriented_input_normals);
+}
