@@ -216,22 +216,33 @@ fn carving_wraps_a_genus2_cloud_without_normals() {
     assert!(subfit_init::carve(&t, 80, 0.0, 0.05).is_err());
 }
 
-/// With a third of the normals flipped the IMLS contour gets the genus wrong; given the expected
-/// genus, `initial_control_mesh` falls back to carving and gets it right.
+/// With a third of the normals flipped at random, their signs disagree between neighbours:
+/// the target orients them again (`reoriented_input_normals`) and the IMLS contour has the
+/// torus's genus without help.
+#[test]
+fn randomly_flipped_normals_are_oriented_again_and_the_contour_is_right() {
+    let shape = Shape::DEFAULT_TORUS;
+    let cloud = shape.sample(8000, 0.0, 5);
+    let normals = flipped(&cloud, |i, _| i % 3 == 0);
+    let t =
+        Target::from_points(&cloud.positions, Some(&normals), &TargetOptions::default()).unwrap();
+    assert!(t.stats().reoriented_input_normals);
+    let (m, rep) = initial_control_mesh(&t, None, 200, &InitOptions::default()).unwrap();
+    assert!(rep.carve_radius.is_none());
+    assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
+}
+
+/// Normals flipped over a whole half of the torus agree with their neighbours within each
+/// half, so the target keeps them, and the IMLS contour gets the genus wrong; given the
+/// expected genus, `initial_control_mesh` falls back to carving and gets it right.
 #[test]
 fn wrong_normals_fall_back_to_carving_when_the_genus_is_known() {
     let shape = Shape::DEFAULT_TORUS;
     let cloud = shape.sample(8000, 0.0, 5);
-    let normals: Vec<[f64; 3]> = cloud
-        .normals
-        .as_ref()
-        .unwrap()
-        .iter()
-        .enumerate()
-        .map(|(i, n)| if i % 3 == 0 { n.map(|c| -c) } else { *n })
-        .collect();
+    let normals = flipped(&cloud, |_, p| p[0] > 0.0);
     let t =
         Target::from_points(&cloud.positions, Some(&normals), &TargetOptions::default()).unwrap();
+    assert!(!t.stats().reoriented_input_normals);
     let (_, plain) = initial_control_mesh(&t, None, 200, &InitOptions::default()).unwrap();
     assert!(plain.carve_radius.is_none());
     assert_ne!(
@@ -247,6 +258,17 @@ fn wrong_normals_fall_back_to_carving_when_the_genus_is_known() {
     assert!(rep.carve_radius.is_some(), "{rep:?}");
     assert_eq!(topology(&m), (1, 0, 1), "{rep:?}");
     assert!(m.num_vertices() <= 200);
+}
+
+/// The normals of `cloud` with those of the points where `flip(index, position)` turned over.
+fn flipped(cloud: &subfit_mesh::PolyMesh, flip: impl Fn(usize, [f64; 3]) -> bool) -> Vec<[f64; 3]> {
+    let normals = cloud.normals.as_ref().unwrap();
+    normals
+        .iter()
+        .zip(&cloud.positions)
+        .enumerate()
+        .map(|(i, (n, &p))| if flip(i, p) { n.map(|c| -c) } else { *n })
+        .collect()
 }
 
 /// Every undirected edge of `m` is in exactly two triangles (no crack, no fin).
