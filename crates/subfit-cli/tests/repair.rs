@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use common::{corpus_dir, subfit};
 use subfit::io::{Encoding, WriteOptions};
+use subfit::mesh::thin_shapes::two_sided_lens;
 use subfit::mesh::{diagnose_mesh, PolyMesh, Polygons};
 
 /// Writes `mesh` to `dir/name` as full-precision ASCII (OBJ or PLY by the extension).
@@ -114,61 +115,10 @@ fn a_sphere_with_a_sheet_glued_along_an_edge_is_fitted() {
     assert!(report["control_points"].as_u64().unwrap() > 0);
 }
 
-/// A lens over `[−1, 1]²` (top `z = h`, bottom `z = −h`, joined at the rim) whose middle square
-/// `|x|, |y| ≤ 1/3` has `h = 0`: there both sides are the same triangles, written turned, in a
-/// checkerboard order of which comes first. Closed, genus 0.
-fn lens() -> PolyMesh {
-    let n = 12usize;
-    let coord = |i: usize| -1.0 + 2.0 * i as f64 / n as f64;
-    let height = |i: usize, j: usize| {
-        let r = coord(i).abs().max(coord(j).abs());
-        if r <= 0.4 || r >= 1.0 - 1e-9 {
-            0.0
-        } else {
-            0.3 * (std::f64::consts::PI * (r - 0.4) / 0.6).sin()
-        }
-    };
-    let mut p = Vec::new();
-    let (mut top, mut bottom) = (
-        vec![vec![0u32; n + 1]; n + 1],
-        vec![vec![0u32; n + 1]; n + 1],
-    );
-    for i in 0..=n {
-        for j in 0..=n {
-            let h = height(i, j);
-            top[i][j] = p.len() as u32;
-            p.push([coord(i), coord(j), h]);
-            bottom[i][j] = top[i][j];
-            if h != 0.0 {
-                bottom[i][j] = p.len() as u32;
-                p.push([coord(i), coord(j), -h]);
-            }
-        }
-    }
-    let mut f = Polygons::new();
-    for i in 0..n {
-        for j in 0..n {
-            let cell = |g: &Vec<Vec<u32>>| [g[i][j], g[i + 1][j], g[i + 1][j + 1], g[i][j + 1]];
-            let (t, b) = (cell(&top), cell(&bottom));
-            let up = [[t[0], t[1], t[2]], [t[0], t[2], t[3]]];
-            let down = [[b[0], b[2], b[1]], [b[0], b[3], b[2]]];
-            let order = if (i + j) % 2 == 0 {
-                [up, down]
-            } else {
-                [down, up]
-            };
-            for tri in order.iter().flatten() {
-                f.push(tri);
-            }
-        }
-    }
-    PolyMesh::new(p, f)
-}
-
 #[test]
 fn a_sheet_of_no_thickness_written_on_both_sides_is_fitted_as_one_closed_surface() {
     let d = tempfile::tempdir().unwrap();
-    let mesh = lens();
+    let mesh = two_sided_lens(|i, j| (i + j) % 2 == 0);
     assert!(diagnose_mesh(&mesh).duplicate_faces >= 32);
     let path = write(d.path(), "lens.ply", &mesh);
     let (err, report) = quick_fit(&path, &d.path().join("fit"));

@@ -13,7 +13,9 @@
 //! * [`handle_torus`]: a body with a thin handle — a torus whose tube radius goes from thick
 //!   on one side to thin on the other (genus 1);
 //! * [`lattice`]: a plate with a grid of square holes, smoothed (genus = the number of holes;
-//!   8 with the defaults of the benchmark).
+//!   8 with the defaults of the benchmark);
+//! * [`two_sided_lens`]: a closed lens whose middle is a sheet of no thickness written as both
+//!   its sides (a repair's hard case).
 //!
 //! Surfaces of revolution are meshed on rings at uniform arc length along the meridian
 //! profile (near-square triangles away from the poles); the lattice is the boundary of a
@@ -294,6 +296,58 @@ fn taubin(mesh: &mut PolyMesh, steps: usize) {
             }
         }
     }
+}
+
+/// A lens over `[−1, 1]²` (a `12 × 12` grid): a top sheet `z = h`, a bottom sheet `z = −h`,
+/// joined at the rim and in the middle square `|x|, |y| ≤ 0.4`, where `h = 0`: there the top
+/// and the bottom faces are the same triangles turned — a sheet of no thickness, as a thin part
+/// of a scan collapsed by its reconstruction. `top_first(i, j)` says which copy of the middle
+/// cell `(i, j)` is written first. Genus 0, closed; a repair's hard case, not a fit's truth.
+pub fn two_sided_lens(top_first: impl Fn(usize, usize) -> bool) -> PolyMesh {
+    let n = 12usize;
+    let coord = |i: usize| -1.0 + 2.0 * i as f64 / n as f64;
+    let height = |i: usize, j: usize| {
+        let r = coord(i).abs().max(coord(j).abs());
+        if r <= 0.4 + 1e-9 || r >= 1.0 - 1e-9 {
+            0.0
+        } else {
+            0.3 * (PI * (r - 0.4) / 0.6).sin()
+        }
+    };
+    let mut p = Vec::new();
+    let mut top = vec![vec![0u32; n + 1]; n + 1];
+    let mut bottom = top.clone();
+    for i in 0..=n {
+        for j in 0..=n {
+            let h = height(i, j);
+            top[i][j] = p.len() as u32;
+            p.push([coord(i), coord(j), h]);
+            bottom[i][j] = if h == 0.0 {
+                top[i][j]
+            } else {
+                p.push([coord(i), coord(j), -h]);
+                (p.len() - 1) as u32
+            };
+        }
+    }
+    let mut f = Polygons::new();
+    for i in 0..n {
+        for j in 0..n {
+            let cell = |g: &Vec<Vec<u32>>| [g[i][j], g[i + 1][j], g[i + 1][j + 1], g[i][j + 1]];
+            let (t, b) = (cell(&top), cell(&bottom));
+            let up = [[t[0], t[1], t[2]], [t[0], t[2], t[3]]];
+            let down = [[b[0], b[2], b[1]], [b[0], b[3], b[2]]];
+            let order = if top_first(i, j) {
+                [up, down]
+            } else {
+                [down, up]
+            };
+            for tri in order.iter().flatten() {
+                f.push(tri);
+            }
+        }
+    }
+    PolyMesh::new(p, f)
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 //! coincident sides (what a volumetric reconstruction leaves at a thin part). Each repair must
 //! give back that surface: closed or open as it is, orientable, with the faces it had.
 
+use subfit_mesh::thin_shapes::two_sided_lens;
 use subfit_mesh::{
     clean_faces, cut_nonmanifold_edges, diagnose_mesh, drop_twin_sides, reorient_faces,
     split_bowties, PolyMesh, Polygons,
@@ -142,63 +143,12 @@ fn a_sheet_glued_to_a_sphere_comes_off_and_both_stay() {
     assert_eq!(m.num_faces(), ball.num_faces() + sheet);
 }
 
-/// A lens over `[−1, 1]²`: a top sheet `z = h`, a bottom sheet `z = −h`, joined at the rim and
-/// in the middle square `|x|, |y| ≤ 1/3`, where `h = 0`: there the top and the bottom faces are
-/// the same triangles turned, a sheet of no thickness. `top_first(i, j)` says which copy of a
-/// middle cell is written first. Genus 0, closed.
-fn lens(top_first: impl Fn(usize, usize) -> bool) -> PolyMesh {
-    let n = 12usize;
-    let coord = |i: usize| -1.0 + 2.0 * i as f64 / n as f64;
-    let height = |i: usize, j: usize| {
-        let r = coord(i).abs().max(coord(j).abs());
-        if r <= 0.4 + 1e-9 || r >= 1.0 - 1e-9 {
-            0.0
-        } else {
-            0.3 * (std::f64::consts::PI * (r - 0.4) / 0.6).sin()
-        }
-    };
-    let mut p = Vec::new();
-    let mut top = vec![vec![0u32; n + 1]; n + 1];
-    let mut bottom = top.clone();
-    for i in 0..=n {
-        for j in 0..=n {
-            let h = height(i, j);
-            top[i][j] = p.len() as u32;
-            p.push([coord(i), coord(j), h]);
-            bottom[i][j] = if h == 0.0 {
-                top[i][j]
-            } else {
-                p.push([coord(i), coord(j), -h]);
-                (p.len() - 1) as u32
-            };
-        }
-    }
-    let mut f = Polygons::new();
-    for i in 0..n {
-        for j in 0..n {
-            let cell = |g: &Vec<Vec<u32>>| [g[i][j], g[i + 1][j], g[i + 1][j + 1], g[i][j + 1]];
-            let (t, b) = (cell(&top), cell(&bottom));
-            let up = [[t[0], t[1], t[2]], [t[0], t[2], t[3]]];
-            let down = [[b[0], b[2], b[1]], [b[0], b[3], b[2]]];
-            let order = if top_first(i, j) {
-                [up, down]
-            } else {
-                [down, up]
-            };
-            for tri in order.iter().flatten() {
-                f.push(tri);
-            }
-        }
-    }
-    PolyMesh::new(p, f)
-}
-
 #[test]
 fn a_sheet_of_no_thickness_keeps_both_sides_and_the_lens_stays_closed() {
     // The copies of the middle cells written in a checkerboard order: keeping the first copy
     // of each (what the repair did before) mixed top and bottom faces in the middle, and the
     // cut then left a surface that could not be oriented.
-    let mut m = lens(|i, j| (i + j) % 2 == 0);
+    let mut m = two_sided_lens(|i, j| (i + j) % 2 == 0);
     let nf = m.num_faces();
     let before = diagnose_mesh(&m);
     // 16 middle cells of 2 triangles; their edges: 16 around, 12 + 12 across, 16 diagonals.

@@ -34,15 +34,18 @@ fn signs(count: usize) -> Vec<bool> {
         .collect()
 }
 
+/// `n` with about a third of the normals turned over ([`signs`]).
+fn flipped(n: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    n.iter()
+        .zip(signs(n.len()))
+        .map(|(v, f)| if f { v.map(|c| -c) } else { *v })
+        .collect()
+}
+
 #[test]
 fn inconsistent_input_normals_are_oriented_again() {
     let (p, n) = sheet();
-    let flips = signs(p.len());
-    let given: Vec<[f64; 3]> = n
-        .iter()
-        .zip(&flips)
-        .map(|(v, &f)| if f { v.map(|c| -c) } else { *v })
-        .collect();
+    let given = flipped(&n);
     let t = Target::from_points(&p, Some(&given), &TargetOptions::default()).unwrap();
     let st = t.stats();
     assert!(st.reoriented_input_normals, "{}", st.opposed_input_normals);
@@ -95,12 +98,7 @@ fn consistent_input_normals_are_kept_either_sign() {
 #[test]
 fn a_mesh_keeps_its_vertex_normals() {
     let (p, n) = sheet();
-    let flips = signs(p.len());
-    let given: Vec<[f64; 3]> = n
-        .iter()
-        .zip(&flips)
-        .map(|(v, &f)| if f { v.map(|c| -c) } else { *v })
-        .collect();
+    let given = flipped(&n);
     let m = 60u32;
     let mut faces = subfit_mesh::Polygons::new();
     for j in 0..m - 1 {
