@@ -74,11 +74,17 @@ pub(crate) fn measure_final(
         .map(|p| p.distance)
         .collect();
     // The RMS is the area samples' (not the rim's); the largest distance is also taken over
-    // the rim and every vertex.
+    // the rim and every vertex: the file's as read (the target's are among them, at the same
+    // places, but for the midpoints of edges the repair split), else the target's.
     let mut data_to_surface = DistanceStats::of_samples(&to_surface, data.boundary);
-    let from_vertices = [mesh_vertices(target), file_vertices]
+    let vertices = if file_vertices.is_empty() {
+        mesh_vertices(target)
+    } else {
+        file_vertices
+    };
+    let from_vertices = surface
+        .distances(vertices)
         .iter()
-        .flat_map(|v| surface.distances(v))
         .map(|p| p.distance)
         .fold(0.0, f64::max);
     data_to_surface.max = data_to_surface.max.max(from_vertices);
