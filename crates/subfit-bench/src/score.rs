@@ -1,5 +1,6 @@
 //! One entry scored: run `subfit` on it as a user would (defaults; a cage pair at the given
-//! cage's count in its scheme; a sequence through `subfit sequence`), then judge what it wrote
+//! cage's count (`--control-points` and `--max-control-points`) in its scheme; a sequence
+//! through `subfit sequence`), then judge what it wrote
 //! against the input with [`crate::judge`], and set the fit's own figures beside the judge's.
 
 use std::path::Path;
@@ -181,6 +182,9 @@ fn pair_row(entry: &Entry, control: &Path, dense: &Path, dir: &Path, settings: &
         "-o".into(),
         out.display().to_string(),
         "--max-control-points".into(),
+        given.num_vertices().to_string(),
+        // At the given cage's count: the comparison is per control point.
+        "--control-points".into(),
         given.num_vertices().to_string(),
         "--scheme".into(),
         if scheme == Scheme::Loop {

@@ -85,6 +85,11 @@ pub struct InitArgs {
     /// Keep the cage all triangles.
     #[arg(long)]
     pub no_quad_dominant: bool,
+    /// How a quad cage is laid out: `field` (edges along a cross field of the surface, few
+    /// irregular vertices), `paired` (the QEM cage's triangles paired) or `only` (along the
+    /// field, every face a quad; makes the cage quads without --scheme).
+    #[arg(long, value_enum, default_value_t = QuadsArg::Field)]
+    pub quads: QuadsArg,
     /// Sharp features of a mesh target (tags are written only into an .obj output).
     #[command(flatten)]
     pub features: FeatureArgs,
@@ -471,6 +476,12 @@ pub struct FitArgs {
     /// Keep the cage all triangles (see `--quad-dominant`).
     #[arg(long)]
     pub no_quad_dominant: bool,
+    /// How a quad cage is laid out: `field` (edges along a cross field of the surface, few
+    /// irregular vertices; the paired cage where the target has sharp features), `paired` (the
+    /// QEM cage's triangles paired) or `only` (along the field, every face a quad; makes the
+    /// cage quads, fitted with Catmull-Clark, without --scheme).
+    #[arg(long, value_enum, default_value_t = QuadsArg::Field)]
+    pub quads: QuadsArg,
     /// Sharp features of a mesh target.
     #[command(flatten)]
     pub features: FeatureArgs,
@@ -602,6 +613,28 @@ fn feature_angle(s: &str) -> Result<f64, String> {
         Err(format!(
             "{v}: a dihedral angle in degrees, between 0 and 180 (exclusive)"
         ))
+    }
+}
+
+/// `--quads`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum QuadsArg {
+    /// Edges along a cross field.
+    Field,
+    /// The QEM cage's triangles paired.
+    Paired,
+    /// Along a cross field, all quads.
+    Only,
+}
+
+impl QuadsArg {
+    /// The library's layout.
+    pub fn layout(self) -> subfit::QuadLayout {
+        match self {
+            Self::Field => subfit::QuadLayout::Field,
+            Self::Paired => subfit::QuadLayout::Paired,
+            Self::Only => subfit::QuadLayout::Only,
+        }
     }
 }
 

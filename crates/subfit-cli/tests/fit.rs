@@ -353,9 +353,10 @@ fn catmull_clark_fits_start_from_a_quad_dominant_cage() {
     let d = tempfile::tempdir().unwrap();
     let cloud = d.path().join("ellipsoid.ply");
     save(&cloud, &Shape::PAPER_ELLIPSOID.sample(8_000, 0.0, 3));
-    let quads = fit_cc(&cloud, &d.path().join("quads"), &[]);
+    let quads = fit_cc(&cloud, &d.path().join("quads"), &["--quads", "paired"]);
     let tris = fit_cc(&cloud, &d.path().join("tris"), &["--no-quad-dominant"]);
-    // The cage is paired before the fit, with the same control points.
+    // The cage is paired before the fit, with the same control points (`--quads paired`: the
+    // default also lays a cage along a cross field, tests/quad_cages.rs).
     assert_eq!(quads["init"]["paired"], true);
     assert!(
         quads["init"]["quad_fraction"].as_f64().unwrap() >= 0.85,

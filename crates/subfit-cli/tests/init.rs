@@ -280,6 +280,8 @@ fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
         "--control-points",
         "120",
         "--quad-dominant",
+        "--quads",
+        "paired",
         "-o",
         out.to_str().unwrap(),
     ]);
@@ -318,8 +320,8 @@ fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(r.status.code(), Some(2));
-    // `--scheme quad-tri` (and catmull-clark) pairs by default; `--scheme loop` keeps triangles
-    // and refuses `--quad-dominant`.
+    // `--scheme quad-tri` (and catmull-clark) makes quads by default (paired with `--quads
+    // paired`); `--scheme loop` keeps triangles and refuses `--quad-dominant`.
     for (scheme, paired) in [("quad-tri", true), ("catmull-clark", true), ("loop", false)] {
         let r = subfit(&[
             "init",
@@ -328,6 +330,8 @@ fn quad_dominant_init_pairs_the_torus_cage_into_quads() {
             "120",
             "--scheme",
             scheme,
+            "--quads",
+            "paired",
             "-o",
             out.to_str().unwrap(),
         ]);

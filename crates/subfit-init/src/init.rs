@@ -26,6 +26,9 @@ use crate::semi_sharp::semi_sharp_tags;
 
 use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
+use crate::cross_field::{
+    quad_cage, split_into_quads_tagged, QuadCageError, QuadCageOptions, QuadCageReport,
+};
 use crate::quads::{pair_triangles, PairOptions, PairReport};
 use crate::simplify::{
     simplify_with_features, FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport,
@@ -73,6 +76,16 @@ pub struct InitOptions {
     pub quad_dominant: bool,
     /// Options of the pairing (used with [`Self::quad_dominant`]).
     pub pairing: PairOptions,
+    /// Build the cage from a cross field instead ([`crate::cross_field::quad_cage`]: edges
+    /// along the field, irregular vertices at its singularities; all quads with
+    /// [`QuadCageOptions::quads_only`]) when the target has no sharp features to keep as tags;
+    /// on failure the simplified, paired cage is used and
+    /// [`InitReport::cross_field_failure`] says why. Default `None`.
+    pub cross_field: Option<QuadCageOptions>,
+    /// With [`Self::quad_dominant`]: split every face of the paired cage into quads (an
+    /// `n`-gon into `n`), the simplification taken at about a quarter of the count
+    /// ([`QUARTER_SPLIT`]), so that the cage is all quads. Default `false`.
+    pub split_into_quads: bool,
     /// Detect sharp features with these options and keep them as crease and corner tags of a
     /// feature-aligned cage: a mesh target's sharp edges, or (with [`Self::cloud_features`]) a
     /// point cloud's crease curves with the contour snapped to them
@@ -134,6 +147,8 @@ impl Default for InitOptions {
             contour_vertices_per_control: 8.0,
             quad_dominant: false,
             pairing: PairOptions::default(),
+            cross_field: None,
+            split_into_quads: false,
             features: None,
             semi_sharp: false,
             cloud_features: false,
@@ -144,6 +159,11 @@ impl Default for InitOptions {
         }
     }
 }
+
+/// Vertices of a quad-dominant cage split into quads per vertex of the cage: `V + E + F`,
+/// about 4.4 `V` on the paired QEM cages of the test models (a few triangles and a boundary
+/// make it more than 4).
+pub const QUARTER_SPLIT: f64 = 4.4;
 
 /// The scale of the default start for a point cloud found open
 /// ([`InitOptions::open_cloud_scale`]). Measured on simulated single-view scans (`hard_cases
@@ -264,6 +284,10 @@ pub struct InitReport {
     pub carve_radius: Option<f64>,
     /// The pairing into quads, with [`InitOptions::quad_dominant`].
     pub pairing: Option<PairReport>,
+    /// The cross-field cage, with [`InitOptions::cross_field`] when it was built.
+    pub cross_field: Option<QuadCageReport>,
+    /// Why [`InitOptions::cross_field`] was asked but the simplified cage used.
+    pub cross_field_failure: Option<String>,
     /// Crease and corner tags of the result (infinitely sharp; empty without
     /// [`InitOptions::features`] or when none were found).
     pub tags: Tags,
@@ -514,6 +538,39 @@ pub fn initial_control_mesh(
             ])
         })
         .collect();
+    if let Some(qo) = options
+        .cross_field
+        .as_ref()
+        .filter(|_| lock.edges.is_empty())
+    {
+        let qo = QuadCageOptions {
+            cancel: options.cancel.clone(),
+            ..qo.clone()
+        };
+        match quad_cage(target, &dense, n_vertices, &qo) {
+            Ok((cage, qrep)) => {
+                report.timings.simplify = t.elapsed();
+                report.cross_field = Some(qrep);
+                return finish(cage, report, loops_before, t0, options);
+            }
+            Err(QuadCageError::Interrupted) => return Err(InitError::Interrupted),
+            Err(e) => report.cross_field_failure = Some(e.to_string()),
+        }
+    } else if options.cross_field.is_some() {
+        report.cross_field_failure =
+            Some("the target's sharp features are kept as tags by the simplified cage".into());
+    }
+    // All quads asked but the field's cage not taken: the paired cage of about a quarter of
+    // the count, each face split into quads (V + E + F ≈ 4.4 V for a quad-dominant cage).
+    let split = options.split_into_quads && options.quad_dominant;
+    let sopt = if split {
+        SimplifyOptions {
+            target_vertices: ((n_vertices as f64 / QUARTER_SPLIT).round() as usize).max(4),
+            ..sopt
+        }
+    } else {
+        sopt
+    };
     let (mut out, mut tags, srep) = simplify_with_features(&dense, &lock, &sopt)?;
     if let (true, Some(f)) = (options.semi_sharp, &features) {
         report.fillet_widths = fillet_widths(&dense.positions, &dense.faces, f);
@@ -546,7 +603,22 @@ pub fn initial_control_mesh(
         report.timings.pair = t.elapsed();
         report.pairing = Some(prep);
     }
+    if split {
+        let (quads, tags) = split_into_quads_tagged(&out, &report.tags);
+        out = quads;
+        report.tags = tags;
+    }
+    finish(out, report, loops_before, t0, options)
+}
 
+/// The cage `out` checked and reported: genus, boundary loops, components.
+fn finish(
+    out: PolyMesh,
+    mut report: InitReport,
+    loops_before: usize,
+    t0: Instant,
+    options: &InitOptions,
+) -> Result<(PolyMesh, InitReport), InitError> {
     let after = HalfEdgeMesh::from_mesh(&out)?;
     report.genus_after = after.genus();
     let loops_after = after.boundary_loops().len();

@@ -30,6 +30,7 @@
 pub mod cad_cage;
 pub mod carve;
 pub mod contour;
+pub mod cross_field;
 pub mod curvature_lines;
 mod denoise;
 mod heap;

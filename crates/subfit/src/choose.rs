@@ -34,6 +34,19 @@ impl Measurement {
         score(self) < score(other)
     }
 
+    /// Whether this cage is about as close as `other`'s: both or neither meet the tolerances
+    /// and its worse figure, relative to the better of the two cages' (as in
+    /// [`Self::closer_than`]), is at most `1 + slack` times `other`'s.
+    pub fn about_as_close_as(&self, other: &Self, slack: f64) -> bool {
+        if self.reached != other.reached {
+            return self.reached;
+        }
+        let rms = self.rms.min(other.rms).max(f64::MIN_POSITIVE);
+        let max = self.max.min(other.max).max(f64::MIN_POSITIVE);
+        let score = |e: &Self| (e.rms / rms).max(e.max / max);
+        score(self) <= (1.0 + slack) * score(other)
+    }
+
     /// Whether this fit is better than `other`'s as a start of another kind: of two that meet
     /// the tolerances, the one with fewer control points (the point of a compact cage; equal
     /// counts go to [`Self::closer_than`]); otherwise [`Self::closer_than`].
@@ -89,5 +102,18 @@ mod tests {
         assert!(!small_out.better_start_than(&m(false, 1.0, 1.0)));
         // Equal counts: the closer one.
         assert!(m(true, 1.0, 1.0).better_start_than(&m(true, 1.0, 1.2)));
+    }
+
+    #[test]
+    fn about_as_close_allows_the_slack_and_no_more() {
+        // 18 % more Hausdorff against 14 % more RMS: within 10 % of each other's score.
+        let field = m(true, 0.0175, 0.158);
+        let paired = m(true, 0.0200, 0.134);
+        assert!(!field.closer_than(&paired));
+        assert!(field.about_as_close_as(&paired, 0.1));
+        assert!(!field.about_as_close_as(&paired, 0.01));
+        // Twice as far is not about as close; meeting the tolerances still decides first.
+        assert!(!m(true, 2.0, 2.0).about_as_close_as(&m(true, 1.0, 1.0), 0.1));
+        assert!(!m(false, 1.0, 1.0).about_as_close_as(&m(true, 2.0, 2.0), 0.1));
     }
 }

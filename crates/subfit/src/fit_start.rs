@@ -15,7 +15,7 @@ use crate::choose::Measurement;
 use crate::error::Error;
 use crate::fitted::Fitted;
 use crate::measure_fit::{measure_final, usd_difference, FinalMeasure};
-use crate::options::{FitScanOptions, InitialCage};
+use crate::options::{FitScanOptions, InitialCage, QuadLayout};
 use crate::outputs::usd_scheme;
 use crate::prepare::Prepared;
 use crate::progress::{Notify, Step};
@@ -183,6 +183,12 @@ fn tolerances(
         Some(kind) => target_tolerances(&options.stages, kind, prepared.diagonal),
         None => options.stages.clone(),
     };
+    // An all-quad cage keeps its connectivity: local refinement and edge flips would bring
+    // triangles back (no template closes a quad split on one edge with quads).
+    if options.quads == QuadLayout::Only {
+        judged.refine = false;
+        judged.edge_flips = false;
+    }
     // A tessellation's cage never grows past the tessellation's (distinct) vertices.
     judged.max_control_points = if tessellation {
         tessellation_budget(prepared, options, budget)

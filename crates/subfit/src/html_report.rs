@@ -281,8 +281,11 @@ impl Fitted {
             (
                 "initial cage".into(),
                 format!(
-                    "{} with {} control points (genus {})",
-                    r.init.source, r.init.control_points, r.init.genus
+                    "{} with {} control points (genus {}){}",
+                    r.init.source,
+                    r.init.control_points,
+                    r.init.genus,
+                    cross_field_note(r.init.cross_field.as_ref())
                 ),
             ),
             (
@@ -525,4 +528,28 @@ fn sig(v: f64) -> String {
 
 fn percent(fraction: f64) -> String {
     format!("{}%", subfit_report::html::number(100.0 * fraction))
+}
+
+/// The initial cage's layout for the table: along a cross field, with its valences, or why
+/// not; empty when no cross field was asked.
+fn cross_field_note(c: Option<&crate::pipeline_report::CrossFieldSummary>) -> String {
+    match c {
+        Some(c) if c.used => {
+            let valences: Vec<String> = c
+                .valences
+                .iter()
+                .map(|(v, n)| format!("{v}: {n}"))
+                .collect();
+            format!(
+                ", along a cross field: {} irregular vertices; interior valences {}",
+                c.irregular,
+                valences.join(", ")
+            )
+        }
+        Some(c) => format!(
+            ", simplified and paired (no cross-field cage: {})",
+            c.failure.as_deref().unwrap_or("not taken")
+        ),
+        None => String::new(),
+    }
 }

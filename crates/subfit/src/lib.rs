@@ -67,7 +67,7 @@ pub use fitted::Fitted;
 pub use html_report::{ViewMesh, VIEW_POINTS, VIEW_TRIANGLES};
 pub use initialize::{initialize, Initialized};
 pub use markers::{parse_markers, read_markers};
-pub use options::{method_named, FitScanOptions, InitialCage, Input, EXACT_ERROR};
+pub use options::{method_named, FitScanOptions, InitialCage, Input, QuadLayout, EXACT_ERROR};
 pub use outputs::{log_csv, usd_scheme, OutputOptions, OUTPUTS};
 pub use pipeline_report::Report;
 pub use prepare::Prepared;

@@ -56,6 +56,21 @@ pub enum InitialCage {
     },
 }
 
+/// How an automatic quad cage is laid out ([`FitScanOptions::quads`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum QuadLayout {
+    /// Edges along a smooth cross field of the surface, irregular vertices at its
+    /// singularities ([`subfit_init::cross_field`]); the paired QEM cage when the field's cage
+    /// cannot be taken or the target has sharp features to keep.
+    #[default]
+    Field,
+    /// The QEM cage's triangles paired into quads ([`subfit_init::pair_triangles`]).
+    Paired,
+    /// Along a cross field, every face a quad (each face of the field's cage split into
+    /// quads, as one Catmull-Clark step does).
+    Only,
+}
+
 /// Options of [`crate::fit_scan`]. Lengths are in the target's normalized units (the unit cube).
 #[derive(Clone, Debug)]
 pub struct FitScanOptions {
@@ -82,6 +97,11 @@ pub struct FitScanOptions {
     /// given, makes the inferred scheme Catmull-Clark; it cannot be combined with Loop.
     /// It replaces [`InitOptions::quad_dominant`] in [`Self::init_options`].
     pub quad_dominant: Option<bool>,
+    /// How an automatic quad cage is laid out when there is one ([`Self::quad_dominant`], or a
+    /// quad scheme): along a cross field (default), the QEM cage's triangles paired, or along
+    /// a cross field with every face a quad ([`QuadLayout::Only`] also makes the cage quads
+    /// when neither is given).
+    pub quads: QuadLayout,
     /// Per-iteration options (method, step control, sample level, solver; by default with the
     /// data → surface part on, [`FitOptions::coverage`] = 1, so the fit aims at the two-sided
     /// tolerance it is judged by). Its scheme, tags,
@@ -122,6 +142,7 @@ impl Default for FitScanOptions {
             as_points: false,
             scheme: None,
             quad_dominant: None,
+            quads: QuadLayout::default(),
             fit: FitOptions {
                 coverage: 1.0,
                 ..FitOptions::default()
@@ -252,6 +273,11 @@ pub(crate) fn validate(o: &FitScanOptions) -> Result<(), Error> {
                 "--error-scale must be in (0, 1) (unit-cube units), got {v}"
             ));
         }
+    }
+    if o.quads == QuadLayout::Only
+        && (o.scheme == Some(Scheme::Loop) || o.quad_dominant == Some(false))
+    {
+        return bad("--quads only makes every face a quad: it needs a quad scheme (catmull-clark or quad-tri) and cannot be combined with --no-quad-dominant".into());
     }
     if o.quad_dominant == Some(true) && o.scheme == Some(Scheme::Loop) {
         return bad("--quad-dominant makes quads, and the Loop scheme needs triangles: use --scheme catmull-clark (or drop --quad-dominant)".into());

@@ -173,6 +173,31 @@ pub struct InitSummary {
     /// whether it is this cage, and why not. `None` when it was not tried.
     #[serde(default)]
     pub curvature_lines: Option<CurvatureLineSummary>,
+    /// A quad cage laid along a cross field (`subfit_init::cross_field`) when it was asked
+    /// of this start: the cage's face sizes and valences, or why the paired simplification was
+    /// used instead. `None` for other starts.
+    #[serde(default)]
+    pub cross_field: Option<CrossFieldSummary>,
+}
+
+/// The cross-field cage of a start ([`InitSummary::cross_field`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CrossFieldSummary {
+    /// Whether the cage is the field's (otherwise the paired simplification, see `failure`).
+    pub used: bool,
+    /// Why the field's cage was not taken.
+    pub failure: Option<String>,
+    /// Whether the lattice was taken at about a quarter of the count, each face then split
+    /// into quads.
+    pub split: bool,
+    /// Irregular vertices (interior of valence other than 4, boundary other than 2 or 3).
+    pub irregular: usize,
+    /// Interior vertices by valence: `[valence, count]`, ascending.
+    pub valences: Vec<(usize, usize)>,
+    /// Working-mesh vertices the fields were computed on.
+    pub working_vertices: usize,
+    /// Seconds spent.
+    pub seconds: f64,
 }
 
 /// The curvature-line initial cage of Lavoué et al. 2007 §4 ([`InitSummary::curvature_lines`]).
@@ -660,6 +685,9 @@ pub struct BudgetStart {
     pub seconds: f64,
     /// Whether its cage is the one written.
     pub kept: bool,
+    /// Whether its initial cage was laid along a cross field ([`InitSummary::cross_field`]).
+    #[serde(default)]
+    pub cross_field: bool,
 }
 
 /// Tag counts.

@@ -12,7 +12,6 @@ use std::time::Instant;
 
 use subfit_init::InitOptions;
 use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons};
-use subfit_subdiv::Scheme;
 use subfit_target::{Target, TargetOptions};
 
 use crate::error::Error;
@@ -85,9 +84,7 @@ impl Prepared {
             init.simplify.exact_error = 0.0;
         }
         // Catmull-Clark and quad/triangle cages start quad-dominant; Loop needs triangles.
-        init.quad_dominant = options
-            .quad_dominant
-            .unwrap_or(options.scheme.is_some_and(|s| s != Scheme::Loop));
+        init.quad_dominant = crate::starts::wants_quads(options);
         if let Some(t) = self.expected_topology {
             // A genus the caller gave (`subfit init --genus`) wins over the dropped faces'.
             init.expected_genus.get_or_insert(t.genus);

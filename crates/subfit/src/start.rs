@@ -21,6 +21,10 @@ pub enum StartKind {
     Qem {
         /// The fraction of the budget the start was capped to, if it was.
         budget_fraction: Option<f64>,
+        /// The cage laid along a cross field ([`subfit_init::cross_field`]) instead of the
+        /// simplification paired into quads (the simplification when the field's cage cannot
+        /// be taken).
+        cross_field: bool,
     },
     /// The curvature-line cage of Lavoué et al. 2007 §4 ([`subfit_init::curvature_lines`]).
     CurvatureLines,

@@ -11,7 +11,7 @@ use subfit_target::FeatureOptions;
 use crate::error::Error;
 use crate::options::FitScanOptions;
 use crate::pipeline_report::{
-    face_counts, BoundaryLoops, FeatureSummary, InitSummary, InitTimings,
+    face_counts, BoundaryLoops, CrossFieldSummary, FeatureSummary, InitSummary, InitTimings,
 };
 use crate::prepare::{topology, Prepared};
 use crate::start::{Start, StartKind};
@@ -93,6 +93,7 @@ pub(crate) fn given_start(
         },
         curvature_lines: None,
         cad: None,
+        cross_field: None,
     };
     Ok(Start {
         kind: StartKind::Given,
@@ -156,5 +157,26 @@ pub(crate) fn init_summary(
         },
         curvature_lines: None,
         cad: None,
+        cross_field: cross_field_summary(r),
+    }
+}
+
+/// What the cross-field cage of `r` was, when it was asked.
+fn cross_field_summary(r: &InitReport) -> Option<CrossFieldSummary> {
+    match (&r.cross_field, &r.cross_field_failure) {
+        (Some(q), _) => Some(CrossFieldSummary {
+            used: true,
+            failure: None,
+            split: q.split,
+            irregular: q.irregular,
+            valences: q.valences.clone(),
+            working_vertices: q.working_vertices,
+            seconds: q.seconds,
+        }),
+        (None, Some(why)) => Some(CrossFieldSummary {
+            failure: Some(why.clone()),
+            ..CrossFieldSummary::default()
+        }),
+        (None, None) => None,
     }
 }

@@ -11,7 +11,7 @@ use subfit_init::{default_control_points, initial_control_mesh, InitOptions};
 use subfit_subdiv::Scheme;
 
 use crate::error::Error;
-use crate::options::FitScanOptions;
+use crate::options::{FitScanOptions, QuadLayout};
 use crate::pipeline_report::InitSummary;
 use crate::prepare::Prepared;
 use crate::start::{Start, StartKind};
@@ -27,9 +27,20 @@ pub(crate) fn qem_start(
     options: &FitScanOptions,
     budget: usize,
     fraction: f64,
+    cross_field: bool,
 ) -> Result<Start, Error> {
     let (target, name) = (&*prepared.target, &prepared.name);
     let mut init_options = prepared.init_options(options);
+    // The layout of a quad cage: along a cross field, or the simplification paired (and with
+    // `--quads only` split into quads).
+    let only = options.quads == QuadLayout::Only;
+    init_options.cross_field = (cross_field && init_options.quad_dominant).then(|| {
+        subfit_init::cross_field::QuadCageOptions {
+            quads_only: only,
+            ..Default::default()
+        }
+    });
+    init_options.split_into_quads = only && init_options.quad_dominant;
     let mut budget_start = None;
     let n = match options.control_points {
         Some(n) if n > budget => {
@@ -38,6 +49,15 @@ pub(crate) fn qem_start(
             )))
         }
         Some(n) => n,
+        // An all-quad cage is not refined: a budget given is its size.
+        None if options.quads == QuadLayout::Only => {
+            let given = budget < subfit_fit::StageOptions::default().max_control_points;
+            if given {
+                budget
+            } else {
+                default_control_points(target.len()).min(budget)
+            }
+        }
         None => {
             let (n, f) = start_control_points(
                 default_control_points(target.len()),
@@ -131,6 +151,7 @@ pub(crate) fn qem_start(
     Ok(Start {
         kind: StartKind::Qem {
             budget_fraction: budget_start,
+            cross_field,
         },
         cage: m,
         tags,

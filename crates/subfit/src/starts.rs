@@ -32,6 +32,18 @@
 //! report's `init.source` says which start was kept, `init.curvature_lines` what the other
 //! gave.
 //!
+//! ## Cross-field starts
+//!
+//! A quad cage (`--scheme catmull-clark` or `quad-tri`, `--quad-dominant`, `--quads only`)
+//! under `--quads field` (the default) or `only` is also laid along a cross field of the
+//! surface ([`subfit_init::cross_field`]): edges that follow the shape, irregular vertices
+//! where the field has its singularities. That cage is a variant of the QEM start, fitted
+//! first, and the closer of the fits is kept ([`crate::choose::Measurement::closer_than`]):
+//! on smooth shapes the field's cage fits as closely as the paired simplification and has
+//! half its irregular vertices; on thin parts (the bunny's ears, the armadillo's limbs) a
+//! lattice of even cells leaves too few control points where the simplification puts many,
+//! and the paired cage is kept. `--quads paired` fits the paired cage alone.
+//!
 //! ## Budget starts
 //!
 //! Fits under a small budget from more than one start, the better cage kept.
@@ -78,7 +90,7 @@ use subfit_init::default_control_points;
 use subfit_subdiv::Scheme;
 
 use crate::error::Error;
-use crate::options::{FitScanOptions, InitialCage};
+use crate::options::{FitScanOptions, InitialCage, QuadLayout};
 use crate::prepare::Prepared;
 pub use crate::start::{Start, StartKind};
 use crate::start_cad::{cad_applies, cad_start, tessellation_budget};
@@ -111,7 +123,9 @@ pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
         InitialCage::CurvatureLines => vec![StartKind::CurvatureLines],
         InitialCage::Auto | InitialCage::Qem => {
             let default = default_control_points(prepared.target.len());
+            // An all-quad cage is not refined: it starts at its final size, once.
             let capped = options.control_points.is_none()
+                && options.quads != QuadLayout::Only
                 && start_control_points(default, budget, options.scheme, BUDGET_STARTS[0])
                     .1
                     .is_some();
@@ -120,13 +134,26 @@ pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
                     .iter()
                     .map(|&f| StartKind::Qem {
                         budget_fraction: Some(f),
+                        cross_field: false,
                     })
                     .collect()
             } else {
                 vec![StartKind::Qem {
                     budget_fraction: None,
+                    cross_field: false,
                 }]
             };
+            // A quad cage is also laid along a cross field, at the first size: a variant of
+            // the QEM start, the closer fit kept (see the module docs).
+            if wants_quads(options) && options.quads != QuadLayout::Paired {
+                kinds.insert(
+                    0,
+                    StartKind::Qem {
+                        budget_fraction: capped.then_some(BUDGET_STARTS[0]),
+                        cross_field: true,
+                    },
+                );
+            }
             let both = matches!(options.init, InitialCage::Auto)
                 && options.control_points.is_none()
                 && options.scheme != Some(Scheme::Loop)
@@ -166,11 +193,15 @@ pub fn build_start(
             };
             given_start(prepared, mesh, tags, name, budget, options)
         }
-        StartKind::Qem { budget_fraction } => qem_start(
+        StartKind::Qem {
+            budget_fraction,
+            cross_field,
+        } => qem_start(
             prepared,
             options,
             budget,
             budget_fraction.unwrap_or(BUDGET_STARTS[0]),
+            cross_field,
         ),
         StartKind::CurvatureLines => curvature_line_start(prepared, options, budget),
         StartKind::Cad => cad_start(
@@ -188,6 +219,14 @@ pub fn build_start(
     }?;
     start.seconds = t.elapsed().as_secs_f64();
     Ok(start)
+}
+
+/// Whether `options` make the automatic cage quads: `--quad-dominant`, `--quads only`, or a
+/// quad scheme asked (Catmull-Clark, quad/triangle).
+pub fn wants_quads(options: &FitScanOptions) -> bool {
+    options.quad_dominant.unwrap_or(
+        options.quads == QuadLayout::Only || options.scheme.is_some_and(|s| s != Scheme::Loop),
+    )
 }
 
 /// Whether `kind` is a variant of `other` (the budget fractions of the QEM start): variants

@@ -86,6 +86,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
         as_points: a.as_points,
         scheme: scheme_of(a.scheme),
         quad_dominant: quad_dominant_flag(a.quad_dominant, a.no_quad_dominant),
+        quads: a.quads.layout(),
         fit: FitOptions {
             sample_level: a.sample_level as usize,
             method,
@@ -227,7 +228,12 @@ pub fn init_line(i: &subfit::pipeline_report::InitSummary) -> String {
         i.quads,
         i.triangles,
         100.0 * i.quad_fraction,
-        if i.paired { ", triangles paired" } else { "" },
+        match &i.cross_field {
+            Some(c) if c.used =>
+                format!(", along a cross field: {} irregular vertices", c.irregular),
+            _ if i.paired => ", triangles paired".to_string(),
+            _ => String::new(),
+        },
         if i.cloud_open {
             format!(
                 "; open cloud: {} contour faces trimmed{}, {} boundary loop(s){}{}",

@@ -103,6 +103,7 @@ fn options(a: &InitArgs) -> FitScanOptions {
         as_points: a.from_points,
         scheme: crate::commands::fit::scheme_of(a.scheme),
         quad_dominant: crate::cli::quad_dominant_flag(a.quad_dominant, a.no_quad_dominant),
+        quads: a.quads.layout(),
         // The fit's defaults decide as they do for `subfit fit` without a tolerance.
         target_tolerances: true,
         cad_feature_angle: defaults
@@ -188,7 +189,7 @@ fn print_notes(report: &InitReport, out: &PolyMesh, requested: usize) {
             report.genus_target
         );
     }
-    if !report.simplify.reached_target {
+    if !report.simplify.reached_target && report.cross_field.is_none() {
         eprintln!(
             "subfit: warning: no legal collapse left at {} vertices ({requested} requested)",
             out.num_vertices()
@@ -344,8 +345,18 @@ fn print_summary(
         "cage: {} vertices ({requested} requested), {} faces ({quads} quads, {triangles} triangles{}), {}, {} component(s); {versus}",
         out.num_vertices(),
         out.num_faces(),
-        if r.pairing.is_some() { ", triangles paired" } else { "" },
+        match (&r.cross_field, r.pairing.is_some()) {
+            (Some(q), _) => format!(
+                ", along a cross field: {} irregular vertices, {} field singularities",
+                q.irregular, q.singularities
+            ),
+            (None, true) => ", triangles paired".to_string(),
+            (None, false) => String::new(),
+        },
         topo(Some(r.genus_after), r.boundary_loops.1),
         r.components,
     );
+    if let Some(why) = &r.cross_field_failure {
+        out!("cross field: not used ({why}); the simplified cage is paired instead");
+    }
 }
