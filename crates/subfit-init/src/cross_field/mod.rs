@@ -34,6 +34,8 @@ mod spacing;
 
 use std::time::Instant;
 
+use rayon::prelude::*;
+
 use subfit_mesh::vec3::{add, cross, dot, norm, normalize, scale, sub};
 use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_target::Target;
@@ -45,9 +47,6 @@ use field::{orientation_field, position_field, Graph, Hierarchy, Lines};
 
 /// Most takes of the lattice while the count is corrected (step 5).
 pub const MAX_ATTEMPTS: usize = 8;
-
-/// Vertices of the hierarchy's coarsest level.
-const COARSEST: usize = 64;
 
 /// Options of [`quad_cage`].
 #[derive(Clone, Debug, PartialEq)]
@@ -82,6 +81,12 @@ pub struct QuadCageOptions {
     /// Dihedral angle (degrees) above which a working-mesh edge is a crease the field is held
     /// along. Default 45.
     pub crease_angle_deg: f64,
+    /// Sizes (vertices) of the hierarchy's coarsest level to take the fields from, one take
+    /// each; the cage with the fewest irregular vertices is kept. Where the fields' local
+    /// minima fall depends on the hierarchy, and a take costs a fraction of a second: on Keenan
+    /// Crane's Bob at 334, 27–39 irregular vertices over coarsest sizes 4–1024. Default
+    /// `[16, 64, 256]`.
+    pub coarsest: Vec<usize>,
     /// Options of the pairing into quads.
     pub pairing: PairOptions,
     /// Cancellation, polled between steps and takes.
@@ -98,6 +103,7 @@ impl Default for QuadCageOptions {
             curvature_weight: 0.0,
             adaptive: false,
             crease_angle_deg: 45.0,
+            coarsest: vec![16, 64, 256],
             pairing: PairOptions::default(),
             cancel: Cancel::default(),
         }
@@ -176,18 +182,35 @@ pub fn quad_cage(
     let mut best: Option<(PolyMesh, QuadCageReport)> = None;
     let mut failure = None;
     for &split in splits {
-        match lattice_cage(target, mesh, n, split, options) {
-            Ok((cage, report)) => {
-                let better = best.as_ref().is_none_or(|(b, r)| {
-                    (report.irregular, std::cmp::Reverse(cage.num_vertices()))
-                        < (r.irregular, std::cmp::Reverse(b.num_vertices()))
-                });
-                if better {
-                    best = Some((cage, report));
-                }
-            }
+        let w = match Working::new(mesh, n, if split { 0.25 } else { 1.0 }, options) {
+            Ok(w) => w,
             Err(QuadCageError::Interrupted) => return Err(QuadCageError::Interrupted),
-            Err(e) => failure = Some(e),
+            Err(e) => {
+                failure = Some(e);
+                continue;
+            }
+        };
+        // The takes of one working mesh are independent: in parallel, then compared in
+        // their listed order (deterministic).
+        let takes: Vec<_> = options
+            .coarsest
+            .par_iter()
+            .map(|&coarsest| lattice_cage(target, &w, n, split, coarsest, options))
+            .collect();
+        for taken in takes {
+            match taken {
+                Ok((cage, report)) => {
+                    let better = best.as_ref().is_none_or(|(b, r)| {
+                        (report.irregular, std::cmp::Reverse(cage.num_vertices()))
+                            < (r.irregular, std::cmp::Reverse(b.num_vertices()))
+                    });
+                    if better {
+                        best = Some((cage, report));
+                    }
+                }
+                Err(QuadCageError::Interrupted) => return Err(QuadCageError::Interrupted),
+                Err(e) => failure = Some(e),
+            }
         }
     }
     match (best, failure) {
@@ -202,49 +225,81 @@ pub fn quad_cage(
 
 /// The cage of one lattice: at the count itself, or (`split`) at about a quarter of it with
 /// every face then split into quads.
+/// The working mesh of one lattice size (step 1) with what every take on it shares.
+struct Working {
+    mesh: PolyMesh,
+    tris: Vec<[u32; 3]>,
+    graph: Graph,
+    boundary: Vec<Vec<u32>>,
+    genus: u32,
+    area: f64,
+    lattice_n: f64,
+}
+
+impl Working {
+    /// The working mesh of `mesh` for a lattice at `share` of `n` vertices.
+    fn new(
+        mesh: &PolyMesh,
+        n: usize,
+        share: f64,
+        options: &QuadCageOptions,
+    ) -> Result<Self, QuadCageError> {
+        let lattice_n = (n as f64 * share).max(4.0);
+        let (working, tris) = working_mesh(mesh, lattice_n, options)?;
+        options.cancel.check()?;
+        let he =
+            HalfEdgeMesh::from_mesh(&working).map_err(|e| QuadCageError::Surface(e.to_string()))?;
+        let boundary = he
+            .boundary_loops()
+            .into_iter()
+            .map(|l| l.into_iter().map(|v| v.0).collect())
+            .collect();
+        let graph = Graph::new(working.positions.clone(), &tris);
+        let area = tris
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| graph.positions[v as usize]);
+                0.5 * norm(cross(sub(b, a), sub(c, a)))
+            })
+            .sum();
+        Ok(Self {
+            genus: he.genus(),
+            mesh: working,
+            tris,
+            graph,
+            boundary,
+            area,
+            lattice_n,
+        })
+    }
+}
+
+/// The cage of one lattice on `w` (its hierarchy coarsened to `coarsest` vertices): at the
+/// count itself, or (`split`) at about a quarter of it with every face then split into quads.
 fn lattice_cage(
     target: &Target,
-    mesh: &PolyMesh,
+    w: &Working,
     n: usize,
     split: bool,
+    coarsest: usize,
     options: &QuadCageOptions,
 ) -> Result<(PolyMesh, QuadCageReport), QuadCageError> {
     let mut report = QuadCageReport {
         split,
+        working_vertices: w.mesh.num_vertices(),
         ..QuadCageReport::default()
     };
-    // The lattice's share of the final count: a split quad-dominant cage has about
-    // V + E + F ≈ 4 V vertices.
-    let lattice_share = if split { 0.25 } else { 1.0 };
-    let lattice_n = (n as f64 * lattice_share).max(4.0);
-    let (working, tris) = working_mesh(mesh, lattice_n, options)?;
-    options.cancel.check()?;
-    let he =
-        HalfEdgeMesh::from_mesh(&working).map_err(|e| QuadCageError::Surface(e.to_string()))?;
-    let boundary: Vec<Vec<u32>> = he
-        .boundary_loops()
-        .into_iter()
-        .map(|l| l.into_iter().map(|v| v.0).collect())
-        .collect();
-    let (genus, loops) = (he.genus(), boundary.len());
-    report.working_vertices = working.num_vertices();
-    let graph = Graph::new(working.positions.clone(), &tris);
-    let area: f64 = tris
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| graph.positions[v as usize]);
-            0.5 * norm(cross(sub(b, a), sub(c, a)))
-        })
-        .sum();
-    let mut s = (area / lattice_n).sqrt();
-    let lines = field_lines(&graph, &tris, target, s, options);
-    let hierarchy = Hierarchy::new(graph.clone(), COARSEST);
+    let (graph, tris, boundary, working) = (&w.graph, &w.tris, &w.boundary, &w.mesh);
+    let (genus, loops, lattice_n) = (w.genus, w.boundary.len(), w.lattice_n);
+    let mut s = (w.area / lattice_n).sqrt();
+    let lines = field_lines(graph, tris, target, s, options);
+    let hierarchy = Hierarchy::new(graph.clone(), coarsest);
     let o = orientation_field(&hierarchy, &lines, options.orientation_sweeps);
-    report.singularities = field::singular_triangles(&graph, &o, &tris);
+    report.singularities = field::singular_triangles(graph, &o, tris);
     options.cancel.check()?;
     // The spacing per vertex relative to the mean (`s` scales it to the count).
     let relative = if options.adaptive {
-        spacing::relative_spacing(&working, &graph, &tris, lattice_n, &options.cancel)?
+        spacing::relative_spacing(working, graph, tris, lattice_n, &options.cancel)?
     } else {
         vec![1.0; graph.len()]
     };
@@ -256,15 +311,15 @@ fn lattice_cage(
         let p = position_field(&hierarchy, &o, &spacing, options.position_sweeps);
         options.cancel.check()?;
         let taken = take(
-            &graph,
-            &tris,
+            graph,
+            tris,
             &o,
             &p,
             &spacing,
             target,
             options,
             split,
-            &boundary,
+            boundary,
             (genus, loops),
         );
         let count = match taken {

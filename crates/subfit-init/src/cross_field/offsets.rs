@@ -23,7 +23,7 @@ use subfit_mesh::vec3::dot;
 use super::field::{compat_position, lattice_of, matched, pair_spacing, Graph};
 
 /// Most triangles one search for a dislocation's partner visits.
-pub(crate) const SEARCH_TRIANGLES: usize = 200_000;
+pub(crate) const SEARCH_TRIANGLES: usize = 50_000;
 
 /// The offsets of a mesh's edges, and its triangles' adjacency.
 pub(crate) struct Offsets {
@@ -202,9 +202,9 @@ impl Offsets {
         adjacency: &[[u32; 3]],
     ) -> Option<Vec<(usize, u32, u32)>> {
         // Per reached triangle: the step into it, and the curl carried to its base frame.
-        let mut parent: std::collections::HashMap<usize, (usize, u32, u32)> = Default::default();
+        let mut parent: Vec<Option<(usize, u32, u32)>> = vec![None; tris.len()];
         let mut queue = VecDeque::from([(f, c)]);
-        parent.insert(f, (usize::MAX, 0, 0));
+        parent[f] = Some((usize::MAX, 0, 0));
         let mut visited = 0;
         while let Some((g, carried)) = queue.pop_front() {
             visited += 1;
@@ -223,10 +223,10 @@ impl Offsets {
                     return Some(path);
                 }
                 let h = next as usize;
-                if parent.contains_key(&h) {
+                if parent[h].is_some() {
                     continue;
                 }
-                parent.insert(h, (g, u, w));
+                parent[h] = Some((g, u, w));
                 // The carried curl in h's base frame: through u, which both share.
                 let at_u = turn(carried, self.turns(u, t[0]));
                 let here = turn(at_u, self.turns(tris[h][0], u));
@@ -247,13 +247,9 @@ impl Offsets {
 
     /// The steps from the search's root to `h` (reversed), each the triangle left and the edge
     /// crossed.
-    fn back(
-        &self,
-        parent: &std::collections::HashMap<usize, (usize, u32, u32)>,
-        mut h: usize,
-    ) -> Vec<(usize, u32, u32)> {
+    fn back(&self, parent: &[Option<(usize, u32, u32)>], mut h: usize) -> Vec<(usize, u32, u32)> {
         let mut out = Vec::new();
-        while let Some(&(g, u, w)) = parent.get(&h) {
+        while let Some((g, u, w)) = parent[h] {
             if g == usize::MAX {
                 break;
             }
