@@ -114,6 +114,35 @@ fn a_torus_cage_along_the_cross_field_has_fewer_irregular_vertices_than_the_pair
 }
 
 #[test]
+fn a_hole_smaller_than_a_cell_is_kept_as_a_hole() {
+    let d = tempfile::tempdir().unwrap();
+    let mut torus = torus_mesh(1.0, 0.4, 96, 40, true);
+    // Two triangles out: a hole far smaller than a cell of a 200-point lattice.
+    let tris: Vec<[u32; 3]> = torus
+        .faces
+        .iter()
+        .skip(2)
+        .map(|f| [f[0], f[1], f[2]])
+        .collect();
+    torus.faces = subfit::mesh::Polygons::from_triangles(&tris);
+    let torus = write(d.path(), "holed.obj", &torus);
+    let (v, f, text) = init(&torus, &d.path().join("field.obj"), "200", "field");
+    assert!(text.contains("along a cross field"), "{text}");
+    // Genus 1 with one boundary loop: V − E + F = 2 − 2g − b = −1 (a boundary edge counted
+    // once: E = (Σ sizes + boundary edges) / 2).
+    let mut edges = std::collections::BTreeMap::new();
+    for p in &f {
+        for i in 0..p.len() {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let boundary = edges.values().filter(|&&k| k == 1).count();
+    assert!(boundary >= 3, "no hole: {text}");
+    assert_eq!(v as i64 - edges.len() as i64 + f.len() as i64, -1, "{text}");
+}
+
+#[test]
 fn quads_only_writes_only_quads_and_refuses_loop() {
     let d = tempfile::tempdir().unwrap();
     let torus = write(d.path(), "torus.obj", &torus_mesh(1.0, 0.4, 96, 40, true));

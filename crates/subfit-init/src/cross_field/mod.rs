@@ -227,7 +227,10 @@ pub fn quad_cage(
 /// every face then split into quads.
 /// The working mesh of one lattice size (step 1) with what every take on it shares.
 struct Working {
+    /// The working mesh with its small holes capped (module step 1).
     mesh: PolyMesh,
+    /// Centroids of the capped holes: each reopened as the cage face nearest it.
+    caps: Vec<[f64; 3]>,
     tris: Vec<[u32; 3]>,
     graph: Graph,
     boundary: Vec<Vec<u32>>,
@@ -245,8 +248,13 @@ impl Working {
         options: &QuadCageOptions,
     ) -> Result<Self, QuadCageError> {
         let lattice_n = (n as f64 * share).max(4.0);
-        let (working, tris) = working_mesh(mesh, lattice_n, options)?;
+        let (working, _) = working_mesh(mesh, lattice_n, options)?;
         options.cancel.check()?;
+        let he =
+            HalfEdgeMesh::from_mesh(&working).map_err(|e| QuadCageError::Surface(e.to_string()))?;
+        let spacing = (surface_area(&working) / lattice_n).sqrt();
+        let (working, caps) = cap_small_holes(&working, &he, SMALL_HOLE * spacing);
+        let tris = working.faces.triangulate_fan();
         let he =
             HalfEdgeMesh::from_mesh(&working).map_err(|e| QuadCageError::Surface(e.to_string()))?;
         let boundary = he
@@ -264,6 +272,7 @@ impl Working {
             .sum();
         Ok(Self {
             genus: he.genus(),
+            caps,
             mesh: working,
             tris,
             graph,
@@ -290,7 +299,7 @@ fn lattice_cage(
         ..QuadCageReport::default()
     };
     let (graph, tris, boundary, working) = (&w.graph, &w.tris, &w.boundary, &w.mesh);
-    let (genus, loops, lattice_n) = (w.genus, w.boundary.len(), w.lattice_n);
+    let (genus, loops, lattice_n) = (w.genus, w.boundary.len() + w.caps.len(), w.lattice_n);
     let mut s = (w.area / lattice_n).sqrt();
     let lines = field_lines(graph, tris, target, s, options);
     let hierarchy = Hierarchy::new(graph.clone(), coarsest);
@@ -320,6 +329,7 @@ fn lattice_cage(
             options,
             split,
             boundary,
+            &w.caps,
             (genus, loops),
         );
         let count = match taken {
@@ -365,6 +375,7 @@ fn take(
     options: &QuadCageOptions,
     split: bool,
     loops: &[Vec<u32>],
+    caps: &[[f64; 3]],
     want: (u32, usize),
 ) -> Result<PolyMesh, String> {
     let mut offsets = offsets::Offsets::new(graph, o, p, s);
@@ -387,6 +398,7 @@ fn take(
     } else {
         paired
     };
+    let cage = reopen_holes(cage, caps)?;
     let he = HalfEdgeMesh::from_mesh(&cage).map_err(|e| e.to_string())?;
     let got = (he.genus(), he.boundary_loops().len());
     if got != want {
@@ -396,6 +408,118 @@ fn take(
         ));
     }
     Ok(cage)
+}
+
+/// A boundary loop shorter than this many lattice spacings is a small hole: capped while the
+/// lattice is laid (a hole smaller than a cell cannot be bounded by cells of its own) and
+/// reopened as one cage face.
+pub const SMALL_HOLE: f64 = 4.0;
+
+/// Area of a polygon mesh (its fan triangles).
+fn surface_area(m: &PolyMesh) -> f64 {
+    m.faces
+        .triangulate_fan()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            0.5 * norm(cross(sub(b, a), sub(c, a)))
+        })
+        .sum()
+}
+
+/// `m` with every boundary loop of `he` shorter than `perimeter` capped by a fan to its
+/// centroid (a new vertex); returns the centroids too.
+fn cap_small_holes(m: &PolyMesh, he: &HalfEdgeMesh, perimeter: f64) -> (PolyMesh, Vec<[f64; 3]>) {
+    let tris = m.faces.triangulate_fan();
+    let mut positions = m.positions.clone();
+    let mut faces = Polygons::from_triangles(&tris);
+    let mut caps = Vec::new();
+    let mut directed: Vec<(u32, u32)> = tris
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .collect();
+    directed.sort_unstable();
+    for l in he.boundary_loops() {
+        let l: Vec<u32> = l.into_iter().map(|v| v.0).collect();
+        let length: f64 = (0..l.len())
+            .map(|i| {
+                norm(sub(
+                    positions[l[(i + 1) % l.len()] as usize],
+                    positions[l[i] as usize],
+                ))
+            })
+            .sum();
+        if length >= perimeter || l.len() < 3 {
+            continue;
+        }
+        let c = l
+            .iter()
+            .fold([0.0; 3], |s, &v| add(s, positions[v as usize]));
+        let c = scale(c, 1.0 / l.len() as f64);
+        positions.push(c);
+        let g = (positions.len() - 1) as u32;
+        for i in 0..l.len() {
+            let (a, b) = (l[i], l[(i + 1) % l.len()]);
+            // Run the loop edge opposite to the triangle beside it.
+            if directed.binary_search(&(a, b)).is_ok() {
+                faces.push(&[g, b, a]);
+            } else {
+                faces.push(&[g, a, b]);
+            }
+        }
+        caps.push(c);
+    }
+    (PolyMesh::new(positions, faces), caps)
+}
+
+/// `cage` with, for each cap centroid, the face whose centroid is nearest removed (a hole
+/// again); fails when a removed face would touch another hole.
+fn reopen_holes(cage: PolyMesh, caps: &[[f64; 3]]) -> Result<PolyMesh, String> {
+    if caps.is_empty() {
+        return Ok(cage);
+    }
+    let centroid = |f: &[u32]| {
+        let s = f
+            .iter()
+            .fold([0.0; 3], |s, &v| add(s, cage.positions[v as usize]));
+        scale(s, 1.0 / f.len() as f64)
+    };
+    let mut removed = vec![false; cage.faces.len()];
+    let mut touched = vec![false; cage.num_vertices()];
+    let he = HalfEdgeMesh::from_mesh(&cage).map_err(|e| e.to_string())?;
+    for l in he.boundary_loops() {
+        for v in l {
+            touched[v.0 as usize] = true;
+        }
+    }
+    let centroids: Vec<[f64; 3]> = cage.faces.iter().map(centroid).collect();
+    for c in caps {
+        let f = (0..centroids.len())
+            .filter(|&f| !removed[f])
+            .min_by(|&a, &b| {
+                let d = |f: usize| {
+                    let x = sub(centroids[f], *c);
+                    dot(x, x)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .ok_or("no face left to reopen a hole")?;
+        let face = cage.faces.face(subfit_mesh::FaceId(f as u32));
+        if face.iter().any(|&v| touched[v as usize]) {
+            return Err("two holes would share a vertex".into());
+        }
+        for &v in face {
+            touched[v as usize] = true;
+        }
+        removed[f] = true;
+    }
+    let mut faces = Polygons::new();
+    for (f, p) in cage.faces.iter().enumerate() {
+        if !removed[f] {
+            faces.push(p);
+        }
+    }
+    Ok(PolyMesh::new(cage.positions, faces))
 }
 
 /// The working mesh of step 1 (triangles) for a lattice of `lattice_n` vertices.
