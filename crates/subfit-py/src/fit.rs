@@ -190,7 +190,7 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
     edge_flips=true,
     max_depth=5, local=false, local_rings=None, local_field_peak=0.8, local_field_share=0.5,
-    error_scale=None, imls_radius=None, arap=0.0, name=None, progress=None
+    error_scale=None, imls_radius=None, arap=0.0, quads="field", name=None, progress=None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit(
@@ -225,6 +225,7 @@ pub fn fit(
     error_scale: Option<f64>,
     imls_radius: Option<f64>,
     arap: f64,
+    quads: &str,
     name: Option<String>,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<NativeFit> {
@@ -253,6 +254,16 @@ pub fn fit(
         error_scale,
         (imls_radius, arap),
     )?;
+    opts.quads = match quads.to_ascii_lowercase().as_str() {
+        "field" => subfit::QuadLayout::Field,
+        "paired" => subfit::QuadLayout::Paired,
+        "only" => subfit::QuadLayout::Only,
+        _ => {
+            return Err(value_error(format!(
+                "quads must be \"field\", \"paired\" or \"only\", got {quads:?}"
+            )))
+        }
+    };
     let positions = vec3s("points", &points, subfit::target::MIN_POINTS)?;
     let n = positions.len();
     let mut mesh = match &faces {

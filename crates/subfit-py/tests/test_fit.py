@@ -91,6 +91,17 @@ def test_catmull_clark_scheme():
     assert ellipsoid_distance(s).max() < 2e-2
 
 
+def test_quads_only_gives_an_all_quad_cage_and_bad_layouts_are_refused():
+    points, _ = ellipsoid_cloud(3000, seed=7)
+    f = subfit.fit(points, quads="only", max_control_points=150, max_iterations=10)
+    sizes = {len(face) for face in f.faces}
+    assert sizes == {4}, sizes
+    assert len(f.vertices) <= 150
+    assert f.scheme == "catmull-clark"
+    with pytest.raises(ValueError, match="quads must be"):
+        subfit.fit(points, quads="hexagons", max_control_points=150)
+
+
 def test_mesh_target_and_given_initial_cage(fitted):
     # A dense triangle mesh (the fitted limit tessellation) as the target.
     pos, tris = fitted.surface().tessellation(3)

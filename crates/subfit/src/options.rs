@@ -200,6 +200,14 @@ impl FitScanOptions {
         self.stages.lambda_end = end.unwrap_or(start.min(1e-5));
     }
 
+    /// Whether the automatic cage is quads: `--quad-dominant`, `--quads only`, or a quad
+    /// scheme asked (Catmull-Clark, quad/triangle), unless `--no-quad-dominant`.
+    pub fn wants_quads(&self) -> bool {
+        self.quad_dominant.unwrap_or(
+            self.quads == QuadLayout::Only || self.scheme.is_some_and(|s| s != Scheme::Loop),
+        )
+    }
+
     /// Sets the refinement between stages: local refinement on or off (`--no-refine`), and
     /// edge flips (`--no-flips`), which need refinement.
     pub fn set_refinement(&mut self, refine: bool, edge_flips: bool) {

@@ -84,7 +84,7 @@ impl Prepared {
             init.simplify.exact_error = 0.0;
         }
         // Catmull-Clark and quad/triangle cages start quad-dominant; Loop needs triangles.
-        init.quad_dominant = crate::starts::wants_quads(options);
+        init.quad_dominant = options.wants_quads();
         if let Some(t) = self.expected_topology {
             // A genus the caller gave (`subfit init --genus`) wins over the dropped faces'.
             init.expected_genus.get_or_insert(t.genus);

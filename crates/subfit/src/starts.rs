@@ -145,7 +145,7 @@ pub fn starts(prepared: &Prepared, options: &FitScanOptions) -> Vec<StartKind> {
             };
             // A quad cage is also laid along a cross field, at the first size: a variant of
             // the QEM start, the closer fit kept (see the module docs).
-            if wants_quads(options) && options.quads != QuadLayout::Paired {
+            if options.wants_quads() && options.quads != QuadLayout::Paired {
                 kinds.insert(
                     0,
                     StartKind::Qem {
@@ -219,14 +219,6 @@ pub fn build_start(
     }?;
     start.seconds = t.elapsed().as_secs_f64();
     Ok(start)
-}
-
-/// Whether `options` make the automatic cage quads: `--quad-dominant`, `--quads only`, or a
-/// quad scheme asked (Catmull-Clark, quad/triangle).
-pub fn wants_quads(options: &FitScanOptions) -> bool {
-    options.quad_dominant.unwrap_or(
-        options.quads == QuadLayout::Only || options.scheme.is_some_and(|s| s != Scheme::Loop),
-    )
 }
 
 /// Whether `kind` is a variant of `other` (the budget fractions of the QEM start): variants

@@ -250,7 +250,10 @@ def fit(
         ``local_field_share`` (0.5; 0 turns local enrichment off), ``error_scale``,
         ``imls_radius`` (``method="imls"``: the kernel's support radius h, unit-cube units;
         default half the point spacing, at least 4 × the noise level), ``arap`` (0: the weight
-        of the as-rigid-as-possible regularizer, Xie et al. 2023 eq. 5), ``name`` (used in
+        of the as-rigid-as-possible regularizer, Xie et al. 2023 eq. 5), ``quads`` ("field":
+        a quad cage is also laid along a cross field and the closer fit kept, or the field's
+        within a tenth for its fewer irregular vertices; "paired": the simplification's
+        triangles paired; "only": every face a quad, connectivity kept), ``name`` (used in
         messages).
 
     Returns

@@ -55,6 +55,7 @@ def fit(
     error_scale: Optional[float] = None,
     imls_radius: Optional[float] = None,
     arap: float = 0.0,
+    quads: str = "field",
     name: Optional[str] = None,
     progress: Optional[Callable[[dict], Any]] = None,
 ) -> NativeFit: ...
