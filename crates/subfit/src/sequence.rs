@@ -40,6 +40,15 @@
 //! the slide along its surface free: its drift stays a few per cent, the priors' choice (see
 //! [`subfit_fit::track`]); markers pin it ([`TrackingOptions::markers`]).
 //!
+//! On the corpus (`subfit bench corpus --entry seq-cat-run`): the 36-frame run cycle of a
+//! low-poly cat (398 vertices, 4,723 control points by [`fit_scan`]'s rule) is tracked within
+//! 0.19 % of the diagonal both ways at its worst frame, its drift 3.2 % RMS and 7.4 % at the
+//! 95th percentile — growing with the pose's distance from the template's and back to 0.16 %
+//! as the cycle closes, so what is left is the tracking's reach, not an accumulation. Smaller
+//! templates drift less and fit worse (first 12 frames, no silhouette: 500 / 1,500 / 4,723
+//! control points, RMS 0.21 / 0.16 / 0.14 %, drift 1.9 / 2.5 / 3.6 %). Poses that are not a
+//! capture's steps (seq-lion: consecutive frames 8–124° apart) are lost from the second frame.
+//!
 //! All frames share one normalization, the first frame's (the unit cube of frame 0), so that
 //! the cage moves in one set of units; every figure is reported in the frame's own units and
 //! as a fraction of the frame's own bounding-box diagonal.
