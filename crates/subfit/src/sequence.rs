@@ -42,11 +42,13 @@
 //!
 //! On the corpus (`subfit bench corpus --entry seq-cat-run`): the 36-frame run cycle of a
 //! low-poly cat (398 vertices, 4,723 control points by [`fit_scan`]'s rule) is tracked within
-//! 0.19 % of the diagonal both ways at its worst frame, its drift 3.2 % RMS and 7.4 % at the
+//! 0.16 % of the diagonal both ways at its worst frame, its drift 2.4 % RMS and 5.7 % at the
 //! 95th percentile — growing with the pose's distance from the template's and back to 0.16 %
 //! as the cycle closes, so what is left is the tracking's reach, not an accumulation. Smaller
-//! templates drift less and fit worse (first 12 frames, no silhouette: 500 / 1,500 / 4,723
-//! control points, RMS 0.21 / 0.16 / 0.14 %, drift 1.9 / 2.5 / 3.6 %). Poses that are not a
+//! templates drift less over the first frames and fit worse (first 12 frames, no silhouette,
+//! before the tracking's robust weights: 500 / 1,500 / 4,723 control points, RMS 0.21 / 0.16 /
+//! 0.14 %, drift 1.9 / 2.5 / 3.6 %), but not over the whole cycle (1,000: RMS 0.39 %, drift
+//! 3.9 %; 1,500: 0.24 %, 3.3 %; 4,723: 0.19 %, 3.2 %, with the silhouette). Poses that are not a
 //! capture's steps (seq-lion: consecutive frames 8–124° apart) are lost from the second frame.
 //!
 //! All frames share one normalization, the first frame's (the unit cube of frame 0), so that
