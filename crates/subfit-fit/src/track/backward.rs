@@ -12,6 +12,7 @@
 //!   shorter correspondence radius, down to [`super::TrackOptions`]' own weights and radius.
 
 use rayon::prelude::*;
+use subfit_measure::data_samples::area_samples;
 use subfit_mesh::vec3::dot;
 use subfit_target::neighbors::PointIndex;
 use subfit_target::Target;
@@ -24,7 +25,13 @@ pub(super) struct DataPoints {
     normals: Vec<[f64; 3]>,
 }
 
-/// Every `⌈n / count⌉`-th point of `target` with its normal (all of them when `count ≥ n`).
+/// Seed of the area samples of a mesh frame (any fixed value: the step is deterministic).
+const SEED: u64 = 0x5eed_7a2c;
+
+/// `count` points of `target` with their normals: on a mesh, uniform by area over its
+/// triangles with the normal of the triangle each lies on (a mesh's vertices crowd where its
+/// triangles are small, and a low-poly frame has too few of them to stand for its faces);
+/// on a point cloud every `⌈n / count⌉`-th point (all of them when `count ≥ n`).
 pub(super) fn subsample(target: &Target, count: usize) -> DataPoints {
     let n = target.len();
     if count == 0 || n == 0 {
@@ -32,6 +39,16 @@ pub(super) fn subsample(target: &Target, count: usize) -> DataPoints {
             points: Vec::new(),
             normals: Vec::new(),
         };
+    }
+    if let Some(bvh) = target.mesh() {
+        let points = area_samples(bvh.vertices(), bvh.triangles(), count, SEED);
+        if !points.is_empty() {
+            let normals = points
+                .par_iter()
+                .map(|&p| target.mesh_foot_point(p).normal)
+                .collect();
+            return DataPoints { points, normals };
+        }
     }
     let step = n.div_ceil(count).max(1);
     DataPoints {

@@ -87,6 +87,9 @@ pub(super) struct FitRows<'a> {
     pub(super) samples: &'a [[f64; 3]],
     pub(super) g: &'a [[f64; 3]],
     pub(super) moved: &'a [[f64; 3]],
+    /// Scale `c` of the robust weights `1 / (1 + (e / c)²)` of the residuals `e` (normalized
+    /// units); 0: every row at full weight.
+    pub(super) robust: f64,
 }
 
 impl FitRows<'_> {
@@ -114,8 +117,14 @@ impl FitRows<'_> {
                 let mut j: Vec<(usize, f64)> = Vec::with_capacity(PER * self.skin.per);
                 for &(i, y, n) in part {
                     let r = sub(self.moved[i], y);
+                    let e = dot3(n, r);
+                    let wf = if self.robust > 0.0 {
+                        wf / (1.0 + (e / self.robust).powi(2))
+                    } else {
+                        wf
+                    };
                     self.skin.jacobian(&mut j, i, self.samples[i], self.g, n);
-                    local.row(&j, dot3(n, r), wf);
+                    local.row(&j, e, wf);
                     if beta > 0.0 {
                         for a in 0..3 {
                             let mut e = [0.0; 3];

@@ -116,3 +116,108 @@ fn extrapolation_continues_a_steady_motion() {
         }
     }
 }
+
+/// A low-poly frame (a cube of 14 vertices): points on its faces lie on it. The step's foot
+/// points are the exact closest points on the triangles, so their point-to-plane RMS — the
+/// floor the step stops at ([`TrackOptions::stop_rms`]) — is zero; the local quadrics of 14
+/// vertices would put a face's middle well off the face.
+#[test]
+fn points_on_a_low_poly_frame_lie_on_it() {
+    use subfit_mesh::{PolyMesh, Polygons};
+    use subfit_target::{Target, TargetOptions};
+    let corners: Vec<[f64; 3]> = (0..8)
+        .map(|i| [f64::from(i & 1), f64::from((i >> 1) & 1), f64::from(i >> 2)])
+        .collect();
+    // Outward quads (x−, x+, y−, y+, z−, z+), split into triangles.
+    let quads = [
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+    ];
+    // Each quad as a fan of 4 triangles round its centre (14 vertices: enough for a target).
+    let mut vertices = corners.clone();
+    let mut tris: Vec<[u32; 3]> = Vec::new();
+    for q in &quads {
+        let centre = vertices.len() as u32;
+        vertices.push(std::array::from_fn(|a| {
+            q.iter().map(|&k| corners[k as usize][a]).sum::<f64>() / 4.0
+        }));
+        tris.extend((0..4).map(|k| [q[k], q[(k + 1) % 4], centre]));
+    }
+    let mesh = PolyMesh::new(vertices, Polygons::from_triangles(&tris));
+    let target = Target::from_mesh(&mesh, &TargetOptions::default()).expect("a cube");
+    let (mut samples, mut normals) = (Vec::new(), Vec::new());
+    for q in &quads {
+        let c: [[f64; 3]; 4] = std::array::from_fn(|k| corners[q[k] as usize]);
+        let n = unit_normal(c[0], c[1], c[2]);
+        for (s, t) in [(0.3, 0.4), (0.5, 0.5), (0.7, 0.2)] {
+            let p: [f64; 3] = std::array::from_fn(|a| {
+                c[0][a] + s * (c[1][a] - c[0][a]) + t * (c[3][a] - c[0][a])
+            });
+            samples.push(target.to_normalized(p));
+            normals.push(n);
+        }
+    }
+    let (rms, matched) = plane_rms_to(&samples, &normals, &target, 0.1);
+    assert_eq!(matched, samples.len(), "every sample matched");
+    assert!(rms < 1e-12, "point-to-plane RMS {rms} on the frame itself");
+}
+
+/// The unit normal of the triangle `a, b, c` (counter-clockwise seen from outside).
+fn unit_normal(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
+    let n = subfit_mesh::vec3::cross(sub(b, a), sub(c, a));
+    let l = dot3(n, n).sqrt();
+    [n[0] / l, n[1] / l, n[2] / l]
+}
+
+/// One node, samples on a plane moved 0.01 along its normal, a tenth of them matched to points
+/// 0.5 off (a part the graph cannot explain): least squares moves the plane by the mean
+/// (0.059); Cauchy weights at the RMS residual ([`TrackOptions::robust`]) weigh the far tenth
+/// down to about a tenth each, and the plane moves by 0.015 (the RMS, which the outliers
+/// still dominate, sets the scale).
+#[test]
+fn robust_weights_leave_the_unexplained_part_out() {
+    let samples: Vec<[f64; 3]> = (0..100)
+        .map(|i| [f64::from(i % 10) * 0.1, f64::from(i / 10) * 0.1, 0.0])
+        .collect();
+    let offset = |i: usize| if i % 10 == 3 { 0.5 } else { 0.01 };
+    let graph = DeformationGraph::new(&samples, 1, 0);
+    let skin = graph.skin_of(&samples, 1);
+    let shift = |robust_scale: f64| {
+        let mut motion = NodeMotion::identity(1);
+        for _ in 0..30 {
+            let moved = deform(&graph, &samples, &motion, 1);
+            let matches: Vec<(usize, [f64; 3], [f64; 3])> = (0..samples.len())
+                .map(|i| {
+                    let p = samples[i];
+                    (i, [p[0], p[1], offset(i)], [0.0, 0.0, 1.0])
+                })
+                .collect();
+            let rms = plane_rms(&moved, &matches);
+            let rows = FitRows {
+                skin: &skin,
+                samples: &samples,
+                g: graph.positions(),
+                moved: &moved,
+                robust: robust_scale * rms,
+            };
+            let mut sys = Normal::new(PER);
+            rows.add(&mut sys, &matches, 1.0, 0.0);
+            assert!(sys.solve_into(&mut motion), "solvable");
+        }
+        let moved = deform(&graph, &samples, &motion, 1);
+        moved.iter().map(|p| p[2]).sum::<f64>() / moved.len() as f64
+    };
+    let (plain, robust) = (shift(0.0), shift(1.0));
+    assert!(
+        (plain - 0.059).abs() < 1e-4,
+        "least squares moved by {plain}"
+    );
+    assert!(
+        (0.01..0.02).contains(&robust),
+        "robust weights moved by {robust}"
+    );
+}
