@@ -32,15 +32,20 @@
 //!    coarser lattice, all quads), each from hierarchies of several coarsest sizes
 //!    ([`QuadCageOptions::coarsest`]); the cage with the fewest irregular vertices is kept
 //!    ([`QuadCageOptions::quads_only`]: the split ones only).
+//! 7. **Rotations** (`rotate.rs`, in every take, before the split and after it): interior
+//!    edges between two quads turned, in sequences of up to five, where that cancels
+//!    valence-3/5 pairs, with the vertices around them relaxed on the surface and every quad
+//!    there kept convex ([`QuadCageOptions::rotate_edges`]).
 //!
-//! Measured (`subfit init --quad-dominant`, irregular vertices; QuadriFlow 1.0's at about the
-//! same count in brackets, through the peers' `pyquadriflow`): Keenan Crane's Bob at 334, 26
-//! (16; the artist's own cage 20); a torus at 200, 23 (0); an icosphere at 400, 15 (8); the
-//! 3,485-vertex bunny at 479, 48 (40). Instant Meshes gives 52 on Bob. The remaining gap is
-//! the extraction: after the dislocations are paired away, QuadriFlow solves the positions
-//! again under the integer offsets so that every lattice point gets its own cell; here the
-//! regions keep the first positions, and thin regions along the pairing paths are merged into
-//! their neighbours.
+//! Measured (`quad_cage` at the count, irregular vertices without → with the rotations of
+//! step 7; QuadriFlow 1.0's at about the same count in brackets, through the peers'
+//! `pyquadriflow`): Keenan Crane's Bob at 334, 26 → 17 (16; the artist's own cage 20); a
+//! torus at 200, 19 → 14 (0); an icosphere at 400, 15 → 8 (8); the 3,485-vertex bunny at 479,
+//! 48 → 36 (40); Fertility at 600, 111 → 94; Igea at 600, 43 → 27; the rocker arm at 500,
+//! 41 → 32. The rotations add about a third to the time (Bob 1.6 → 2.0 s). Instant Meshes gives 52 on Bob. The remaining gap is the extraction: after the
+//! dislocations are paired away, QuadriFlow solves the positions again under the integer
+//! offsets so that every lattice point gets its own cell; here the regions keep the first
+//! positions, and thin regions along the pairing paths are merged into their neighbours.
 //!
 //! The cage has the working mesh's genus and boundary loops or the call fails
 //! ([`QuadCageError::Extraction`]); callers fall back to the paired QEM cage.
@@ -48,12 +53,14 @@
 mod extract;
 pub(crate) mod field;
 mod offsets;
+mod rotate;
 mod spacing;
 
 use std::time::Instant;
 
 use rayon::prelude::*;
 
+use subfit_mesh::bvh::TriangleBvh;
 use subfit_mesh::vec3::{add, cross, dot, norm, normalize, scale, sub};
 use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, Tags};
 use subfit_target::Target;
@@ -105,6 +112,9 @@ pub struct QuadCageOptions {
     /// Crane's Bob at 334, 27–39 irregular vertices over coarsest sizes 4–1024. Default
     /// `[16, 64, 256]`.
     pub coarsest: Vec<usize>,
+    /// Interior edges between two quads rotated while that brings valences closer to regular
+    /// (`rotate.rs`, step 7). Default true.
+    pub rotate_edges: bool,
     /// Options of the pairing into quads.
     pub pairing: PairOptions,
     /// Cancellation, polled between steps and takes.
@@ -122,6 +132,7 @@ impl Default for QuadCageOptions {
             adaptive: false,
             crease_angle_deg: 45.0,
             coarsest: vec![16, 64, 256],
+            rotate_edges: true,
             pairing: PairOptions::default(),
             cancel: Cancel::default(),
         }
@@ -143,6 +154,8 @@ pub struct QuadCageReport {
     pub spacing: f64,
     /// Takes of the lattice (step 5).
     pub attempts: usize,
+    /// Edges rotated towards regular valence in the cage kept (step 7).
+    pub rotations: usize,
     /// Faces by size: `(corners, count)`, ascending.
     pub face_sizes: Vec<(usize, usize)>,
     /// Vertices by valence (edges at the vertex): `(valence, count)` over interior vertices.
@@ -251,6 +264,8 @@ struct Working {
     caps: Vec<[f64; 3]>,
     tris: Vec<[u32; 3]>,
     graph: Graph,
+    /// The working mesh for closest-point queries (the rotations' relaxation, step 7).
+    surface: TriangleBvh,
     boundary: Vec<Vec<u32>>,
     genus: u32,
     area: f64,
@@ -281,6 +296,7 @@ impl Working {
             .map(|l| l.into_iter().map(|v| v.0).collect())
             .collect();
         let graph = Graph::new(working.positions.clone(), &tris);
+        let surface = TriangleBvh::new(working.positions.clone(), tris.clone());
         let area = tris
             .iter()
             .map(|t| {
@@ -294,6 +310,7 @@ impl Working {
             mesh: working,
             tris,
             graph,
+            surface,
             boundary,
             area,
             lattice_n,
@@ -316,8 +333,7 @@ fn lattice_cage(
         working_vertices: w.mesh.num_vertices(),
         ..QuadCageReport::default()
     };
-    let (graph, tris, boundary, working) = (&w.graph, &w.tris, &w.boundary, &w.mesh);
-    let (genus, loops, lattice_n) = (w.genus, w.boundary.len() + w.caps.len(), w.lattice_n);
+    let (graph, tris, working, lattice_n) = (&w.graph, &w.tris, &w.mesh, w.lattice_n);
     let mut s = (w.area / lattice_n).sqrt();
     let lines = field_lines(graph, tris, target, s, options);
     let hierarchy = Hierarchy::new(graph.clone(), coarsest);
@@ -330,32 +346,20 @@ fn lattice_cage(
     } else {
         vec![1.0; graph.len()]
     };
-    let mut best: Option<(PolyMesh, f64)> = None;
+    let mut best: Option<(PolyMesh, f64, usize)> = None;
     let mut reason = String::from("no take");
     for attempt in 0..MAX_ATTEMPTS {
         report.attempts = attempt + 1;
         let spacing: Vec<f64> = relative.iter().map(|r| r * s).collect();
         let p = position_field(&hierarchy, &o, &spacing, options.position_sweeps);
         options.cancel.check()?;
-        let taken = take(
-            graph,
-            tris,
-            &o,
-            &p,
-            &spacing,
-            target,
-            options,
-            split,
-            boundary,
-            &w.caps,
-            (genus, loops),
-        );
+        let taken = take(w, &o, &p, &spacing, target, options, split);
         let count = match taken {
-            Ok(cage) => {
+            Ok((cage, rotations)) => {
                 let m = cage.num_vertices();
-                let better = m <= n && best.as_ref().is_none_or(|(b, _)| m > b.num_vertices());
+                let better = m <= n && best.as_ref().is_none_or(|(b, _, _)| m > b.num_vertices());
                 if better {
-                    best = Some((cage, s));
+                    best = Some((cage, s, rotations));
                 }
                 m
             }
@@ -372,10 +376,11 @@ fn lattice_cage(
         }
         s *= (count as f64 / goal).sqrt();
     }
-    let Some((cage, spacing)) = best else {
+    let Some((cage, spacing, rotations)) = best else {
         return Err(QuadCageError::Extraction { budget: n, reason });
     };
     report.spacing = spacing;
+    report.rotations = rotations;
     describe(&cage, &mut report);
     Ok((cage, report))
 }
@@ -384,18 +389,27 @@ fn lattice_cage(
 /// checked against `want`. Errors: why, as text.
 #[allow(clippy::too_many_arguments)]
 fn take(
-    graph: &Graph,
-    tris: &[[u32; 3]],
+    w: &Working,
     o: &[[f64; 3]],
     p: &[[f64; 3]],
     s: &[f64],
     target: &Target,
     options: &QuadCageOptions,
     split: bool,
-    loops: &[Vec<u32>],
-    caps: &[[f64; 3]],
-    want: (u32, usize),
-) -> Result<PolyMesh, String> {
+) -> Result<(PolyMesh, usize), String> {
+    let (graph, tris, loops, caps) = (&w.graph, &w.tris, &w.boundary, &w.caps);
+    let mut rotations = 0;
+    // Step 7, before the split (a defect of the coarse cage is one of the split's too) and
+    // after it.
+    let mut rotate = |cage: PolyMesh| {
+        if !options.rotate_edges {
+            return cage;
+        }
+        let (rotated, k) = rotate::rotate_for_valence(&cage, &w.surface);
+        rotations += k;
+        rotated
+    };
+    let want = (w.genus, w.boundary.len() + w.caps.len());
     let mut offsets = offsets::Offsets::new(graph, o, p, s);
     offsets.remove_dislocations(tris);
     let mut labels = regions(graph, &offsets);
@@ -411,8 +425,9 @@ fn take(
         &options.pairing,
     )
     .map_err(|e| e.to_string())?;
+    let paired = rotate(paired);
     let cage = if split {
-        split_into_quads(&paired)
+        rotate(split_into_quads(&paired))
     } else {
         paired
     };
@@ -425,7 +440,7 @@ fn take(
             got.0, got.1, want.0, want.1
         ));
     }
-    Ok(cage)
+    Ok((cage, rotations))
 }
 
 /// A boundary loop shorter than this many lattice spacings is a small hole: capped while the
