@@ -16,6 +16,7 @@
 
 use std::time::{Duration, Instant};
 
+use subfit_mesh::bvh::TriangleBvh;
 use subfit_mesh::{
     split_concave_corners, Cancel, Cancelled, ConcaveSplits, HalfEdgeMesh, PolyMesh, Tags,
     TopologyError,
@@ -27,7 +28,8 @@ use crate::semi_sharp::semi_sharp_tags;
 use crate::carve::carve_cancellable;
 use crate::contour::{contour, ContourError, ContourOptions, ContourReport};
 use crate::cross_field::{
-    quad_cage, split_into_quads_tagged, QuadCageError, QuadCageOptions, QuadCageReport,
+    quad_cage, rotate_for_valence, split_into_quads_tagged, QuadCageError, QuadCageOptions,
+    QuadCageReport,
 };
 use crate::quads::{pair_triangles, PairOptions, PairReport};
 use crate::simplify::{
@@ -86,6 +88,10 @@ pub struct InitOptions {
     /// `n`-gon into `n`), the simplification taken at about a quarter of the count
     /// ([`QUARTER_SPLIT`]), so that the cage is all quads. Default `false`.
     pub split_into_quads: bool,
+    /// With [`Self::quad_dominant`]: the paired (and split) cage's interior quad–quad edges
+    /// rotated towards regular valence ([`crate::cross_field::rotate_for_valence`]), its
+    /// creases and corners kept. Default `true`.
+    pub rotate_edges: bool,
     /// Detect sharp features with these options and keep them as crease and corner tags of a
     /// feature-aligned cage: a mesh target's sharp edges, or (with [`Self::cloud_features`]) a
     /// point cloud's crease curves with the contour snapped to them
@@ -149,6 +155,7 @@ impl Default for InitOptions {
             pairing: PairOptions::default(),
             cross_field: None,
             split_into_quads: false,
+            rotate_edges: true,
             features: None,
             semi_sharp: false,
             cloud_features: false,
@@ -603,10 +610,26 @@ pub fn initial_control_mesh(
         report.timings.pair = t.elapsed();
         report.pairing = Some(prep);
     }
+    // The surface the rotations relax vertices on: the target's mesh, or the contour.
+    let rotate = options.quad_dominant && options.rotate_edges;
+    let contour_surface = match (rotate, target.mesh()) {
+        (true, None) => Some(TriangleBvh::new(
+            dense.positions.clone(),
+            dense.faces.triangulate_fan(),
+        )),
+        _ => None,
+    };
+    let surface = target.mesh().or(contour_surface.as_ref());
+    if let (true, Some(surface)) = (rotate, surface) {
+        out = rotate_for_valence(&out, surface, &report.tags).0;
+    }
     if split {
         let (quads, tags) = split_into_quads_tagged(&out, &report.tags);
         out = quads;
         report.tags = tags;
+        if let (true, Some(surface)) = (rotate, surface) {
+            out = rotate_for_valence(&out, surface, &report.tags).0;
+        }
     }
     finish(out, report, loops_before, t0, options)
 }

@@ -54,6 +54,7 @@ mod extract;
 pub(crate) mod field;
 mod offsets;
 mod rotate;
+pub use rotate::rotate_for_valence;
 mod spacing;
 
 use std::time::Instant;
@@ -405,7 +406,7 @@ fn take(
         if !options.rotate_edges {
             return cage;
         }
-        let (rotated, k) = rotate::rotate_for_valence(&cage, &w.surface);
+        let (rotated, k) = rotate::rotate_for_valence(&cage, &w.surface, &Tags::new());
         rotations += k;
         rotated
     };
