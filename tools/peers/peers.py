@@ -98,7 +98,9 @@ class Runner:
     def prepare(self, row, entry_dir, scratch):
         """The worker's job: the model read once by subfit (the reader the bench uses) and
         written as PLY for MeshLab, and the settings. Raises RuntimeError on a bad row."""
-        if row["kind"] not in ("mesh", "points"):
+        # A cage pair's input is its dense mesh: the peers remesh it at the given cage's count.
+        kind = "mesh" if row["kind"] == "cage-pair" else row["kind"]
+        if kind not in ("mesh", "points"):
             raise RuntimeError(f"kind `{row['kind']}`: the peers need a mesh or a point cloud")
         source = pathlib.Path(row["input"])
         if not source.is_file():
@@ -108,10 +110,10 @@ class Runner:
         run = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         if run.returncode != 0:
             raise RuntimeError(f"subfit convert failed: {run.stdout.strip()[-300:]}")
-        trim = self.args.trim_points if row["kind"] == "points" else self.args.trim_mesh
+        trim = self.args.trim_points if kind == "points" else self.args.trim_mesh
         job = {
             "entry": row["entry"], "input": str(source), "input_ply": str(ply),
-            "kind": row["kind"], "category": row["category"],
+            "kind": kind, "category": row["category"],
             "vertices": row["control_points"], "subfit": str(self.subfit),
             "depth": self.args.depth, "threads": 1,
             "trim_quantile": trim, "fit_method": self.args.fit_method,

@@ -171,8 +171,8 @@ fn truncate(s: &str, n: usize) -> String {
 }
 
 fn pair_table(s: &mut String, rows: &[&Row]) {
-    s.push_str("| pair | exit | ours: cps / quads / irregular | ours RMS / H | given: cps / quads / irregular | given RMS / H | pass |\n");
-    s.push_str("|---|---|---|---|---|---|---|\n");
+    s.push_str("| pair | exit | ours: cps / quads / irregular | ours RMS / H | given: cps / quads / irregular | given RMS / H | QuadriFlow + fit: cps / quads / irregular, RMS / H | pass |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let g = r.given.as_ref();
         let stats = |c: Option<&crate::cage_stats::CageStats>| {
@@ -192,15 +192,25 @@ fn pair_table(s: &mut String, rows: &[&Row]) {
                 pct(j.map(|j| j.hausdorff_fraction))
             )
         };
+        // The remesher a user would try for a quad cage, fitted at about the same count.
+        let quadriflow = r
+            .peers
+            .iter()
+            .find(|p| p.by == "quadriflow")
+            .map_or("–".into(), |p| match &p.judge {
+                Some(j) => format!("{}, {}", stats(Some(&p.stats)), errs(Some(j))),
+                None => "failed".into(),
+            });
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
             r.entry,
             r.exit().map_or("–".into(), |e| e.label()),
             stats(r.cage.as_ref()),
             errs(r.judge.as_ref()),
             stats(g.map(|g| &g.stats)),
             errs(g.and_then(|g| g.judge.as_ref())),
+            quadriflow,
             pass_mark(r.pass),
         );
     }

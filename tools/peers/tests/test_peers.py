@@ -130,6 +130,8 @@ def test_peers_on_an_icosphere(tmp_path):
          "kind": "mesh", "control_points": 100},
         {"entry": "failed", "input": str(model), "category": "scan", "kind": "mesh",
          "control_points": None},
+        {"entry": "pair", "input": str(model), "category": "cage", "kind": "cage-pair",
+         "control_points": 100},
     ]}  # fmt: skip
     (tmp_path / "ours.json").write_text(json.dumps(ours))
     out = tmp_path / "peers"
@@ -139,7 +141,10 @@ def test_peers_on_an_icosphere(tmp_path):
     assert run.returncode == 0, run.stderr
     rows = json.loads((out / "peers.json").read_text())["peers"]
     by = {(r["entry"], r["peer"]): r for r in rows}
-    assert {e for e, _ in by} == {"sphere", "gone"}  # the failed fit has no peers
+    assert {e for e, _ in by} == {"sphere", "gone", "pair"}  # the failed fit has no peers
+    # A cage pair's dense mesh is remeshed like a mesh entry (QuadriFlow + fit is its row).
+    assert by[("pair", "quadriflow")]["error"] is None, by[("pair", "quadriflow")]
+    assert by[("pair", "quadriflow")]["quad_fraction"] == 1.0
     for peer in ("poisson-qem", "instant-meshes", "quadriflow"):
         assert "no such file" in by[("gone", peer)]["error"]
         r = by[("sphere", peer)]
