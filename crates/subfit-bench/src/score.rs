@@ -166,6 +166,22 @@ fn pair_row(entry: &Entry, control: &Path, dense: &Path, dir: &Path, settings: &
             return row;
         }
     };
+    // A cage whose faces disagree in orientation has no limit surface until they agree; the
+    // fit's reader repairs the same on its inputs, so the given cage is repaired alike.
+    let (given, reoriented) = match subfit::mesh::reorient_faces(
+        &given.faces,
+        given.num_vertices(),
+        Some(&given.positions),
+    ) {
+        Ok((faces, report)) if report.needed => (
+            PolyMesh { faces, ..given },
+            Some(format!(
+                "given cage: {} faces re-oriented to agree with their neighbours",
+                report.flipped_faces
+            )),
+        ),
+        _ => (given, None),
+    };
     let tags =
         subfit::io::read_tags_file(control, given.num_vertices()).unwrap_or_else(|_| Tags::new());
     // The given cage's scheme: Loop for a triangle cage, Catmull-Clark otherwise.
@@ -206,6 +222,12 @@ fn pair_row(entry: &Entry, control: &Path, dense: &Path, dir: &Path, settings: &
         });
     }
     judge_fit(&mut row, entry, mesh, &args, &out, dir, settings);
+    if let Some(r) = reoriented {
+        row.note = Some(match row.note.take() {
+            Some(n) => format!("{n}; {r}"),
+            None => r,
+        });
+    }
     row
 }
 

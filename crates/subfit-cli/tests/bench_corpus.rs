@@ -106,3 +106,49 @@ fn a_plain_folder_is_scored_and_its_rows_reused() {
     );
     assert!(String::from_utf8_lossy(&r.stdout).contains("regression: torus rms"));
 }
+
+/// A cage pair whose given cage has faces that disagree in orientation (as one of the
+/// corpus's does): the given cage is re-oriented, as the fit's reader does for its input, and
+/// judged next to ours, and the row says so.
+#[test]
+fn a_given_cage_with_flipped_faces_is_reoriented_and_judged() {
+    let d = tempfile::tempdir().unwrap();
+    let corpus = d.path().join("corpus");
+    let pair = corpus.join("pair");
+    std::fs::create_dir_all(&pair).unwrap();
+    let mut cage = subfit::mesh::shapes::octahedron_mesh(1.0, 0.8, 0.6);
+    let mut faces: Vec<Vec<u32>> = cage.faces.iter().map(<[u32]>::to_vec).collect();
+    for f in faces.iter_mut().take(3) {
+        f.reverse();
+    }
+    let mut polygons = subfit::mesh::Polygons::new();
+    for f in &faces {
+        polygons.push(f);
+    }
+    cage.faces = polygons;
+    let dense = subfit::mesh::shapes::geodesic_sphere(3);
+    subfit::io::write_file(&pair.join("control.obj"), &cage, &Default::default()).unwrap();
+    subfit::io::write_file(&pair.join("dense.obj"), &dense, &Default::default()).unwrap();
+    std::fs::write(
+        corpus.join("manifest.tsv"),
+        "file\tcategory\tkind\npair/control.obj\tcage\tcage-pair\npair/dense.obj\tcage\tcage-pair\n",
+    )
+    .unwrap();
+    let out = d.path().join("board.json");
+    let r = bench(&corpus, &out, &["--surface-samples", "20000"]);
+    assert!(
+        r.status.code().is_some(),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let b = board(&out);
+    let row = &b["rows"][0];
+    assert_eq!(row["kind"], "cage-pair");
+    assert!(
+        row["given"]["judge"]["rms_fraction"].as_f64().is_some(),
+        "the given cage was not judged: {}",
+        row["given"]
+    );
+    let note = row["note"].as_str().unwrap_or("");
+    assert!(note.contains("3 faces re-oriented"), "{note}");
+}
