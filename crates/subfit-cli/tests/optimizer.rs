@@ -1,4 +1,4 @@
-//! `subfit fit --optimizer adam|lbfgs`: the first-order path of issue 16 runs end to end,
+//! `subfit fit --optimizer adam|lbfgs`: the first-order path runs end to end,
 //! is recorded in report.json, lowers the error, and a bad step size is a usage error.
 
 mod common;

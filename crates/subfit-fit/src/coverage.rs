@@ -1,4 +1,4 @@
-//! The data → surface part of the objective ("coverage"; DESIGN.md decision 11, issue 14's
+//! The data → surface part of the objective ("coverage"; DESIGN.md decision 11;
 //! boundary-aware fitting, Lavoué et al. 2005 §4.2 and §5.2 on boundaries that must reach the
 //! data's edge).
 //!
@@ -53,7 +53,7 @@
 //! given (segments, e.g. the sharp edges the feature-aligned cage was built along), each
 //! segment's midpoint also pulls its nearest sample on a crease of the tessellation, across
 //! the data curve only (`Q = I − t tᵀ`), so the crease curve of the limit surface is fitted to
-//! the feature curve (issue 15) rather than left to the surface samples on either side of it.
+//! the feature curve rather than left to the surface samples on either side of it.
 //! Weighted by [`FEATURE_WEIGHT`].
 //!
 //! Cost per projection: a kd-tree over the `m` samples (O(m log m), parallel above 50k), one
@@ -259,7 +259,7 @@ impl Coverage {
 
     /// Adds the data's sharp feature curves, given as segments (normalized units; e.g. the
     /// sharp edges of [`subfit_target::detect_features`]): the crease curve of the limit
-    /// surface is fitted to them (issue 15; Hoppe et al. 1994 §3 fit the creases of their
+    /// surface is fitted to them (Hoppe et al. 1994 §3 fit the creases of their
     /// tagged surfaces by the same point-to-surface energy, Lavoué et al. 2005 §4.2 fit
     /// boundary curves with a curve distance). Each segment's midpoint `p` pulls the nearest
     /// sample on a crease of the cage's tessellation perpendicular to the segment,

@@ -75,7 +75,7 @@ impl Splitter {
 /// How much a face along a crease is preferred when refinement cannot split every face above
 /// the tolerance (the growth or control-point budget): its score counts this many times for
 /// the order (not for whether it is above the tolerance). A sharp feature is where a smooth
-/// patch misses most and where a split buys most (issue 15: "refinement prefers feature
+/// patch misses most and where a split buys most ("refinement prefers feature
 /// regions").
 pub(crate) const FEATURE_PRIORITY: f64 = 2.0;
 

@@ -58,7 +58,7 @@ pub struct StageOptions {
     pub tolerance_max: f64,
     /// The largest distance (normalized units) of a mesh target's boundary vertices to the
     /// limit surface, judged with [`Self::tolerance_max`] (0 = none; needs a max tolerance):
-    /// an open surface's rim is judged tighter than the rest (issue 14: every boundary vertex
+    /// an open surface's rim is judged tighter than the rest (every boundary vertex
     /// within 0.5 % of the diagonal). Default 0.
     pub tolerance_boundary: f64,
     /// The part of the data → surface RMS that is the data's own noise (normalized units;

@@ -1,4 +1,4 @@
-//! The first-order path (issue 16): the objective's gradient `∇_P F = Cᵀ ∂F/∂S` against
+//! The first-order path: the objective's gradient `∇_P F = Cᵀ ∂F/∂S` against
 //! central differences of the objective itself (SDM with smoothing, SDM with ARAP, IMLS; they
 //! agree to 5e-5 of the largest entry for steps from 1e-5 to 1e-7, the rest being the point
 //! cloud's piecewise-smooth distance field: blended local quadrics, the IMLS fallback), and

@@ -6,7 +6,7 @@
 //! supported by a few of them. But a single-view range scan also holds real, small, separate
 //! pieces — a one-pixel strip of a flat base seen edge-on, a patch of the far side seen through
 //! a gap between the ears. Dropped, their points are 12–20 % of the diagonal from the surface
-//! (measured on four simulated scans of `bunny.off`, issue 14), and a fit that leaves data
+//! (measured on four simulated scans of `bunny.off`), and a fit that leaves data
 //! uncovered has not reached its tolerance (DESIGN.md decision 11). A blob around stray points
 //! sits next to data the kept surface already covers; an island is the only surface near its
 //! points. So a component that would be dropped is kept when at least [`MIN_ISLAND_POINTS`] data

@@ -263,7 +263,7 @@ fn candidates(
 /// [`MAX_HOLE_CORNER_DEG`] at a boundary vertex (`a` or `c`) around which the faces span
 /// more than [`HOLE_TURN_DEG`] (`span`, per vertex; the corner is the two triangles' angles
 /// there together). Around a small hole the faces at a boundary vertex span about 300°. On
-/// the armadillo with 27 holes (`hard_cases holes`, issue 14), one hole's three-vertex cage
+/// the armadillo with 27 holes (`hard_cases holes`), one hole's three-vertex cage
 /// loop had a vertex with two quads, corners 144° and 153°; once refined, the loop tangled
 /// and grew to five times the hole, and `subfit fit --scheme quad-tri` ended at 1,531 control
 /// points with a Hausdorff distance of 1.01 % of the diagonal (tolerance missed). With this

@@ -1,4 +1,4 @@
-//! Semi-sharp crease tags from the data's fillet widths (`--semi-sharp`, issue 15).
+//! Semi-sharp crease tags from the data's fillet widths (`--semi-sharp`).
 //!
 //! A feature-aligned cage tags its feature curves as infinitely sharp creases. A rounded edge
 //! of the data — a fillet a few triangles wide ([`subfit_target::fillet_widths`]) — is better

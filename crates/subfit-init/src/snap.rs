@@ -1,5 +1,5 @@
 //! Feature-aligned contours of point clouds: the dense contour is snapped to the cloud's
-//! crease curves (issue 15).
+//! crease curves.
 //!
 //! The IMLS contour of a point cloud ([`crate::contour()`]) rounds sharp edges, and its edges
 //! run across them. Before simplification, each crease curve of the cloud

@@ -6,7 +6,7 @@
 //! contour has no component there (the IMLS zero set of one point is not a surface) or one too
 //! small to keep as an island ([`crate::islands::MIN_ISLAND_POINTS`]). Left alone, those
 //! points end 1–4 % of the diagonal from the fitted surface (measured on five simulated
-//! 400 × 400 views of the armadillo, `hard_cases range-scan`, issue 14), and a fit that leaves
+//! 400 × 400 views of the armadillo, `hard_cases range-scan`), and a fit that leaves
 //! data uncovered has not reached its tolerance (DESIGN.md decision 11).
 //!
 //! So the points farther than the island gap from the trimmed contour are linked into clusters

@@ -1,4 +1,4 @@
-//! Feature-aligned cages of point clouds (issue 15): a box sampled as points gives a cage whose
+//! Feature-aligned cages of point clouds: a box sampled as points gives a cage whose
 //! creases follow the box's edges and whose corners sit at the box's corners; the contour is
 //! only moved, so genus and manifoldness are kept.
 #![allow(clippy::print_stdout)]

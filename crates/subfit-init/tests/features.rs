@@ -1,4 +1,4 @@
-//! Feature-aligned simplification (issue 15): the sharp edges of a CAD-like box stay cage
+//! Feature-aligned simplification: the sharp edges of a CAD-like box stay cage
 //! edges, tagged as creases, its corners stay where they are, tagged as corners, and the flat
 //! sides keep only the vertices their shape needs (`exact_error`).
 

@@ -1,4 +1,4 @@
-//! Open point clouds give open cages, closed ones stay closed (issue 14; DESIGN.md §3.6: the
+//! Open point clouds give open cages, closed ones stay closed (DESIGN.md §3.6: the
 //! initial mesh has the target's topology, boundary loops included).
 //!
 //! * Open: points on a hemisphere and on a half-cylinder patch, and simulated single-view range
@@ -258,7 +258,7 @@ fn a_range_scan_of_a_torus_gives_an_annulus() {
     check_open("torus scan", &points, 0, 2);
 }
 
-/// A range image of a height field seen from above (issue 48, "a single view is one sheet"):
+/// A range image of a height field seen from above ("a single view is one sheet"):
 /// the unit sphere's cap `z = √(1 − x² − y²)` sampled on a regular 120 × 120 grid of rays along
 /// −z (sparse where the surface turns away, as a scanner sees it) out to `r = 0.97`, where the
 /// surface is 76° from the view — the silhouette edge of the view —, with two occlusion holes

@@ -1,4 +1,4 @@
-//! Concave corners of a tagged cage split by a crease (issue 15).
+//! Concave corners of a tagged cage split by a crease.
 //!
 //! At a corner (a vertex tagged as a corner, or where three or more sharp edges meet, boundary
 //! edges counted) the limit surface of every sector between two consecutive sharp edges is, to

@@ -815,7 +815,7 @@ impl XorShift {
     }
 }
 
-/// A noisy scan of `mesh` (issue 16): `n` points sampled uniformly by area, each moved by
+/// A noisy scan of `mesh`: `n` points sampled uniformly by area, each moved by
 /// Gaussian noise of `noise` × the bounding-box diagonal per coordinate, followed by
 /// `outliers` × `n` points uniform in the bounding box grown by 10 % per side. Seeded by
 /// `seed` ([`XorShift`]). An empty vector for a mesh without faces or area.
@@ -868,7 +868,7 @@ pub fn noisy_scan(
     points
 }
 
-/// An artist-like mixed quad/triangle control cage of 201 points (issue 13's hidden check
+/// An artist-like mixed quad/triangle control cage of 201 points (the hidden check
 /// compares fits with an artist's 201-point cage): a 5 × 4 × 8 grid box rounded into a body
 /// (semi-axes about 0.6 × 0.45 × 1), four legs, a head and a tail pulled out of it, and 15 of
 /// its quads (drawn by `XorShift::new(3)`) turned into fans of 4 triangles around a raised

@@ -1,4 +1,4 @@
-//! Preprocessing time of target analysis on a noisy 150k-point scan (issue 16): 0.3 % (of the
+//! Preprocessing time of target analysis on a noisy 150k-point scan: 0.3 % (of the
 //! bounding-box diagonal) Gaussian noise and 3 % outliers uniform in the bounding box.
 //!
 //! `cargo run --release -p subfit-target --example noisy_bench [-- N [SHAPE]]`, `SHAPE` one of

@@ -1,5 +1,5 @@
 //! Boundary loops of a mesh target and the sharp turns along them (Lavoué et al. 2005 §4.2:
-//! "corner rules (eq. 3) at detected sharp turns" of a boundary; issue 14).
+//! "corner rules (eq. 3) at detected sharp turns" of a boundary).
 //!
 //! A boundary loop is the cycle of edges used by one triangle. A turn is measured at the
 //! scale of the shape, not of its triangles: at a boundary vertex the chords to the boundary

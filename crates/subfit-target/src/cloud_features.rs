@@ -1,4 +1,4 @@
-//! Sharp features of point clouds: crease curves and corners (issue 15).
+//! Sharp features of point clouds: crease curves and corners.
 //!
 //! A point cloud has no edges whose dihedral angle could be measured ([`crate::features`] does
 //! that for meshes); its sharp features show as normal discontinuities. This module follows the

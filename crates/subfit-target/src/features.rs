@@ -3,7 +3,7 @@
 //! Cheng et al. 2007 name sharp features as future work (§V); Lavoué et al. 2005 (§6, Fig. 13)
 //! segment CAD objects and tag the patch boundaries as sharp control edges; Hoppe et al. 1994
 //! (*Piecewise smooth surface reconstruction*) tag sharp edges, corners and darts. This module
-//! finds them on a triangle or polygon mesh, as the input of feature-aligned cages (issue 15):
+//! finds them on a triangle or polygon mesh, as the input of feature-aligned cages:
 //!
 //! 1. **Sharp edges**: interior manifold edges whose dihedral angle (the angle between the two
 //!    face normals, with the faces' relative orientation taken into account, so a mis-oriented

@@ -1,7 +1,7 @@
 //! Fillet widths of sharp feature curves: how wide the band is over which a mesh target's
 //! surface turns from one side of a feature curve to the other — zero for a designed crease, a
 //! few triangles for a rounded (filleted or worn) edge. The input of semi-sharp crease tags
-//! (`subfit fit --semi-sharp`, issue 15): OpenSubdiv's sharpness `s` keeps a crease sharp for
+//! (`subfit fit --semi-sharp`): OpenSubdiv's sharpness `s` keeps a crease sharp for
 //! `s` levels and then lets the smooth rules round it (DeRose, Kass and Truong 1998,
 //! *Subdivision Surfaces in Character Animation*, §3), so a wider fillet needs a smaller `s`.
 //!

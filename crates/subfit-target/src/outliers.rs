@@ -13,7 +13,7 @@
 //!    single-view range scan is sparse where the surface turns away from the scanner (returns
 //!    up to 80° from the view are up to 6 pixels apart across the rim but one along it; bumps
 //!    near the silhouette leave single returns on the surface's continuation) and in slivers
-//!    seen through gaps; those are data. On six simulated scans of `bunny.off` (issue 14) the
+//!    seen through gaps; those are data. On six simulated scans of `bunny.off` the
 //!    rules without this exemption dropped 6–41 such points each, and the fitted surface
 //!    ended 1.6–5.4 % of the diagonal from them; with it, 0–4 are dropped. A point scattered in
 //!    space has neither (900 uniform outliers around a clean 30k-point sphere: 827 caught
@@ -36,7 +36,7 @@
 //!    [`crate::cloud_rim`]'s criterion) and in the direction of that gap. A single-view range
 //!    scan leaves lone returns there where the surface turns away near the silhouette, 1–3.5 `D`
 //!    beyond the last row (returns up to 80° from the view). On six simulated scans of
-//!    `bunny.off` (issue 14), rules 1–3 dropped 0–4 such points per view, and the fitted surface
+//!    `bunny.off`, rules 1–3 dropped 0–4 such points per view, and the fitted surface
 //!    ended 1.5–2.2 % of the diagonal from them; this rule keeps all seven. A stray point above a
 //!    closed surface is never past an edge; around an open one, those beside its rim are
 //!    (`subfit analyze --json`, 900 points uniform in the box around 30k points of a clean
@@ -45,7 +45,7 @@
 //!    one point in [`FEW_PER`] (2,000), rule 4 runs again with the reach [`LONE_REACH`] (8 `D`):
 //!    a clean scan flags that few where it sees small parts alone past an occluding edge (a
 //!    claw through a gap, a toe's tip behind another), not where it is contaminated, whose
-//!    stray returns come at a rate. On six simulated views of the armadillo (issue 14) rules 1–4
+//!    stray returns come at a rate. On six simulated views of the armadillo rules 1–4
 //!    dropped 0–4 points each, all within 5e-4 of the diagonal of the true surface and 1.3–2.6 %
 //!    from the rest of the scan; the init's specks then cover them (`subfit_init::specks`, in
 //!    the crate that builds cages). A point above the middle of a surface is not past an edge:

@@ -1,4 +1,4 @@
-//! Sharp features of point clouds (issue 15, `subfit_target::cloud_features`): generated CAD-like
+//! Sharp features of point clouds (`subfit_target::cloud_features`): generated CAD-like
 //! shapes sampled with seeded randomness give their crease curves and corners; smooth shapes
 //! give none. Real scans (`$SUBFIT_DATA`) follow at the end: without `SUBFIT_DATA` they fail
 //! when `CI=true`, else print a notice and pass.

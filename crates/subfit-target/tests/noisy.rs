@@ -1,4 +1,4 @@
-//! Noisy scans with outliers (issue 16): outliers are dropped, clean samplings keep their
+//! Noisy scans with outliers: outliers are dropped, clean samplings keep their
 //! points, the noise level is estimated and the normals of a noisy closed shape are oriented
 //! outward. Generated shapes, seeded; no timing.
 

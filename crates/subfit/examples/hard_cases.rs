@@ -1,5 +1,5 @@
 //! Hard cases made from a closed mesh, for checking open-surface fits on data we do not have
-//! (issue 14's hidden checks: a single-view range scan of a closed animal, a mesh with many
+//! (the hidden checks: a single-view range scan of a closed animal, a mesh with many
 //! holes, a statue open at its base):
 //!
 //! ```text
@@ -20,7 +20,7 @@
 //!   fit` splits with a warning); holes that would touch another one are skipped.
 //! * `noisy`: `N` points (default 150,000) sampled uniformly by area, moved by Gaussian noise of
 //!   `NOISE` × the diagonal (default 0.003) and joined by `OUTLIERS` × N points (default 0.03)
-//!   drawn uniformly in the bounding box grown by 10 % (issue 16's noisy scans). Points only.
+//!   drawn uniformly in the bounding box grown by 10 % (the noisy scans). Points only.
 //! * `cut`: the faces whose centroid lies below `FRACTION` (default 0.05) of the extent along
 //!   `AXIS` (x, y or z; default y) are removed: open at the base.
 #![allow(clippy::print_stdout)]

@@ -1,5 +1,5 @@
-//! Three open CAD-like patches in the spirit of Lavoué et al. 2007, Table 1 and Fig. 12 (issue
-//! 14 asks for that kind of result on patches of our own making), written as triangle meshes
+//! Three open CAD-like patches in the spirit of Lavoué et al. 2007, Table 1 and Fig. 12 (that
+//! kind of result on patches of our own making), written as triangle meshes
 //! scaled to the unit cube (longest side 1, the paper's units for its `E_L1`):
 //!
 //! ```text

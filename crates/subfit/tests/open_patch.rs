@@ -1,4 +1,4 @@
-//! Open patches through the whole pipeline with defaults (issue 14): the rim of the limit
+//! Open patches through the whole pipeline with defaults: the rim of the limit
 //! surface reaches the data's edge (the data → surface part of the objective), genus and
 //! boundary loops are kept, and the two-sided tolerance holds. (Patches with corners in their
 //! rim are not yet fitted this well: see `subfit_target::boundary_corners`.)

@@ -33,7 +33,7 @@ struct Model {
     /// The data term.
     method: Method,
     /// `subfit fit`'s defaults: the target's own tolerances ([`FitScanOptions::target_tolerances`];
-    /// `tolerance`, `max_error` and `max_control_points` unused), as issue 14's open models
+    /// `tolerance`, `max_error` and `max_control_points` unused), as the open models
     /// are judged.
     defaults: bool,
     /// Fitted to this many points sampled uniformly by area on the file's triangles, each
@@ -71,7 +71,7 @@ impl Model {
     }
 }
 
-/// An open model of issue 14, fitted with `subfit fit`'s defaults ([`Model::defaults`]).
+/// An open model, fitted with `subfit fit`'s defaults ([`Model::defaults`]).
 const fn open_model(
     name: &'static str,
     file: &'static str,
@@ -178,7 +178,7 @@ const MODELS: &[Model] = &[
     },
     // Xie et al. 2023 Fig. 6 and 13: the bunny's points (no normals used from the file: the
     // OBJ has none) fitted with the IMLS term at a fixed 314 and 4,667 control points, and SDM
-    // at 4,667 beside it. Goals (issue 16): two-sided RMS ≤ 3e-3 / 1e-3 of the diagonal.
+    // at 4,667 beside it. Goals: two-sided RMS ≤ 3e-3 / 1e-3 of the diagonal.
     Model {
         name: "bunny-imls-314",
         file: "stanford-bunny.obj",
@@ -221,10 +221,10 @@ const MODELS: &[Model] = &[
     // Issue 14's open models with `subfit fit`'s defaults: boundary loops and genus kept,
     // two-sided RMS ≤ 1e-3 and Hausdorff ≤ 1 % of the diagonal (the fit's own default
     // tolerances are 0.075 % and 0.7 %, boundary vertices 0.4 %).
-    open_model("face", "face.obj", false, "issue 14 (open, 1 loop): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
-    open_model("camelhead", "camelhead.off", false, "issue 14 (open, 1 loop): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
-    open_model("beetle", "beetle.off", false, "issue 14 (open, 11 loops): two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
-    open_model("bun000", "bun000_points.ply", true, "issue 14 (single-view scan): an open surface, two-sided RMS ≤ 1e-3 of the diagonal"),
+    open_model("face", "face.obj", false, "open, 1 loop: two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
+    open_model("camelhead", "camelhead.off", false, "open, 1 loop: two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
+    open_model("beetle", "beetle.off", false, "open, 11 loops: two-sided RMS ≤ 1e-3, Hausdorff ≤ 1 % of the diagonal"),
+    open_model("bun000", "bun000_points.ply", true, "single-view scan: an open surface, two-sided RMS ≤ 1e-3 of the diagonal"),
     // A million points of a real scan's surface with `subfit fit`'s defaults: the scale the
     // preprocessing and the fit must stay near-linear in (run with `--models igea-1m`).
     Model {

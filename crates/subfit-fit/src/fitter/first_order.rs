@@ -1,4 +1,4 @@
-//! The first-order path (issue 16): the fitter's objective `F(P)` with its gradient
+//! The first-order path: the fitter's objective `F(P)` with its gradient
 //! `∇_P F = Cᵀ ∂F/∂S` (+ the smoothing, surface-term and ARAP parts), and the Adam and L-BFGS
 //! drivers of [`Optimizer`]. Xie et al. 2023 (§3.1, §5.1) minimize their IMLS + ARAP energy
 //! with Adam through a dense Jacobian on a GPU; here the gradient is one sparse product with

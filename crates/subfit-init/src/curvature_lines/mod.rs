@@ -1,6 +1,6 @@
 //! The initial control mesh of an open mesh target from its boundaries and its lines of
-//! curvature (Lavoué et al. 2007, "Subdivision surface fitting with quad/triangle meshes" §4;
-//! issue 14), the other initializer beside QEM simplification ([`crate::initial_control_mesh`]):
+//! curvature (Lavoué et al. 2007, "Subdivision surface fitting with quad/triangle meshes" §4),
+//! the other initializer beside QEM simplification ([`crate::initial_control_mesh`]):
 //!
 //! 1. **Boundary curves** (§4.2, [`boundary_curve`]): each boundary loop of the target, with its
 //!    sharp turns ([`subfit_target::boundary_corners`]) as corners, is approximated by a closed
