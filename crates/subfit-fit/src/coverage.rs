@@ -572,7 +572,7 @@ fn mean_edge_length(faces: &Polygons, xs: &[[f64; 3]]) -> f64 {
 
 /// Unit vertex normals of the polygon mesh `faces` over `xs` (Newell normals of the faces,
 /// area-weighted, summed at their vertices; zero where they cancel). Cost O(#corners).
-fn vertex_normals(faces: &Polygons, xs: &[[f64; 3]]) -> Vec<[f64; 3]> {
+pub(crate) fn vertex_normals(faces: &Polygons, xs: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let mut acc = vec![[0.0; 3]; xs.len()];
     for f in faces.iter() {
         let mut n = [0.0; 3];

@@ -126,6 +126,11 @@ pub struct FootPointTerm<'t> {
     power: f64,
     /// With `p > 2`: the mean squared error `r²` at the first projection of all samples.
     reference: std::sync::OnceLock<f64>,
+    /// Whether foot points on a mesh target face the sample's side inside thin parts
+    /// ([`FitOptions::facing`]).
+    facing: bool,
+    /// The sample tessellation (from [`DataTerm::prepare`]), for the samples' normals.
+    sample_faces: Option<(subfit_mesh::Polygons, usize)>,
 }
 
 /// What [`FootPointTerm`] keeps per sample: the foot point and, on projections of all samples
@@ -170,7 +175,17 @@ impl<'t> FootPointTerm<'t> {
             rim: Vec::new(),
             power: 2.0,
             reference: std::sync::OnceLock::new(),
+            facing: false,
+            sample_faces: None,
         }
+    }
+
+    /// The term with foot points that face the sample's side inside thin parts (`true`) or
+    /// plain closest points (`false`, the default; see [`Target::mesh_foot_points_facing`]:
+    /// mesh targets only, on projections of all samples).
+    pub fn with_facing(mut self, facing: bool) -> Self {
+        self.facing = facing;
+        self
     }
 
     /// The term with error power `p` (`2 ≤ p ≤ 8`; see the module docs and
@@ -212,8 +227,9 @@ impl<'t> FootPointTerm<'t> {
     /// [`FitOptions::coverage`] > 0 adds the data → surface part, with
     /// [`FitOptions::feature_segments`] fitted by the creases).
     pub fn from_options(target: &'t Target, options: &FitOptions) -> Self {
-        let term =
-            Self::new(target, options.method, options.foot_points).with_power(options.error_power);
+        let term = Self::new(target, options.method, options.foot_points)
+            .with_power(options.error_power)
+            .with_facing(options.facing);
         if options.coverage > 0.0 {
             let mut term = term.with_coverage(options.coverage);
             if let Some(f) = &options.feature_segments {
@@ -322,13 +338,28 @@ impl DataTerm for FootPointTerm<'_> {
         if let Some(c) = self.coverage.as_mut() {
             c.prepare(op);
         }
+        self.sample_faces = Some((op.faces.clone(), op.num_vertices));
     }
 
     fn project(&self, rows: Option<&[u32]>, xs: &[[f64; 3]]) -> Vec<FootSample> {
         // A poisoned lock only loses the hints.
         let mut hints = self.hints.lock().unwrap_or_else(PoisonError::into_inner);
         let Some(rows) = rows else {
-            let feet = self.foot_points_hinted(xs, &mut hints);
+            let feet = match &self.sample_faces {
+                Some((faces, n))
+                    if self.facing
+                        && *n == xs.len()
+                        && matches!(self.source, FootPointSource::Auto)
+                        && self.target.mesh().is_some() =>
+                {
+                    hints.resize(xs.len(), u32::MAX);
+                    let normals = crate::coverage::vertex_normals(faces, xs);
+                    self.target
+                        .mesh_foot_points_facing(xs, &normals, &mut hints)
+                        .0
+                }
+                _ => self.foot_points_hinted(xs, &mut hints),
+            };
             drop(hints);
             let mut out = match &self.coverage {
                 None => plain(feet),

@@ -203,6 +203,12 @@ pub struct FitOptions {
     /// Dimensionless, ≥ 0. Default 0 (off: the papers' one-sided objective, as in the
     /// convergence studies); `subfit::fit_scan` turns it on (1).
     pub coverage: f64,
+    /// Whether a mesh target's foot points face the sample's side inside thin parts
+    /// ([`subfit_target::Target::mesh_foot_points_facing`]): a sample whose surface has sunk
+    /// past the middle of a limb is pulled by the wall on its own side, not the nearer
+    /// opposite one. Default false (the papers' closest point); `subfit::fit_scan` turns it
+    /// on.
+    pub facing: bool,
     /// The data's sharp feature curves as segments (normalized units), e.g. the sharp edges
     /// [`subfit_target::detect_features`] finds on a mesh target: with [`Self::coverage`] > 0
     /// they pull the creases of the limit surface onto them ([`crate::Coverage::with_features`]).
@@ -278,6 +284,7 @@ impl Default for FitOptions {
             pcg_max_iterations: 500,
             foot_points: FootPointSource::Auto,
             coverage: 0.0,
+            facing: false,
             error_power: 2.0,
             feature_segments: None,
             imls_radius: None,

@@ -232,6 +232,13 @@ impl TriangleBvh {
         &self.vertices
     }
 
+    /// The normal `(b − a) × (c − a)` of triangle `t` (right-hand rule on its corners' order;
+    /// not normalized: its length is twice the area). Panics if `t` is out of range.
+    pub fn triangle_normal(&self, t: u32) -> [f64; 3] {
+        let [a, b, c] = self.triangles[t as usize].map(|v| self.vertices[v as usize]);
+        cross(sub(b, a), sub(c, a))
+    }
+
     /// The exact closest point on the triangles to `x`, or `None` when there are no
     /// triangles. Among triangles at the same distance, the first one the traversal meets wins.
     /// Allocates nothing.
@@ -259,6 +266,18 @@ impl TriangleBvh {
     /// [`Self::closest`] among the triangles within squared distance `bound` (`None` when none
     /// is): nodes whose box is farther than `bound` are skipped.
     fn closest_bounded(&self, x: [f64; 3], bound: f64) -> Option<MeshClosestPoint> {
+        self.closest_accepted(x, bound, |_| true)
+    }
+
+    /// [`Self::closest`] among the triangles that `accept` admits (by index) within squared
+    /// distance `bound` (`None` when none is), e.g. only those facing a given direction.
+    /// Boxes farther than `bound` or than the best admitted triangle so far are not opened.
+    pub fn closest_accepted(
+        &self,
+        x: [f64; 3],
+        bound: f64,
+        accept: impl Fn(u32) -> bool,
+    ) -> Option<MeshClosestPoint> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -278,6 +297,9 @@ impl TriangleBvh {
                 let s = node.first as usize;
                 let slots = s..s + node.count as usize;
                 for (&t, &[a, b, c]) in self.order[slots.clone()].iter().zip(&self.corners[slots]) {
+                    if !accept(t) {
+                        continue;
+                    }
                     let (p, bary) = closest_on_triangle(x, a, b, c);
                     let dd = sub(x, p);
                     let dd = dot(dd, dd);

@@ -113,7 +113,7 @@ fn options(
             coverage,
             imls_radius,
             arap,
-            ..FitOptions::default()
+            ..FitScanOptions::default().fit
         },
         stages: StageOptions {
             iterations_per_stage: range("stage_iterations", stage_iterations, 1, 10_000)?,

@@ -74,4 +74,4 @@ pub use options::{
 };
 pub use project::{alpha_plus, FootPoint};
 pub use quadric::{FitQuality, LocalQuadric, SurfaceFrame};
-pub use target::{PointAttributes, Target, MIN_POINTS};
+pub use target::{PointAttributes, Target, CLOSED_BOUNDARY_SHARE, MIN_POINTS};

@@ -24,6 +24,11 @@ pub use crate::foot::{alpha_plus, foot_point_on, FootPoint};
 use crate::target::Target;
 use subfit_mesh::vec3::{cross, dot, scale, sub};
 
+/// How much farther than the closest triangle a facing one may be
+/// ([`Target::mesh_foot_points_facing`]): across a thin part the opposite wall is at most its
+/// thickness away, while a facing triangle much farther off belongs to another part.
+pub const FACING_REACH: f64 = 3.0;
+
 /// Batches at least this large are processed in Morton order.
 const SPATIAL_SORT_MIN: usize = 4096;
 
@@ -277,6 +282,122 @@ impl Target {
                 f
             })
             .collect()
+    }
+
+    /// [`Self::mesh_foot_points_hinted`] for points of a surface whose unit normals are
+    /// `normals` (zero: unknown), taking the side of thin parts into account. Inside a thin
+    /// part — a limb, a tentacle, a fin — a surface that has sunk past the middle is drawn by
+    /// the plain closest point to the opposite wall, which pulls it further in: a fixed point
+    /// of the closest-point fit whose error refinement cannot lower. So where a point lies
+    /// behind its closest triangle, which faces away from the point's normal (cosine below
+    /// −1/2), the closest triangle facing the same way (cosine above 1/2) within
+    /// [`FACING_REACH`] times that distance is taken instead, if the point lies behind it too
+    /// (inside the part both walls bound). This is the compatible-normals pairing of ICP
+    /// (Turk & Levoy 1994; Rusinkiewicz & Levoy 2001) restricted to the inside of thin parts;
+    /// it chooses which triangle pulls, while the error reported stays the plain distance
+    /// ([`Self::mesh_foot_point`]). Outside the target (a web across a gap, a point in a
+    /// narrow gap between two parts) the plain closest point is kept, and so it is on
+    /// components that do not enclose a volume ([`Self::closed_components`]): a sheet has no
+    /// inside.
+    ///
+    /// The triangles' orientation relative to the points' normals is taken by a majority of
+    /// the points, on each connected component of the target's triangles
+    /// ([`Self::triangle_components`]) on its own: a target oriented inwards, separate sheets
+    /// oriented either way, or a surface facing the other way are handled. Returns the foot
+    /// points and how many were taken on a facing triangle. `hints` as in
+    /// [`Self::mesh_foot_points_hinted`] (the plain closest triangles are kept there).
+    ///
+    /// # Panics
+    /// If `hints.len()` or `normals.len()` differs from `xs.len()`.
+    #[track_caller]
+    pub fn mesh_foot_points_facing(
+        &self,
+        xs: &[[f64; 3]],
+        normals: &[[f64; 3]],
+        hints: &mut [u32],
+    ) -> (Vec<FootPoint>, usize) {
+        assert_eq!(
+            xs.len(),
+            normals.len(),
+            "mesh_foot_points_facing: length mismatch"
+        );
+        let mut feet = self.mesh_foot_points_hinted(xs, hints);
+        let Some(bvh) = self.mesh() else {
+            return (feet, 0);
+        };
+        let (labels, closed) = (self.triangle_components(), self.closed_components());
+        let encloses = |t: u32| -> bool {
+            let l = labels.get(t as usize).copied().unwrap_or(u32::MAX);
+            closed.get(l as usize).copied().unwrap_or(false)
+        };
+        // The cosine between a point's normal and triangle t's normal.
+        let cosine = |t: u32, n: [f64; 3]| -> f64 {
+            let m = bvh.triangle_normal(t);
+            let l = (dot(m, m) * dot(n, n)).sqrt();
+            if l > 0.0 && l.is_finite() {
+                dot(m, n) / l
+            } else {
+                0.0
+            }
+        };
+        let cosines: Vec<f64> = hints
+            .par_iter()
+            .zip(normals.par_iter())
+            .map(|(&t, &n)| {
+                if (t as usize) < bvh.len() {
+                    cosine(t, n)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        // Per component: +1 when most points agree with its triangles, −1 when most disagree.
+        let count = labels
+            .iter()
+            .filter(|&&l| l != u32::MAX)
+            .map(|&l| l as usize + 1)
+            .max();
+        let mut votes = vec![0i64; count.unwrap_or(0)];
+        for (&t, &c) in hints.iter().zip(&cosines) {
+            if let Some(&l) = labels.get(t as usize) {
+                if let Some(v) = votes.get_mut(l as usize) {
+                    *v += i64::from(c > 0.0) - i64::from(c < 0.0);
+                }
+            }
+        }
+        let sign_of = |t: u32| -> f64 {
+            let l = labels.get(t as usize).copied().unwrap_or(u32::MAX);
+            match votes.get(l as usize) {
+                Some(&v) if v < 0 => -1.0,
+                _ => 1.0,
+            }
+        };
+        // Whether x lies behind triangle t (oriented by its component's sign) at its point p.
+        let behind = |t: u32, x: [f64; 3], p: [f64; 3]| -> bool {
+            sign_of(t) * dot(sub(x, p), bvh.triangle_normal(t)) < 0.0
+        };
+        let swapped: Vec<(usize, FootPoint)> = cosines
+            .par_iter()
+            .enumerate()
+            .filter(|&(i, &c)| {
+                let t = hints[i];
+                encloses(t) && sign_of(t) * c < -0.5 && behind(t, xs[i], feet[i].point)
+            })
+            .filter_map(|(i, _)| {
+                let (x, n) = (xs[i], normals[i]);
+                let d = sub(x, feet[i].point);
+                let reach = FACING_REACH * FACING_REACH * dot(d, d);
+                let c = bvh.closest_accepted(x, reach, |t| {
+                    encloses(t) && sign_of(t) * cosine(t, n) > 0.5
+                })?;
+                behind(c.triangle, x, c.point).then(|| (i, self.mesh_foot_from(x, &c)))
+            })
+            .collect();
+        let count = swapped.len();
+        for (i, f) in swapped {
+            feet[i] = f;
+        }
+        (feet, count)
     }
 
     /// The foot point of `x` whose closest point on the triangles is `c`

@@ -101,7 +101,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             coverage: a.coverage,
             imls_radius: a.imls_radius,
             arap: a.arap,
-            ..FitOptions::default()
+            ..defaults.fit.clone()
         },
         stages: StageOptions {
             iterations_per_stage: a.stage_iterations as usize,
