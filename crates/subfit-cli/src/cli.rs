@@ -419,6 +419,13 @@ pub struct FitArgs {
     /// the papers.
     #[arg(long, default_value_t = 1.0)]
     pub coverage: f64,
+    /// Inside the thin parts of a closed mesh (limbs, tentacles, plates), pull a sample that
+    /// sank past the middle by the wall facing its own way, not the nearer opposite wall
+    /// (foot points that face the sample; sheets and single views keep the closest point).
+    /// Helps thin-limbed sculpts; off by default, as it also moved two reference fits above
+    /// their tolerance.
+    #[arg(long)]
+    pub facing: bool,
     /// The control-point budget: the initial cage and every refinement stay within it (exit
     /// code 2 when the target's topology needs more) [default: 5000]. A budget given without
     /// --tolerance and --max-error is spent on the best cage it holds: the tolerance is then

@@ -401,3 +401,36 @@ fn catmull_clark_fits_start_from_a_quad_dominant_cage() {
     ]);
     assert_eq!(r.status.code(), Some(2));
 }
+
+/// `--facing` reaches the fit (report.json `options.facing`) and a thin limb — a capsule 6 %
+/// of its length thick — is fitted within the tolerance with it, genus kept.
+#[test]
+fn facing_foot_points_are_an_option_of_fit() {
+    let d = tempfile::tempdir().unwrap();
+    let limb = d.path().join("limb.ply");
+    save(&limb, &subfit::mesh::thin_shapes::capsule(0.03, 0.9, 32));
+    for facing in [false, true] {
+        let out = d.path().join(format!("fit-{facing}"));
+        let mut args = vec![
+            "fit",
+            limb.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--sample-level",
+            "2",
+        ];
+        if facing {
+            args.push("--facing");
+        }
+        let r = subfit(&args);
+        assert_eq!(
+            r.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        let rep = report(&out);
+        assert_eq!(rep["options"]["facing"], facing);
+        assert_eq!(rep["target_topology"]["genus"], 0);
+    }
+}

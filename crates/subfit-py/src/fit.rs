@@ -187,8 +187,8 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     points, faces=None, normals=None, *, scheme="auto", method="sdm", step="lm",
     tolerance=None, max_error=None, max_control_points=None, control_points=None,
     as_points=false, init=None, init_method=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
-    max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, refine=true,
-    edge_flips=true,
+    max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, facing=false,
+    refine=true, edge_flips=true,
     max_depth=5, local=false, local_rings=None, local_field_peak=0.8, local_field_share=0.5,
     error_scale=None, imls_radius=None, arap=0.0, quads="field", name=None, progress=None
 ))]
@@ -215,6 +215,7 @@ pub fn fit(
     stage_iterations: i64,
     one_sided: bool,
     coverage: f64,
+    facing: bool,
     refine: bool,
     edge_flips: bool,
     max_depth: i64,
@@ -254,6 +255,7 @@ pub fn fit(
         error_scale,
         (imls_radius, arap),
     )?;
+    opts.fit.facing = facing;
     opts.quads = match quads.to_ascii_lowercase().as_str() {
         "field" => subfit::QuadLayout::Field,
         "paired" => subfit::QuadLayout::Paired,

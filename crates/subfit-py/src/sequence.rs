@@ -166,7 +166,6 @@ pub fn fit_sequence_py(
         scheme: scheme(scheme_name, true)?,
         fit: FitOptions {
             sample_level: 3,
-            facing: FitScanOptions::default().fit.facing,
             ..fit.clone()
         },
         ..FitScanOptions::default()

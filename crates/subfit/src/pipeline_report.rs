@@ -361,6 +361,9 @@ pub struct OptionsSummary {
     /// Weight `α` of the ARAP regularizer (0: off).
     #[serde(default)]
     pub arap: f64,
+    /// Whether foot points face the sample's side inside thin parts (`--facing`).
+    #[serde(default)]
+    pub facing: bool,
     /// The optimizer (`GaussNewton`, `Adam`, `Lbfgs`; `--optimizer`).
     #[serde(default)]
     pub optimizer: String,

@@ -171,6 +171,7 @@ fn options_summary(p: &ReportParts<'_>) -> OptionsSummary {
         imls_radius: (fit.method == subfit_fit::Method::Imls)
             .then(|| subfit_fit::ImlsTerm::from_options(&p.prepared.target, fit).radius()),
         arap: fit.arap,
+        facing: fit.facing,
         optimizer: match fit.optimizer {
             subfit_fit::Optimizer::GaussNewton => "GaussNewton",
             subfit_fit::Optimizer::Adam { .. } => "Adam",

@@ -98,7 +98,6 @@ fn options(a: &SequenceArgs) -> anyhow::Result<SequenceOptions> {
         scheme,
         fit: FitOptions {
             sample_level: 3,
-            facing: FitScanOptions::default().fit.facing,
             ..fit.clone()
         },
         ..FitScanOptions::default()

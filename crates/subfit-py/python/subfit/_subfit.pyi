@@ -45,6 +45,7 @@ def fit(
     stage_iterations: int = 6,
     one_sided: bool = False,
     coverage: float = 1.0,
+    facing: bool = False,
     refine: bool = True,
     edge_flips: bool = True,
     max_depth: int = 5,
