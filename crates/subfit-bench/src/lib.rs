@@ -45,6 +45,9 @@ pub struct Settings {
     pub judge: judge::JudgeOptions,
     /// Entries scored at once.
     pub jobs: usize,
+    /// Flags added to every `subfit fit` (e.g. `--facing`), to score an option before it
+    /// becomes a default; empty: the defaults.
+    pub fit_args: Vec<String>,
 }
 
 /// A scored corpus: what `--out` writes as JSON and what a baseline is.
@@ -64,6 +67,9 @@ pub struct Scoreboard {
     pub seconds: f64,
     /// The judge's samples of each limit surface.
     pub judge_surface_samples: usize,
+    /// Flags added to every `subfit fit` ([`Settings::fit_args`]); empty: the defaults.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fit_args: Vec<String>,
     /// One row per entry, in corpus order.
     pub rows: Vec<Row>,
     /// Per category.

@@ -302,6 +302,13 @@ pub fn render(board: &Scoreboard) -> String {
         board.rows.len(),
         100.0 * DISAGREEMENT_FLAG,
     );
+    if !board.fit_args.is_empty() {
+        let _ = writeln!(
+            s,
+            "Every `subfit fit` ran with `{}` added (not the defaults).\n",
+            board.fit_args.join(" ")
+        );
+    }
     for source in &board.sources {
         let _ = writeln!(s, "- rows from {source}");
     }

@@ -73,12 +73,13 @@ fn fit_row(entry: &Entry, input: &Path, dir: &Path, settings: &Settings) -> Row 
         input.display().to_string(),
     );
     let out = dir.join("fit");
-    let args = vec![
+    let mut args = vec![
         "fit".to_string(),
         input.display().to_string(),
         "-o".into(),
         out.display().to_string(),
     ];
+    args.extend(settings.fit_args.iter().cloned());
     judge_fit(&mut row, entry, mesh, &args, &out, dir, settings);
     row
 }
@@ -192,7 +193,7 @@ fn pair_row(entry: &Entry, control: &Path, dense: &Path, dir: &Path, settings: &
     };
     let mesh = read_model(dense);
     let out = dir.join("fit");
-    let args = vec![
+    let mut args = vec![
         "fit".to_string(),
         dense.display().to_string(),
         "-o".into(),
@@ -209,6 +210,7 @@ fn pair_row(entry: &Entry, control: &Path, dense: &Path, dir: &Path, settings: &
             "catmull-clark".into()
         },
     ];
+    args.extend(settings.fit_args.iter().cloned());
     if let Ok(m) = &mesh {
         let stats = cage_stats(&given, &tags);
         let candidate = Candidate::limit(given.clone(), tags.clone(), scheme);

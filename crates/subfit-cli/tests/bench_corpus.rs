@@ -152,3 +152,46 @@ fn a_given_cage_with_flipped_faces_is_reoriented_and_judged() {
     let note = row["note"].as_str().unwrap_or("");
     assert!(note.contains("3 faces re-oriented"), "{note}");
 }
+
+/// `--fit-arg` adds a flag to every fit (here `--facing`, and `--coverage 0`): the runs' own
+/// reports show it, and the scoreboard records it.
+#[test]
+fn fit_args_reach_every_fit_and_are_recorded() {
+    let d = tempfile::tempdir().unwrap();
+    let models = d.path().join("models");
+    std::fs::create_dir(&models).unwrap();
+    let torus = torus_mesh(0.35, 0.15, 32, 16, true);
+    subfit::io::write_file(&models.join("torus.ply"), &torus, &Default::default()).unwrap();
+    let out = d.path().join("board.json");
+    let work = d.path().join("work");
+    let r = bench(
+        &models,
+        &out,
+        &[
+            "--surface-samples",
+            "20000",
+            "--work",
+            work.to_str().unwrap(),
+            "--fit-arg",
+            "--facing",
+            "--fit-arg",
+            "--coverage",
+            "--fit-arg",
+            "0",
+        ],
+    );
+    assert!(
+        r.status.code() == Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let b = board(&out);
+    assert_eq!(
+        b["fit_args"],
+        serde_json::json!(["--facing", "--coverage", "0"])
+    );
+    let report = board(&work.join("torus").join("fit").join("report.json"));
+    assert_eq!(report["options"]["facing"], true);
+    let md = std::fs::read_to_string(out.with_extension("md")).unwrap();
+    assert!(md.contains("`--facing --coverage 0` added"), "{md}");
+}

@@ -60,6 +60,7 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
             ..JudgeOptions::default()
         },
         jobs,
+        fit_args: a.fit_args.clone(),
     };
     eprintln!(
         "subfit: scoring {} entries of {} ({jobs} at once; runs under {})",
@@ -89,6 +90,7 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
         cores,
         seconds: earlier_seconds.unwrap_or_else(|| t0.elapsed().as_secs_f64()),
         judge_surface_samples: a.surface_samples,
+        fit_args: a.fit_args.clone(),
         rows,
         sources,
         ..Scoreboard::default()
