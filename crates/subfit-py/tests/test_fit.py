@@ -102,6 +102,15 @@ def test_quads_only_gives_an_all_quad_cage_and_bad_layouts_are_refused():
         subfit.fit(points, quads="hexagons", max_control_points=150)
 
 
+def test_facing_is_an_option_and_reaches_the_report(fitted):
+    # A mesh target (the fitted tessellation): facing foot points apply to meshes.
+    pos, tris = fitted.surface().tessellation(2)
+    for facing in (False, True):
+        m = subfit.fit(pos, faces=tris, facing=facing, max_control_points=600, max_iterations=10)
+        assert m.report["options"]["facing"] is facing
+        assert ellipsoid_distance(m.surface().sample(2)).max() < 1e-2
+
+
 def test_mesh_target_and_given_initial_cage(fitted):
     # A dense triangle mesh (the fitted limit tessellation) as the target.
     pos, tris = fitted.surface().tessellation(3)
