@@ -43,6 +43,7 @@ pub mod fillet;
 mod foot;
 pub mod imls;
 mod layout;
+mod mesh_parts;
 pub mod neighbors;
 mod normalize;
 mod options;
@@ -66,6 +67,7 @@ pub use estimate::Neighborhood;
 pub use features::{detect_features, FeatureCurve, FeatureOptions, Features};
 pub use fillet::fillet_widths;
 pub use imls::{imls_value, ImlsValue};
+pub use mesh_parts::CLOSED_BOUNDARY_SHARE;
 pub use neighbors::{Neighbor, PointIndex};
 pub use normalize::Normalization;
 pub use options::{
@@ -74,4 +76,4 @@ pub use options::{
 };
 pub use project::{alpha_plus, FootPoint};
 pub use quadric::{FitQuality, LocalQuadric, SurfaceFrame};
-pub use target::{PointAttributes, Target, CLOSED_BOUNDARY_SHARE, MIN_POINTS};
+pub use target::{PointAttributes, Target, MIN_POINTS};
