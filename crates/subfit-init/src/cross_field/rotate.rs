@@ -578,18 +578,24 @@ mod tests {
         (positions, quads, surface)
     }
 
+    /// Turns the edge shared by the quads at `(x, y)` and `(x + 1, y)` of the `n × n` grid of
+    /// [`grid`] to the hexagon's diagonal: two vertices of valence 5, two of valence 3.
+    fn twist(quads: &mut [[u32; 4]], n: usize, x: usize, y: usize) {
+        let v = |x: usize, y: usize| (y * n + x) as u32;
+        let i = quads.iter().position(|q| q[0] == v(x, y)).unwrap();
+        let j = quads.iter().position(|q| q[0] == v(x + 1, y)).unwrap();
+        quads[i] = [v(x, y), v(x + 1, y), v(x + 2, y), v(x + 2, y + 1)];
+        quads[j] = [v(x + 2, y + 1), v(x + 1, y + 1), v(x, y + 1), v(x, y)];
+    }
+
     /// Two quads of a regular grid with their shared edge turned to the hexagon's diagonal:
     /// two vertices of valence 5, two of valence 3. One sequence makes the grid regular again
     /// with every quad convex, and the relaxed vertices stay on the surface.
     #[test]
     fn a_rotated_edge_in_a_grid_is_turned_back() {
         let n = 5;
-        let v = |x: usize, y: usize| (y * n + x) as u32;
         let (positions, mut quads, surface) = grid(n);
-        let i = quads.iter().position(|q| q[0] == v(1, 1)).unwrap();
-        let j = quads.iter().position(|q| q[0] == v(2, 1)).unwrap();
-        quads[i] = [v(1, 1), v(2, 1), v(3, 1), v(3, 2)];
-        quads[j] = [v(3, 2), v(2, 2), v(1, 2), v(1, 1)];
+        twist(&mut quads, n, 1, 1);
         let twisted = PolyMesh::new(positions, Polygons::from_quads(&quads));
         assert_eq!(irregular_vertices(&twisted), 4);
         let (fixed, rotations) = rotate_for_valence(&twisted, &surface, &Tags::new());
@@ -622,13 +628,9 @@ mod tests {
     #[test]
     fn two_pairs_apart_are_cancelled_and_no_quad_folds() {
         let n = 8;
-        let v = |x: usize, y: usize| (y * n + x) as u32;
         let (positions, mut quads, surface) = grid(n);
         for (x, y) in [(1, 1), (4, 4)] {
-            let i = quads.iter().position(|q| q[0] == v(x, y)).unwrap();
-            let j = quads.iter().position(|q| q[0] == v(x + 1, y)).unwrap();
-            quads[i] = [v(x, y), v(x + 1, y), v(x + 2, y), v(x + 2, y + 1)];
-            quads[j] = [v(x + 2, y + 1), v(x + 1, y + 1), v(x, y + 1), v(x, y)];
+            twist(&mut quads, n, x, y);
         }
         let twisted = PolyMesh::new(positions, Polygons::from_quads(&quads));
         assert_eq!(irregular_vertices(&twisted), 8);
@@ -646,10 +648,7 @@ mod tests {
         let n = 5;
         let v = |x: usize, y: usize| (y * n + x) as u32;
         let (positions, mut quads, surface) = grid(n);
-        let i = quads.iter().position(|q| q[0] == v(1, 1)).unwrap();
-        let j = quads.iter().position(|q| q[0] == v(2, 1)).unwrap();
-        quads[i] = [v(1, 1), v(2, 1), v(3, 1), v(3, 2)];
-        quads[j] = [v(3, 2), v(2, 2), v(1, 2), v(1, 1)];
+        twist(&mut quads, n, 1, 1);
         let twisted = PolyMesh::new(positions, Polygons::from_quads(&quads));
         let mut tags = Tags::new();
         tags.set_crease(v(1, 1), v(3, 2), 10.0);
