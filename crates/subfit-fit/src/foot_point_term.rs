@@ -338,7 +338,9 @@ impl DataTerm for FootPointTerm<'_> {
         if let Some(c) = self.coverage.as_mut() {
             c.prepare(op);
         }
-        self.sample_faces = Some((op.faces.clone(), op.num_vertices));
+        if self.facing {
+            self.sample_faces = Some((op.faces.clone(), op.num_vertices));
+        }
     }
 
     fn project(&self, rows: Option<&[u32]>, xs: &[[f64; 3]]) -> Vec<FootSample> {
