@@ -225,6 +225,14 @@ fn fit_json_prints_a_closing_summary_that_matches_the_report() {
         summary["two_sided_max"]["fraction_of_diagonal"],
         two["e_max_fraction_of_diagonal"]
     );
+    assert_eq!(summary["largest_at"], report["final"]["largest_at"]);
+    assert_eq!(
+        summary["largest_at"]["data_to_surface"]
+            .as_array()
+            .unwrap()
+            .len(),
+        3
+    );
     assert_eq!(
         summary["tolerance_reached"].as_bool(),
         Some(r.status.code() == Some(0))

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::fitted::Fitted;
 use crate::outputs::OUTPUTS;
+use crate::pipeline_report::LargestErrorAt;
 
 /// One error figure in the three units a fit reports.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -42,6 +43,8 @@ pub struct ClosingSummary {
     pub two_sided_rms: ErrorFigure,
     /// Two-sided largest distance (Hausdorff).
     pub two_sided_max: ErrorFigure,
+    /// Where each direction's largest distance lies, in the input's coordinates.
+    pub largest_at: LargestErrorAt,
     /// Seconds the whole run took (reading to writing).
     pub seconds: f64,
     /// The files written, in the order they were moved into place.
@@ -75,6 +78,7 @@ impl Fitted {
                 two.e_max_fraction_of_diagonal,
                 two.e_max,
             ),
+            largest_at: r.r#final.largest_at,
             seconds: r.timings_s.total,
             files: OUTPUTS.iter().map(|f| dir.join(f)).collect(),
         }
@@ -106,6 +110,13 @@ impl fmt::Display for ClosingSummary {
             self.two_sided_max.units,
             100.0 * self.two_sided_max.fraction_of_diagonal,
             self.diagonal
+        )?;
+        let at = |p: [f64; 3]| format!("({:.5e}, {:.5e}, {:.5e})", p[0], p[1], p[2]);
+        writeln!(
+            f,
+            "largest distances at: data → surface {}, surface → data {} (input coordinates)",
+            at(self.largest_at.data_to_surface),
+            at(self.largest_at.surface_to_data)
         )?;
         writeln!(f, "time: {:.2} s", self.seconds)?;
         let dir = self

@@ -15,7 +15,7 @@ use subfit_subdiv::Scheme;
 use subfit_target::Target;
 
 use crate::error::Error;
-use crate::pipeline_report::UsdDifference;
+use crate::pipeline_report::{LargestErrorAt, UsdDifference};
 
 /// A fitted cage measured both ways on its limit tessellation.
 pub(crate) struct FinalMeasure {
@@ -30,6 +30,18 @@ pub(crate) struct FinalMeasure {
     pub(crate) rim_samples: usize,
     /// Both directions' statistics.
     pub(crate) two_sided: TwoSided,
+    /// Where each direction's largest distance is (normalized units): the tessellation
+    /// vertex farthest from the data, and the data sample or file vertex farthest from the
+    /// tessellation.
+    pub(crate) largest_at: LargestErrorAt,
+}
+
+/// The point of `points` whose `distance` is largest (the origin when there is none) with it.
+fn farthest(points: &[[f64; 3]], distance: impl Fn(usize) -> f64) -> ([f64; 3], f64) {
+    (0..points.len()).map(|i| (points[i], distance(i))).fold(
+        ([0.0; 3], f64::NEG_INFINITY),
+        |a, b| if b.1 > a.1 { b } else { a },
+    )
 }
 
 impl FinalMeasure {
@@ -82,12 +94,19 @@ pub(crate) fn measure_final(
     } else {
         file_vertices
     };
-    let from_vertices = surface
-        .distances(vertices)
-        .iter()
-        .map(|p| p.distance)
-        .fold(0.0, f64::max);
-    data_to_surface.max = data_to_surface.max.max(from_vertices);
+    let from_vertices = surface.distances(vertices);
+    let at_vertex = farthest(vertices, |i| from_vertices[i].distance);
+    let at_sample = farthest(&data.points, |i| to_surface[i]);
+    let data_far = if at_vertex.1 > at_sample.1 {
+        at_vertex
+    } else {
+        at_sample
+    };
+    data_to_surface.max = data_to_surface.max.max(data_far.1);
+    let largest_at = LargestErrorAt {
+        surface_to_data: farthest(&tessellation.mesh.positions, |i| local[i]).0,
+        data_to_surface: data_far.0,
+    };
     let two_sided = TwoSided {
         surface_to_data: DistanceStats::of_weighted(
             &local,
@@ -101,6 +120,7 @@ pub(crate) fn measure_final(
         to_surface,
         rim_samples: data.boundary,
         two_sided,
+        largest_at,
     })
 }
 

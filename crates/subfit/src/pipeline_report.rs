@@ -718,6 +718,21 @@ pub struct FinalErrors {
     pub objective: f64,
     /// Both ways.
     pub two_sided: TwoSidedErrors,
+    /// Where each direction's largest distance lies, in the input's coordinates.
+    #[serde(default)]
+    pub largest_at: LargestErrorAt,
+}
+
+/// Where the largest distance of each direction lies: the place to look at first when a fit
+/// misses its tolerance (report.json `final.largest_at`, printed by `subfit fit`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LargestErrorAt {
+    /// The point of the limit surface (its tessellation written to limit.ply) farthest from
+    /// the data.
+    pub surface_to_data: [f64; 3],
+    /// The data point (a sample of the input's faces, or a vertex) farthest from the limit
+    /// surface.
+    pub data_to_surface: [f64; 3],
 }
 
 /// What the CAD start found and built (report.json `init.cad`, [`crate::start_cad`]).

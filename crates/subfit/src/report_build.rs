@@ -7,8 +7,8 @@ use subfit_fit::{FitOptions, StagesResult};
 use crate::measure_fit::FinalMeasure;
 use crate::options::FitScanOptions;
 use crate::pipeline_report::{
-    face_counts, Errors, FinalErrors, IterationSummary, OptionsSummary, Report, RmsMax,
-    StageSummary, TagCounts, TessellationSummary, Timings, TwoSidedErrors, UsdDifference,
+    face_counts, Errors, FinalErrors, IterationSummary, LargestErrorAt, OptionsSummary, Report,
+    RmsMax, StageSummary, TagCounts, TessellationSummary, Timings, TwoSidedErrors, UsdDifference,
 };
 use crate::prepare::Prepared;
 use crate::start::Start;
@@ -87,6 +87,13 @@ pub(crate) fn build_report(p: ReportParts<'_>) -> Report {
                 e_rms_fraction_of_diagonal: e.e_rms_fraction_of_diagonal,
                 objective: e.objective,
                 two_sided: two,
+                largest_at: {
+                    let at = &p.measured.largest_at;
+                    LargestErrorAt {
+                        surface_to_data: target.to_original(at.surface_to_data),
+                        data_to_surface: target.to_original(at.data_to_surface),
+                    }
+                },
             }
         },
         best_stage: result.report.best_stage,
