@@ -33,6 +33,7 @@ pub mod stencil;
 pub mod topology;
 
 mod child;
+mod mask_types;
 mod mixed;
 mod regular;
 mod semi_limit;
