@@ -33,6 +33,7 @@ pub mod stencil;
 pub mod topology;
 
 mod child;
+mod face_points;
 mod mask_types;
 mod mixed;
 mod regular;

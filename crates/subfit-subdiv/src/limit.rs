@@ -36,12 +36,12 @@ use crate::child::{ChildCorners, ChildRing};
 use crate::error::SubdivError;
 use crate::mask::Mask;
 use crate::refine::{
-    classify, face_kinds, has_semi_sharp, neighborhoods, refine_topology, sharp_edges,
-    topology_for, RefineRows, VertexMaskCache,
+    face_kinds, has_semi_sharp, neighborhoods, refine_topology, sharp_edges, topology_for,
+    RefineRows, VertexMaskCache,
 };
 use crate::regular::{is_regular, Regular, Tables};
 use crate::scheme::Neighborhood;
-use crate::scheme::{Options, Scheme};
+use crate::scheme::{classify, Options, Scheme};
 use crate::semi_limit::{ring_faces, semi_sharp_at, semi_sharp_limit_row};
 use crate::stencil::{compose_rows, MultiRows, SparseSum, Stacked, StencilMatrix};
 use crate::topology::Topology;
