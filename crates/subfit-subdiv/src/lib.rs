@@ -34,6 +34,7 @@ pub mod topology;
 
 mod child;
 mod face_points;
+mod limit_row;
 mod mask_types;
 mod mixed;
 mod regular;
