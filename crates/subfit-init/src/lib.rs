@@ -39,6 +39,7 @@ pub mod init;
 pub mod islands;
 mod march;
 mod octree;
+mod quad_shape;
 pub mod quads;
 pub mod semi_sharp;
 pub mod simplify;
