@@ -21,7 +21,9 @@ use subfit_mesh::{
     split_concave_corners, Cancel, Cancelled, ConcaveSplits, HalfEdgeMesh, PolyMesh, Tags,
     TopologyError,
 };
-use subfit_target::{detect_features, fillet_widths, FeatureOptions, Target};
+use subfit_target::{
+    detect_cloud_features, detect_features, fillet_widths, FeatureOptions, Target,
+};
 
 use crate::semi_sharp::semi_sharp_tags;
 
@@ -35,6 +37,7 @@ use crate::quads::{pair_triangles, PairOptions, PairReport};
 use crate::simplify::{
     simplify_with_features, FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport,
 };
+use crate::snap::snap_to_features;
 use crate::specks::Speck;
 use crate::trim::{boundary_polylines, trim_unsupported, TrimError, TrimOptions, TrimReport};
 
@@ -530,7 +533,7 @@ pub fn initial_control_mesh(
             lock
         }
         (Some(fo), InitSource::Contour) if options.cloud_features => {
-            crate::snap::cloud_feature_lock(target, &mut dense, fo, &mut report)
+            cloud_feature_lock(target, &mut dense, fo, &mut report)
         }
         _ => FeatureLock::default(),
     };
@@ -838,4 +841,25 @@ fn check_topology_allows(he: &HalfEdgeMesh, n_vertices: usize) -> Result<(), Ini
         });
     }
     Ok(())
+}
+
+/// The hook of [`initial_control_mesh`] for point clouds with
+/// [`InitOptions::features`]: detects the cloud's features, snaps `dense` (the trimmed
+/// contour, normalized units) to them and fills `report.features` (edges: contour edges
+/// locked).
+fn cloud_feature_lock(
+    target: &Target,
+    dense: &mut PolyMesh,
+    options: &FeatureOptions,
+    report: &mut InitReport,
+) -> FeatureLock {
+    let f = detect_cloud_features(target, options);
+    let (lock, snap) = snap_to_features(dense, &f, Some((target.points(), target.index())));
+    report.features = Some(FeatureCounts {
+        edges: snap.edges,
+        curves: f.curves.len(),
+        corners: f.corners.len(),
+        darts: f.darts,
+    });
+    lock
 }

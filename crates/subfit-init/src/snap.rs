@@ -33,31 +33,9 @@ use std::collections::{BinaryHeap, HashMap, HashSet};
 
 use subfit_mesh::vec3::{add, cross, dot, norm, norm2, normalize, scale, sub};
 use subfit_mesh::PolyMesh;
-use subfit_target::{detect_cloud_features, CloudFeatures, FeatureOptions, PointIndex, Target};
+use subfit_target::{CloudFeatures, PointIndex};
 
-use crate::init::{FeatureCounts, InitReport};
 use crate::simplify::FeatureLock;
-
-/// The hook of [`crate::initial_control_mesh`] for point clouds with
-/// [`crate::InitOptions::features`]: detects the cloud's features, snaps `dense` (the trimmed
-/// contour, normalized units) to them and fills `report.features` (edges: contour edges
-/// locked).
-pub(crate) fn cloud_feature_lock(
-    target: &Target,
-    dense: &mut PolyMesh,
-    options: &FeatureOptions,
-    report: &mut InitReport,
-) -> FeatureLock {
-    let f = detect_cloud_features(target, options);
-    let (lock, snap) = snap_to_features(dense, &f, Some((target.points(), target.index())));
-    report.features = Some(FeatureCounts {
-        edges: snap.edges,
-        curves: f.curves.len(),
-        corners: f.corners.len(),
-        darts: f.darts,
-    });
-    lock
-}
 
 /// What [`snap_to_features`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
