@@ -7,6 +7,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use subfit_mesh::{Cancel, Cancelled, PolyMesh};
 
+use crate::angular_gap::{boundary_flags, RIM_GAP, RIM_NEIGHBORS};
 use crate::closest::TriangleBvh;
 use crate::error::TargetError;
 use crate::estimate::{
@@ -516,7 +517,13 @@ impl Target {
     /// point, in parallel) and kept: later calls cost nothing.
     pub fn cloud_rim(&self) -> &[bool] {
         self.rim.get_or_init(|| {
-            crate::cloud_boundary_points(self, crate::RIM_NEIGHBORS, crate::RIM_GAP)
+            boundary_flags(
+                self.points(),
+                self.normals(),
+                self.index(),
+                RIM_NEIGHBORS,
+                RIM_GAP,
+            )
         })
     }
 
