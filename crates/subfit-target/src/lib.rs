@@ -33,6 +33,7 @@
 mod angular_gap;
 mod blend;
 pub mod boundary_corners;
+mod build_steps;
 pub mod closest;
 pub mod cloud_features;
 pub mod cloud_rim;
