@@ -36,6 +36,7 @@ mod denoise;
 mod heap;
 pub mod hexagons;
 pub mod init;
+mod init_options;
 pub mod islands;
 mod march;
 mod octree;
