@@ -25,7 +25,7 @@ use std::collections::HashMap;
 
 use subfit_mesh::{Polygons, Tags};
 
-use crate::quads::{shape_score, PairOptions};
+use crate::quad_shape::{shape_score, PairOptions};
 
 /// Splits hexagons made of a quad and two left-over triangles into two quads (see the module
 /// docs). Returns the new faces (merged faces in place of the first of their three faces, in

@@ -39,125 +39,17 @@ use std::cmp::Ordering;
 
 use crate::heap::{Entry, QuadHeap};
 use subfit_mesh::vec3::{add, cross, dot, norm, scale, sub};
-use subfit_mesh::{
-    Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, Tags, TopologyError, SHARPNESS_INFINITE,
-};
+use subfit_mesh::{Cancel, Cancelled, HalfEdgeMesh, PolyMesh, Polygons, Tags, SHARPNESS_INFINITE};
 
-/// Options of [`simplify`]. Lengths are in the mesh's units; the checks are scale-invariant.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SimplifyOptions {
-    /// Stop when at most this many (referenced) vertices remain. Default 1000.
-    pub target_vertices: usize,
-    /// Largest allowed rotation of a face normal by one collapse, in degrees. Default 75
-    /// (valid `(0, 180)`; the task's "no flipped faces" is `< 90`).
-    pub max_normal_rotation_deg: f64,
-    /// Smallest allowed triangle quality `4√3·A / (l₁² + l₂² + l₃²)` (1 for equilateral, 0 for
-    /// degenerate) of a face changed by a collapse, unless the face was already worse. Default 0.02.
-    pub min_triangle_quality: f64,
-    /// Weight of the boundary constraint planes relative to face planes (both are multiplied by
-    /// an area: face area, or boundary edge length²). Default 100.
-    pub boundary_weight: f64,
-    /// Past `target_vertices`, collapses go on while their error (the RMS distance to the
-    /// accumulated planes, mesh units) stays at or below this: regions the surface spans exactly
-    /// with fewer vertices (the flat sides and straight rulings of a CAD part) lose them.
-    /// Default 0 (stop at the target).
-    pub exact_error: f64,
-    /// Cancellation token, polled every 1024 candidate collapses; once cancelled,
-    /// [`simplify`] returns [`SimplifyError::Interrupted`]. Default: a fresh token, never
-    /// cancelled. ([`crate::initial_control_mesh`] uses [`crate::InitOptions::cancel`] instead.)
-    pub cancel: Cancel,
-}
+mod options;
+mod quadric;
+
+pub use options::{FeatureLock, SimplifyError, SimplifyOptions, SimplifyReport};
+use quadric::{add_q, eval_q, plane_quadric, q_minimizer, q_weight, Quadric};
 
 /// Candidate collapses examined between two polls of [`SimplifyOptions::cancel`] (well under a
 /// millisecond of work).
 const COLLAPSE_BATCH: usize = 1024;
-
-impl Default for SimplifyOptions {
-    fn default() -> Self {
-        Self {
-            target_vertices: 1000,
-            max_normal_rotation_deg: 75.0,
-            min_triangle_quality: 0.02,
-            boundary_weight: 100.0,
-            exact_error: 0.0,
-            cancel: Cancel::default(),
-        }
-    }
-}
-
-/// Sharp features [`simplify_with_features`] keeps: vertex ids of the input mesh.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FeatureLock {
-    /// Sharp edges `[a, b]` (either order); they stay edges of the output, as creases.
-    pub edges: Vec<[u32; 2]>,
-    /// Corner vertices: never removed, tagged as corners.
-    pub corners: Vec<u32>,
-}
-
-/// What [`simplify`] did.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct SimplifyReport {
-    /// Referenced vertices of the input.
-    pub vertices_before: usize,
-    /// Vertices of the output.
-    pub vertices_after: usize,
-    /// Triangles of the input (after fan triangulation).
-    pub faces_before: usize,
-    /// Triangles of the output.
-    pub faces_after: usize,
-    /// Edge collapses performed.
-    pub collapses: usize,
-    /// Candidate collapses rejected by the link condition (would change the topology).
-    pub rejected_link: usize,
-    /// Candidates rejected because they join two boundary vertices through the interior, or
-    /// would close a boundary loop.
-    pub rejected_boundary: usize,
-    /// Candidates rejected because a face normal would rotate too far (fold-over).
-    pub rejected_flip: usize,
-    /// Candidates rejected because a face would become degenerate.
-    pub rejected_degenerate: usize,
-    /// Largest quadric error of a performed collapse, as an RMS distance to the accumulated
-    /// planes: `sqrt(pᵀQp / Σ weights)` (mesh units).
-    pub max_error: f64,
-    /// Whether `target_vertices` was reached; `false` means no legal collapse remained.
-    pub reached_target: bool,
-    /// How many times the geometric checks were relaxed because no legal collapse remained
-    /// (0–2: first to 85° and 1/4 of the quality bound, then to 89° and 1/50 of it).
-    pub relaxations: usize,
-    /// Candidates rejected because they would remove a corner, cut a feature curve or leave it
-    /// ([`simplify_with_features`]).
-    pub rejected_feature: usize,
-    /// Whether the input stopped the simplification more than a tenth above its target and the
-    /// result is that of a Taubin-smoothed copy ([`crate::denoise`]): the counts above are the
-    /// copy's, the output's positions are smoothed (a noisy mesh).
-    pub smoothed: bool,
-}
-
-/// Why [`simplify`] cannot run.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum SimplifyError {
-    /// The input has no faces (a point cloud): contour it first.
-    #[error("the mesh has no faces")]
-    NoFaces,
-    /// A coordinate is NaN or infinite.
-    #[error("vertex {vertex} has a non-finite coordinate")]
-    NonFinite {
-        /// The vertex.
-        vertex: usize,
-    },
-    /// The input is not a manifold, consistently oriented surface.
-    #[error("the mesh is not an oriented manifold: {0}")]
-    Topology(#[from] TopologyError),
-    /// The cancellation token ([`SimplifyOptions::cancel`]) was cancelled.
-    #[error("interrupted")]
-    Interrupted,
-}
-
-impl From<Cancelled> for SimplifyError {
-    fn from(_: Cancelled) -> Self {
-        SimplifyError::Interrupted
-    }
-}
 
 /// Simplifies a manifold, oriented polygon mesh (faces are fan-triangulated) by
 /// topology-preserving quadric edge collapses until `options.target_vertices` vertices remain or
@@ -246,67 +138,6 @@ fn collapse(
         c.run(options.target_vertices, cancel)?;
     }
     Ok(c)
-}
-
-/// Symmetric 4×4 quadric, upper triangle row by row:
-/// `[a00 a01 a02 a03 a11 a12 a13 a22 a23 a33]`.
-type Quadric = [f64; 10];
-
-fn plane_quadric(n: [f64; 3], p: [f64; 3], w: f64) -> Quadric {
-    let d = -dot(n, p);
-    let v = [n[0], n[1], n[2], d];
-    let mut q = [0.0; 10];
-    let mut k = 0;
-    for i in 0..4 {
-        for j in i..4 {
-            q[k] = w * v[i] * v[j];
-            k += 1;
-        }
-    }
-    q
-}
-
-fn add_q(a: &mut Quadric, b: &Quadric) {
-    for (x, y) in a.iter_mut().zip(b) {
-        *x += y;
-    }
-}
-
-fn eval_q(q: &Quadric, p: [f64; 3]) -> f64 {
-    let [x, y, z] = p;
-    q[0] * x * x
-        + 2.0 * q[1] * x * y
-        + 2.0 * q[2] * x * z
-        + 2.0 * q[3] * x
-        + q[4] * y * y
-        + 2.0 * q[5] * y * z
-        + 2.0 * q[6] * y
-        + q[7] * z * z
-        + 2.0 * q[8] * z
-        + q[9]
-}
-
-/// Total plane weight (trace of the 3×3 block, since plane normals are unit).
-fn q_weight(q: &Quadric) -> f64 {
-    q[0] + q[4] + q[7]
-}
-
-/// Minimizer of the quadric: solves `A p = −b`; `None` when `A` is ill-conditioned.
-fn q_minimizer(q: &Quadric) -> Option<[f64; 3]> {
-    let a = [[q[0], q[1], q[2]], [q[1], q[4], q[5]], [q[2], q[5], q[7]]];
-    let b = [-q[3], -q[6], -q[8]];
-    let c0 = cross(a[1], a[2]);
-    let det = dot(a[0], c0);
-    let tr = q[0] + q[4] + q[7];
-    if !(det.abs() > 1e-9 * tr * tr * tr) {
-        return None;
-    }
-    // Cramer's rule via the adjugate (rows of the inverse are the cross products of columns).
-    let c1 = cross(a[2], a[0]);
-    let c2 = cross(a[0], a[1]);
-    let inv = 1.0 / det;
-    let p = [0, 1, 2].map(|k| (c0[k] * b[0] + c1[k] * b[1] + c2[k] * b[2]) * inv);
-    p.iter().all(|x| x.is_finite()).then_some(p)
 }
 
 /// A collapse about to be checked or performed.

@@ -33,31 +33,9 @@ use std::collections::{BinaryHeap, HashMap, HashSet};
 
 use subfit_mesh::vec3::{add, cross, dot, norm, norm2, normalize, scale, sub};
 use subfit_mesh::PolyMesh;
-use subfit_target::{detect_cloud_features, CloudFeatures, FeatureOptions, PointIndex, Target};
+use subfit_target::{CloudFeatures, FeaturePolyline, PointIndex};
 
-use crate::init::{FeatureCounts, InitReport};
 use crate::simplify::FeatureLock;
-
-/// The hook of [`crate::initial_control_mesh`] for point clouds with
-/// [`crate::InitOptions::features`]: detects the cloud's features, snaps `dense` (the trimmed
-/// contour, normalized units) to them and fills `report.features` (edges: contour edges
-/// locked).
-pub(crate) fn cloud_feature_lock(
-    target: &Target,
-    dense: &mut PolyMesh,
-    options: &FeatureOptions,
-    report: &mut InitReport,
-) -> FeatureLock {
-    let f = detect_cloud_features(target, options);
-    let (lock, snap) = snap_to_features(dense, &f, Some((target.points(), target.index())));
-    report.features = Some(FeatureCounts {
-        edges: snap.edges,
-        curves: f.curves.len(),
-        corners: f.corners.len(),
-        darts: f.darts,
-    });
-    lock
-}
 
 /// What [`snap_to_features`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -95,20 +73,7 @@ pub fn snap_to_features(
     if features.is_empty() || tris.is_empty() {
         return (FeatureLock::default(), report);
     }
-    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nv];
-    let mut vert_tris: Vec<Vec<u32>> = vec![Vec::new(); nv];
-    for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            adj[a as usize].push(b);
-            adj[b as usize].push(a);
-            vert_tris[a as usize].push(t as u32);
-        }
-    }
-    for a in &mut adj {
-        a.sort_unstable();
-        a.dedup();
-    }
+    let fan = Fan::new(tris, nv);
     // 1. Corners.
     let corner_vertex: Vec<u32> = features
         .corners
@@ -122,66 +87,22 @@ pub fn snap_to_features(
     }
     let mut lock_edges: Vec<[u32; 2]> = Vec::new();
     let mut moves: Vec<(u32, usize)> = Vec::new(); // (vertex, curve)
-                                                   // 2. Paths.
+
+    // 2. Paths.
     for (ci, curve) in features.curves.iter().enumerate() {
-        let mut anchors: Vec<u32> = curve
-            .points
-            .iter()
-            .map(|p| index.nearest(p).index)
-            .collect();
-        if !curve.closed {
-            if let Some(k) = curve.ends[0] {
-                anchors[0] = corner_vertex[k as usize];
-            }
-            if let Some(k) = curve.ends[1] {
-                *anchors.last_mut().expect("a curve has points") = corner_vertex[k as usize];
-            }
-        }
-        anchors.dedup();
-        if curve.closed && anchors.len() > 1 && anchors.first() == anchors.last() {
-            anchors.pop();
-        }
-        // Anchors of other paths (not corners) cannot be used: drop them.
-        anchors.retain(|&a| is_corner[a as usize] || !blocked[a as usize]);
+        let anchors = curve_anchors(curve, &index, &corner_vertex, &is_corner, &blocked);
         if anchors.len() < 2 {
             continue;
         }
-        let mut path: Vec<u32> = vec![anchors[0]];
-        let mut on_path: HashSet<u32> = HashSet::new();
-        on_path.insert(anchors[0]);
-        let mut pairs: Vec<(u32, u32)> = anchors.windows(2).map(|w| (w[0], w[1])).collect();
-        if curve.closed && anchors.len() > 2 {
-            pairs.push((anchors[anchors.len() - 1], anchors[0]));
-        }
-        let first = anchors[0];
-        for (from, to) in pairs {
-            if *path.last().expect("non-empty") != from {
-                // The previous piece failed: restart the path here.
-                flush(&mut path, &mut lock_edges);
-                path.push(from);
-                on_path.insert(from);
-            }
-            let closing = to == first;
-            let allowed = |v: u32| {
-                v == to
-                    || (!blocked[v as usize] && !on_path.contains(&v))
-                    || (closing && v == first)
-            };
-            // Edges are dearer away from the curve, so the path hugs it and its vertices can
-            // move onto it without passing over others.
-            let weight = |v: u32| {
-                let p = mesh.positions[v as usize];
-                let d2 = norm2(sub(closest_on_polyline(&curve.points, curve.closed, p), p));
-                1.0 + 4.0 * d2 / (features.step * features.step)
-            };
-            let piece = shortest_path(&mesh.positions, &adj, from, to, allowed, weight);
-            let Some(piece) = piece else { continue };
-            for &v in &piece[1..] {
-                on_path.insert(v);
-            }
-            path.extend_from_slice(&piece[1..]);
-        }
-        flush(&mut path, &mut lock_edges);
+        let on_path = trace_path(
+            &mesh.positions,
+            &fan.adj,
+            curve,
+            features.step,
+            &anchors,
+            &blocked,
+            &mut lock_edges,
+        );
         let before = lock_edges.len();
         for &v in &on_path {
             if !is_corner[v as usize] {
@@ -194,6 +115,154 @@ pub fn snap_to_features(
         }
     }
     // 3. Snapping: the sides next to the curves flattened, then the corners, then the paths.
+    let targets = snap_targets(
+        &mesh.positions,
+        features,
+        cloud,
+        &blocked,
+        &is_corner,
+        &corner_vertex,
+        moves,
+    );
+    apply_moves(
+        &mut mesh.positions,
+        &fan,
+        &blocked,
+        &is_corner,
+        targets,
+        &mut report,
+    );
+    feature_lock(lock_edges, corner_vertex, report)
+}
+
+/// The contour's faces fan-triangulated, with the neighbours of every vertex (sorted, no
+/// repeats) and the triangles around it.
+struct Fan {
+    tris: Vec<[u32; 3]>,
+    adj: Vec<Vec<u32>>,
+    vert_tris: Vec<Vec<u32>>,
+}
+
+impl Fan {
+    /// The adjacency of `tris` over `nv` vertices. `O(F)`.
+    fn new(tris: Vec<[u32; 3]>, nv: usize) -> Self {
+        let mut adj: Vec<Vec<u32>> = vec![Vec::new(); nv];
+        let mut vert_tris: Vec<Vec<u32>> = vec![Vec::new(); nv];
+        for (t, tri) in tris.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                adj[a as usize].push(b);
+                adj[b as usize].push(a);
+                vert_tris[a as usize].push(t as u32);
+            }
+        }
+        for a in &mut adj {
+            a.sort_unstable();
+            a.dedup();
+        }
+        Self {
+            tris,
+            adj,
+            vert_tris,
+        }
+    }
+}
+
+/// Step 2, the anchors of one curve: the contour vertices nearest its samples, curve ends at
+/// corners anchored at the corner vertices, consecutive duplicates merged, vertices of paths
+/// already traced (`blocked`, except corners) dropped.
+fn curve_anchors(
+    curve: &FeaturePolyline,
+    index: &PointIndex,
+    corner_vertex: &[u32],
+    is_corner: &[bool],
+    blocked: &[bool],
+) -> Vec<u32> {
+    let mut anchors: Vec<u32> = curve
+        .points
+        .iter()
+        .map(|p| index.nearest(p).index)
+        .collect();
+    if !curve.closed {
+        if let Some(k) = curve.ends[0] {
+            anchors[0] = corner_vertex[k as usize];
+        }
+        if let Some(k) = curve.ends[1] {
+            *anchors.last_mut().expect("a curve has points") = corner_vertex[k as usize];
+        }
+    }
+    anchors.dedup();
+    if curve.closed && anchors.len() > 1 && anchors.first() == anchors.last() {
+        anchors.pop();
+    }
+    // Anchors of other paths (not corners) cannot be used: drop them.
+    anchors.retain(|&a| is_corner[a as usize] || !blocked[a as usize]);
+    anchors
+}
+
+/// Step 2, the path of one curve: consecutive `anchors` (at least two) joined by Dijkstra
+/// shortest edge paths over `adj` that avoid `blocked` vertices; a piece that cannot be joined
+/// is skipped and the path restarts after it. The chains' edges go to `lock_edges`; returns the
+/// vertices on the path. `step`: the curves' sampling step.
+fn trace_path(
+    positions: &[[f64; 3]],
+    adj: &[Vec<u32>],
+    curve: &FeaturePolyline,
+    step: f64,
+    anchors: &[u32],
+    blocked: &[bool],
+    lock_edges: &mut Vec<[u32; 2]>,
+) -> HashSet<u32> {
+    let mut path: Vec<u32> = vec![anchors[0]];
+    let mut on_path: HashSet<u32> = HashSet::new();
+    on_path.insert(anchors[0]);
+    let mut pairs: Vec<(u32, u32)> = anchors.windows(2).map(|w| (w[0], w[1])).collect();
+    if curve.closed && anchors.len() > 2 {
+        pairs.push((anchors[anchors.len() - 1], anchors[0]));
+    }
+    let first = anchors[0];
+    for (from, to) in pairs {
+        if *path.last().expect("non-empty") != from {
+            // The previous piece failed: restart the path here.
+            flush(&mut path, lock_edges);
+            path.push(from);
+            on_path.insert(from);
+        }
+        let closing = to == first;
+        let allowed = |v: u32| {
+            v == to || (!blocked[v as usize] && !on_path.contains(&v)) || (closing && v == first)
+        };
+        // Edges are dearer away from the curve, so the path hugs it and its vertices can
+        // move onto it without passing over others.
+        let weight = |v: u32| {
+            let p = positions[v as usize];
+            let d2 = norm2(sub(closest_on_polyline(&curve.points, curve.closed, p), p));
+            1.0 + 4.0 * d2 / (step * step)
+        };
+        let piece = shortest_path(positions, adj, from, to, allowed, weight);
+        let Some(piece) = piece else { continue };
+        for &v in &piece[1..] {
+            on_path.insert(v);
+        }
+        path.extend_from_slice(&piece[1..]);
+    }
+    flush(&mut path, lock_edges);
+    on_path
+}
+
+/// Step 3, where vertices go: with the `cloud`, the free vertices near a curve onto their side
+/// of the crease ([`flatten_target`]); then the corner vertices onto the corners; then the path
+/// vertices (`moves`: vertex and curve) onto the nearest point of their curve.
+fn snap_targets(
+    positions: &[[f64; 3]],
+    features: &CloudFeatures,
+    cloud: Option<(&[[f64; 3]], &PointIndex)>,
+    blocked: &[bool],
+    is_corner: &[bool],
+    corner_vertex: &[u32],
+    mut moves: Vec<(u32, usize)>,
+) -> Vec<(u32, [f64; 3])> {
+    let nv = positions.len();
     let mut targets: Vec<(u32, [f64; 3])> = Vec::new();
     if let Some((points, cloud_index)) = cloud {
         let reach = 2.0 * features.step;
@@ -201,7 +270,7 @@ pub fn snap_to_features(
             if blocked[w as usize] || is_corner[w as usize] {
                 continue;
             }
-            let p = mesh.positions[w as usize];
+            let p = positions[w as usize];
             if let Some(to) = flatten_target(p, features, points, cloud_index, reach) {
                 targets.push((w, to));
             }
@@ -218,9 +287,23 @@ pub fn snap_to_features(
         let c = &features.curves[ci];
         targets.push((
             v,
-            closest_on_polyline(&c.points, c.closed, mesh.positions[v as usize]),
+            closest_on_polyline(&c.points, c.closed, positions[v as usize]),
         ));
     }
+    targets
+}
+
+/// Step 3, the moves: each target tried in turn, a move that would flip or nearly collapse a
+/// triangle not made; counts go to `report`.
+fn apply_moves(
+    positions: &mut [[f64; 3]],
+    fan: &Fan,
+    blocked: &[bool],
+    is_corner: &[bool],
+    mut targets: Vec<(u32, [f64; 3])>,
+    report: &mut SnapReport,
+) {
+    let (tris, adj, vert_tris) = (&fan.tris, &fan.adj, &fan.vert_tris);
     // A move blocked by a neighbour that has not moved yet may pass once it has; one still
     // blocked gets its free neighbours (neither on a path nor a corner) relaxed to the mean of
     // theirs, to untangle the strip. A few rounds.
@@ -235,17 +318,15 @@ pub fn snap_to_features(
                     let m = scale(
                         adj[wi]
                             .iter()
-                            .fold([0.0; 3], |acc, &x| add(acc, mesh.positions[x as usize])),
+                            .fold([0.0; 3], |acc, &x| add(acc, positions[x as usize])),
                         1.0 / adj[wi].len() as f64,
                     );
-                    try_move(&mut mesh.positions, &tris, &vert_tris[wi], w, m);
+                    try_move(positions, tris, &vert_tris[wi], w, m);
                 }
             }
         }
         let before = targets.len();
-        targets.retain(|&(v, to)| {
-            !try_move(&mut mesh.positions, &tris, &vert_tris[v as usize], v, to)
-        });
+        targets.retain(|&(v, to)| !try_move(positions, tris, &vert_tris[v as usize], v, to));
         report.moved += before - targets.len();
         if targets.is_empty() {
             break;
@@ -254,14 +335,23 @@ pub fn snap_to_features(
     report.kept = targets.len();
     // What still cannot move all the way goes as far as it can (halving the step).
     for &(v, to) in &targets {
-        let from = mesh.positions[v as usize];
+        let from = positions[v as usize];
         for f in [0.75, 0.5, 0.25] {
             let p = add(from, scale(sub(to, from), f));
-            if try_move(&mut mesh.positions, &tris, &vert_tris[v as usize], v, p) {
+            if try_move(positions, tris, &vert_tris[v as usize], v, p) {
                 break;
             }
         }
     }
+}
+
+/// The lock for [`crate::simplify_with_features`]: the traced edges and the corner vertices,
+/// sorted and without repeats, their counts in `report`.
+fn feature_lock(
+    mut lock_edges: Vec<[u32; 2]>,
+    corner_vertex: Vec<u32>,
+    mut report: SnapReport,
+) -> (FeatureLock, SnapReport) {
     for e in &mut lock_edges {
         e.sort_unstable();
     }

@@ -13,6 +13,7 @@ mod mni;
 pub mod obj;
 pub mod off;
 mod off_binary;
+mod off_keyword;
 pub mod ply;
 pub mod stl;
 pub mod tags_json;

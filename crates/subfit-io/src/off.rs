@@ -32,19 +32,12 @@ use std::path::Path;
 use subfit_mesh::{PolyMesh, Polygons};
 
 use crate::error::{Error, ErrorKind, Result};
+use crate::off_keyword::{keyword, Layout};
 use crate::text::{
     finite_f64, parse_f64, parse_i64, parse_int, push_f64_exact, push_u64, strip_hash_comment,
     syntax, tokens, unit_to_u8, NumberedLines,
 };
 use crate::Encoding;
-
-/// What the header keyword announces per vertex.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Layout {
-    pub(crate) normals: bool,
-    pub(crate) colors: bool,
-    pub(crate) texcoords: bool,
-}
 
 /// Parses a whole OFF file, text or binary; returns the mesh and the encoding read.
 ///
@@ -189,38 +182,6 @@ fn read_text(bytes: &[u8], path: &Path) -> Result<PolyMesh> {
         colors: layout.colors.then_some(colors),
         faces,
     })
-}
-
-/// Decodes `[ST][C][N][4][n]OFF`.
-pub(crate) fn keyword(kw: &[u8], path: &Path, no: u64) -> Result<Layout> {
-    let Some(mut pre) = kw.strip_suffix(b"OFF") else {
-        return Err(syntax(path, no, "expected the OFF header keyword", kw));
-    };
-    let mut layout = Layout::default();
-    if let Some(p) = pre.strip_prefix(b"ST") {
-        layout.texcoords = true;
-        pre = p;
-    }
-    loop {
-        match pre.first() {
-            Some(b'C') if !layout.colors => layout.colors = true,
-            Some(b'N') if !layout.normals => layout.normals = true,
-            _ => break,
-        }
-        pre = &pre[1..];
-    }
-    match pre {
-        b"" => Ok(layout),
-        b"4" | b"n" | b"4n" => Err(Error::at_line(
-            path,
-            no,
-            ErrorKind::Unsupported(format!(
-                "`{}`: OFF in other than three dimensions",
-                String::from_utf8_lossy(kw)
-            )),
-        )),
-        _ => Err(syntax(path, no, "unknown OFF header keyword", kw)),
-    }
 }
 
 /// Parses `V F [E]`.

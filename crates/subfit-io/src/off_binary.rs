@@ -26,7 +26,7 @@ use std::path::Path;
 use subfit_mesh::{PolyMesh, Polygons};
 
 use crate::error::{Error, ErrorKind, Location, Result};
-use crate::off::Layout;
+use crate::off_keyword::Layout;
 use crate::text::unit_to_u8;
 use crate::Encoding;
 

@@ -25,6 +25,7 @@
 //! f64. Faces and colours are not written.
 
 mod columns;
+mod table;
 
 use std::path::Path;
 
@@ -33,6 +34,7 @@ use subfit_mesh::{PolyMesh, Polygons};
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{finite_f64, parse_f64, parse_i64, push_f64_exact, syntax, NumberedLines};
 use columns::{decide, Plan};
+use table::Table;
 
 /// Cuts a line at `#` or `//`.
 fn strip_comment(line: &[u8]) -> &[u8] {
@@ -51,26 +53,6 @@ fn strip_comment(line: &[u8]) -> &[u8] {
 fn fields(line: &[u8]) -> impl Iterator<Item = &[u8]> {
     line.split(|&c| c.is_ascii_whitespace() || c == b',')
         .filter(|t| !t.is_empty())
-}
-
-/// Every point's values, row by row, with the line each came from.
-pub(crate) struct Table {
-    /// Values per point (the first point's count).
-    pub(crate) cols: usize,
-    /// `cols` values per point, row-major.
-    pub(crate) values: Vec<f64>,
-    /// The 1-based line of each point.
-    lines: Vec<u64>,
-}
-
-impl Table {
-    pub(crate) fn rows(&self) -> usize {
-        self.lines.len()
-    }
-
-    pub(crate) fn row(&self, i: usize) -> &[f64] {
-        &self.values[i * self.cols..(i + 1) * self.cols]
-    }
 }
 
 /// A point count line and how many points followed it so far.

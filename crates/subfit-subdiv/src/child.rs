@@ -31,7 +31,7 @@
 //! caller's [`ChildRing`] buffers.
 
 use crate::error::SubdivError;
-use crate::refine::FacePoints;
+use crate::face_points::FacePoints;
 use crate::scheme::{FaceKinds, Scheme};
 use crate::topology::{ClosedForm, Topology};
 

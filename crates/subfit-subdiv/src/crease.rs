@@ -23,8 +23,7 @@
 //! is left around a vertex (see [`crate::limit`] and [`crate::eval`], which refine until then).
 
 use crate::mask::{EdgeMask, Mask};
-use crate::refine::classify;
-use crate::scheme::{BoundaryRule, Neighborhood, Scheme, VertexRule};
+use crate::scheme::{classify, BoundaryRule, Neighborhood, Scheme, VertexRule};
 use subfit_mesh::SHARPNESS_INFINITE;
 
 /// Infinite sharpness as stored here (OpenSubdiv's `SHARPNESS_INFINITE`); any value at least

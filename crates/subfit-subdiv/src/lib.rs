@@ -33,6 +33,9 @@ pub mod stencil;
 pub mod topology;
 
 mod child;
+mod face_points;
+mod limit_row;
+mod mask_types;
 mod mixed;
 mod regular;
 mod semi_limit;

@@ -33,7 +33,7 @@
 //! spectrum 1, 1/2, 1/2, 1/4, 1/4; masks are invariant under refinement (a vertex's limit at
 //! level k equals its child's at level k + 1); refinement converges to them.
 
-use crate::mask::{EdgeMask, FaceWeights, Mask};
+use crate::mask_types::{EdgeMask, FaceWeights, Mask};
 use crate::scheme::{EdgeNeighborhood, Neighborhood, Scheme, VertexRule};
 use nalgebra::{Complex, DMatrix};
 use std::collections::HashMap;

@@ -30,9 +30,10 @@
 use crate::child::ChildCorners;
 use crate::crease;
 use crate::error::SubdivError;
+use crate::face_points::FacePoints;
 use crate::mask::{FaceWeights, Mask};
 use crate::scheme::{
-    BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Options, Scheme, VertexRule,
+    classify, BoundaryRule, EdgeNeighborhood, FaceKinds, Neighborhood, Options, Scheme, VertexRule,
 };
 use crate::stencil::{compose_rows, Stacked, StencilMatrix};
 use crate::topology::Topology;
@@ -190,37 +191,6 @@ pub(crate) fn neighborhoods(
         .collect()
 }
 
-/// The [`Neighborhood`] of a vertex from the sharpness of its ring edges (in ring order), its
-/// face count and kinds and whether it carries a corner tag. Cost O(valence).
-#[inline]
-pub(crate) fn classify(
-    edge_sharp: impl ExactSizeIterator<Item = bool>,
-    num_faces: usize,
-    faces: FaceKinds,
-    corner_tag: bool,
-    boundary: BoundaryRule,
-) -> Neighborhood {
-    let num_edges = edge_sharp.len();
-    let mut ends = [0usize; 2];
-    let mut nsharp = 0;
-    for (i, sharp) in edge_sharp.enumerate() {
-        if sharp {
-            if nsharp < 2 {
-                ends[nsharp] = i;
-            }
-            nsharp += 1;
-        }
-    }
-    let rule = VertexRule::classify(num_edges, num_faces, nsharp, corner_tag, boundary);
-    Neighborhood {
-        num_edges,
-        num_faces,
-        rule,
-        crease_ends: ends,
-        faces,
-    }
-}
-
 /// Refines `faces` (over `num_vertices` vertices, with crease/corner `tags`) by one level of
 /// `options.scheme`.
 ///
@@ -333,70 +303,6 @@ pub(crate) struct RefineRows<'a> {
     hoods: Vec<Neighborhood>,
     points: FacePoints,
     smooth_triangles: bool,
-}
-
-/// Which parent faces have a face point, and its index among the face points.
-#[derive(Clone, Debug)]
-pub(crate) enum FacePoints {
-    /// Loop: none.
-    None,
-    /// Catmull-Clark: every face, face point `f` of face `f`.
-    All(usize),
-    /// Quad/triangle: the non-triangles; `index[f]` (`u32::MAX` for a triangle) and `face[k]`.
-    Some {
-        /// Face point index of each face.
-        index: Vec<u32>,
-        /// Face of each face point.
-        face: Vec<u32>,
-    },
-}
-
-impl FacePoints {
-    /// The face points of `topo` under `scheme`. Cost O(#F).
-    pub(crate) fn new(topo: &Topology, scheme: Scheme) -> Self {
-        match scheme {
-            Scheme::Loop => FacePoints::None,
-            Scheme::CatmullClark => FacePoints::All(topo.num_faces()),
-            Scheme::QuadTriangle => {
-                let mut index = vec![u32::MAX; topo.num_faces()];
-                let mut face = Vec::new();
-                for (f, slot) in index.iter_mut().enumerate() {
-                    if topo.face(f).len() != 3 {
-                        *slot = face.len() as u32;
-                        face.push(f as u32);
-                    }
-                }
-                FacePoints::Some { index, face }
-            }
-        }
-    }
-
-    /// Number of face points.
-    pub(crate) fn len(&self) -> usize {
-        match self {
-            FacePoints::None => 0,
-            FacePoints::All(n) => *n,
-            FacePoints::Some { face, .. } => face.len(),
-        }
-    }
-
-    /// The face point index of face `f` (which must have one).
-    #[inline]
-    pub(crate) fn index(&self, f: usize) -> u32 {
-        match self {
-            FacePoints::Some { index, .. } => index[f],
-            _ => f as u32,
-        }
-    }
-
-    /// The face of face point `k`.
-    #[inline]
-    pub(crate) fn face(&self, k: usize) -> usize {
-        match self {
-            FacePoints::Some { face, .. } => face[k] as usize,
-            _ => k,
-        }
-    }
 }
 
 impl<'a> RefineRows<'a> {

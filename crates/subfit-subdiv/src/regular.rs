@@ -24,7 +24,7 @@
 
 use rayon::prelude::*;
 
-use crate::refine::FacePoints;
+use crate::face_points::FacePoints;
 use crate::scheme::{Neighborhood, VertexRule};
 use crate::stencil::SparseSum;
 use crate::topology::Topology;

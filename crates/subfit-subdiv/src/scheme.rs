@@ -271,3 +271,34 @@ pub struct EdgeNeighborhood {
     /// scheme reads it).
     pub triangles: [bool; 2],
 }
+
+/// The [`Neighborhood`] of a vertex from the sharpness of its ring edges (in ring order), its
+/// face count and kinds and whether it carries a corner tag. Cost O(valence).
+#[inline]
+pub(crate) fn classify(
+    edge_sharp: impl ExactSizeIterator<Item = bool>,
+    num_faces: usize,
+    faces: FaceKinds,
+    corner_tag: bool,
+    boundary: BoundaryRule,
+) -> Neighborhood {
+    let num_edges = edge_sharp.len();
+    let mut ends = [0usize; 2];
+    let mut nsharp = 0;
+    for (i, sharp) in edge_sharp.enumerate() {
+        if sharp {
+            if nsharp < 2 {
+                ends[nsharp] = i;
+            }
+            nsharp += 1;
+        }
+    }
+    let rule = VertexRule::classify(num_edges, num_faces, nsharp, corner_tag, boundary);
+    Neighborhood {
+        num_edges,
+        num_faces,
+        rule,
+        crease_ends: ends,
+        faces,
+    }
+}

@@ -12,7 +12,7 @@
 //! meaningful). Cost per vertex O(⌈s⌉ · valence) for the largest finite sharpness `s` around
 //! it, independent of the mesh size.
 
-use crate::limit::push_topology_limit_row_for;
+use crate::limit_row::push_topology_limit_row_for;
 use crate::refine::{refine_topology, topology_for};
 use crate::scheme::Options;
 use crate::topology::Topology;

@@ -30,8 +30,10 @@
 // `!(x > 0.0)` is used deliberately: it is true for NaN, which must take the fallback branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod angular_gap;
 mod blend;
 pub mod boundary_corners;
+mod build_steps;
 pub mod closest;
 pub mod cloud_features;
 pub mod cloud_rim;

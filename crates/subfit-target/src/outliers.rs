@@ -71,7 +71,7 @@
 use rayon::prelude::*;
 use subfit_mesh::{Cancel, Cancelled};
 
-use crate::cloud_rim::{AngularGap, RIM_GAP};
+use crate::angular_gap::{AngularGap, RIM_GAP};
 use crate::estimate::pca;
 use crate::neighbors::PointIndex;
 use crate::quadric::sym3_eigen;

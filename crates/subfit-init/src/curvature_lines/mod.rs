@@ -53,7 +53,7 @@ use std::collections::{BinaryHeap, HashSet};
 use rayon::prelude::*;
 use subfit_mesh::vec3::{cross, dot, norm, sub};
 use subfit_mesh::{Cancel, HalfEdgeMesh, PolyMesh, Polygons, Tags, UnionFind, SHARPNESS_INFINITE};
-use subfit_target::{boundary_corners, SurfaceFrame, Target};
+use subfit_target::{boundary_corners, BoundaryCorners, SurfaceFrame, Target};
 
 use boundary_curve::fit_boundary_curve;
 use regions::{Path, Surface, NONE};
@@ -196,16 +196,7 @@ pub fn curvature_line_cage(
     dense: &PolyMesh,
     options: &CurvatureLineOptions,
 ) -> Result<(PolyMesh, Tags, CurvatureLineReport), CurvatureLineError> {
-    let he = HalfEdgeMesh::from_mesh(dense).map_err(|e| CurvatureLineError::Mesh(e.to_string()))?;
-    let (genus, loops, components) = (he.genus(), he.boundary_loops().len(), he.components().count);
-    if genus != 0 || loops == 0 || components != 1 {
-        return Err(CurvatureLineError::Topology {
-            genus,
-            loops,
-            components,
-        });
-    }
-    drop(he);
+    let loops = check_topology(dense)?;
     let tris = dense.faces.triangulate_fan();
     let mut report = CurvatureLineReport::default();
     let bc = boundary_corners(
@@ -218,6 +209,94 @@ pub fn curvature_line_cage(
 
     // 1. Boundary curves: their control points are the cage's vertices.
     let t = std::time::Instant::now();
+    let BoundaryCage {
+        points: cage,
+        tags,
+        id_at,
+        mut edges,
+    } = boundary_cage(dense, &bc, options, &mut report)?;
+    report.seconds.curves = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+    let mut surface = Surface::new(dense.positions.clone(), tris);
+    let scorer = Scorer::new(target, &dense.positions);
+
+    // 2–3. Link the loops into one contour.
+    let loop_of: Vec<Vec<u32>> = bc
+        .loops
+        .iter()
+        .map(|l| {
+            l.iter()
+                .copied()
+                .filter(|&v| id_at[v as usize] != NONE)
+                .collect()
+        })
+        .collect();
+    report.links = link_loops(&mut surface, &scorer, &loop_of, &id_at, &mut edges)?;
+
+    report.seconds.links = t.elapsed().as_secs_f64();
+    let t = std::time::Instant::now();
+
+    // 4. Cut recursively; planar contours become facets.
+    let faces = cut_into_faces(
+        &mut surface,
+        &scorer,
+        &cage,
+        &id_at,
+        &mut edges,
+        options,
+        &mut report,
+    )?;
+    let mut polys = Polygons::new();
+    for f in &faces {
+        polys.push(f);
+    }
+    let out = PolyMesh::new(cage, polys);
+    let he = HalfEdgeMesh::from_mesh(&out).map_err(|e| CurvatureLineError::Cage(e.to_string()))?;
+    if he.genus() != 0 || he.boundary_loops().len() != loops {
+        return Err(CurvatureLineError::Result {
+            genus: he.genus(),
+            loops: he.boundary_loops().len(),
+        });
+    }
+    report.faces = out.faces.len();
+    report.seconds.cuts = t.elapsed().as_secs_f64();
+    Ok((out, tags, report))
+}
+
+/// The topology [`curvature_line_cage`] needs of `dense`: genus 0, one component, at least one
+/// boundary loop. Returns the number of boundary loops.
+fn check_topology(dense: &PolyMesh) -> Result<usize, CurvatureLineError> {
+    let he = HalfEdgeMesh::from_mesh(dense).map_err(|e| CurvatureLineError::Mesh(e.to_string()))?;
+    let (genus, loops, components) = (he.genus(), he.boundary_loops().len(), he.components().count);
+    if genus != 0 || loops == 0 || components != 1 {
+        return Err(CurvatureLineError::Topology {
+            genus,
+            loops,
+            components,
+        });
+    }
+    drop(he);
+    Ok(loops)
+}
+
+/// The cage after step 1: its control points, tags, the control point of each dense vertex
+/// (`NONE` for the others) and its edges (`key` pairs).
+struct BoundaryCage {
+    points: Vec<[f64; 3]>,
+    tags: Tags,
+    id_at: Vec<u32>,
+    edges: HashSet<(u32, u32)>,
+}
+
+/// Step 1: a curve fitted to each boundary loop `bc.loops` of `dense` (its corners kept), whose
+/// control points become the cage's vertices and consecutive ones its edges; corners are
+/// tagged. Errors when the curves need more than [`CurvatureLineOptions::max_control_points`].
+fn boundary_cage(
+    dense: &PolyMesh,
+    bc: &BoundaryCorners,
+    options: &CurvatureLineOptions,
+    report: &mut CurvatureLineReport,
+) -> Result<BoundaryCage, CurvatureLineError> {
     let mut cage = Vec::new();
     let mut tags = Tags::new();
     let mut id_at = vec![NONE; dense.positions.len()];
@@ -250,28 +329,27 @@ pub fn curvature_line_cage(
             allowed: options.max_control_points,
         });
     }
-    report.seconds.curves = t.elapsed().as_secs_f64();
-    let t = std::time::Instant::now();
-    let mut surface = Surface::new(dense.positions.clone(), tris);
-    let scorer = Scorer::new(target, &dense.positions);
+    Ok(BoundaryCage {
+        points: cage,
+        tags,
+        id_at,
+        edges,
+    })
+}
 
-    // 2–3. Link the loops into one contour.
-    let loop_of: Vec<Vec<u32>> = bc
-        .loops
-        .iter()
-        .map(|l| {
-            l.iter()
-                .copied()
-                .filter(|&v| id_at[v as usize] != NONE)
-                .collect()
-        })
-        .collect();
-    report.links = link_loops(&mut surface, &scorer, &loop_of, &id_at, &mut edges)?;
-
-    report.seconds.links = t.elapsed().as_secs_f64();
-    let t = std::time::Instant::now();
-
-    // 4. Cut recursively; planar contours become facets.
+/// Step 4: the contour of each region (starting from region 0, the linked loops) is cut along
+/// the best-scoring path between two of its control points until it is planar (or has at most
+/// four control points); then it becomes facets. A contour that cannot be cut closes as convex
+/// facets or a fan. Returns the faces over `cage`'s ids; adds their edges to `edges`.
+fn cut_into_faces(
+    surface: &mut Surface,
+    scorer: &Scorer,
+    cage: &[[f64; 3]],
+    id_at: &[u32],
+    edges: &mut HashSet<(u32, u32)>,
+    options: &CurvatureLineOptions,
+    report: &mut CurvatureLineReport,
+) -> Result<Vec<Vec<u32>>, CurvatureLineError> {
     let mut faces: Vec<Vec<u32>> = Vec::new();
     let mut stack = vec![0u32];
     while let Some(r) = stack.pop() {
@@ -302,12 +380,11 @@ pub fn curvature_line_cage(
         let closes = f
             .as_ref()
             .is_some_and(|f| inner_edges(f, &ids).all(|e| !edges.contains(&e)));
-        let cut =
-            best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage, false).or_else(|| {
-                (!closes)
-                    .then(|| best_cut(&mut surface, &scorer, r, &occ, &id_at, &edges, &cage, true))
-                    .flatten()
-            });
+        let cut = best_cut(surface, scorer, r, &occ, id_at, edges, cage, false).or_else(|| {
+            (!closes)
+                .then(|| best_cut(surface, scorer, r, &occ, id_at, edges, cage, true))
+                .flatten()
+        });
         match (cut, f) {
             (Some((new, a, b)), _) => {
                 edges.insert(key(a, b));
@@ -322,7 +399,7 @@ pub fn curvature_line_cage(
             (None, Some(_)) => {
                 // No cut, and the convex pieces would repeat an edge: a fan from a control
                 // point none of whose diagonals is an edge yet.
-                let f = fan(&ids, &edges).ok_or(CurvatureLineError::Stuck(ids.len()))?;
+                let f = fan(&ids, edges).ok_or(CurvatureLineError::Stuck(ids.len()))?;
                 report.fans += 1;
                 edges.extend(inner_edges(&f, &ids));
                 faces.extend(f);
@@ -330,21 +407,7 @@ pub fn curvature_line_cage(
             (None, None) => return Err(CurvatureLineError::Stuck(ids.len())),
         }
     }
-    let mut polys = Polygons::new();
-    for f in &faces {
-        polys.push(f);
-    }
-    let out = PolyMesh::new(cage, polys);
-    let he = HalfEdgeMesh::from_mesh(&out).map_err(|e| CurvatureLineError::Cage(e.to_string()))?;
-    if he.genus() != 0 || he.boundary_loops().len() != loops {
-        return Err(CurvatureLineError::Result {
-            genus: he.genus(),
-            loops: he.boundary_loops().len(),
-        });
-    }
-    report.faces = out.faces.len();
-    report.seconds.cuts = t.elapsed().as_secs_f64();
-    Ok((out, tags, report))
+    Ok(faces)
 }
 
 fn key(a: u32, b: u32) -> (u32, u32) {

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::header::{Element, Header, Property, Slot, Ty};
-use super::read::{set_color, Record, Sink};
+use super::sink::{set_color, Record, Sink};
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::{parse_f64, parse_i64, tokens, NumberedLines};
 

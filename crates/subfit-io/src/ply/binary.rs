@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::header::{Element, Header, Role, Scalar, Slot, Ty};
-use super::read::{set_color, Record, Sink};
+use super::sink::{set_color, Record, Sink};
 use crate::error::{Error, ErrorKind, Result};
 
 /// `N` bytes from the front of `b` in little-endian order. The caller guarantees `b.len() >= N`.

@@ -37,14 +37,15 @@
 //! line-level error locations, a no-panic guarantee under fuzzing with allocation capped by the
 //! data, `tristrips`, and I/O-bound speed on fixed-layout binary records.
 //!
-//! Modules: `header` (the header and the record layout it declares), `read` (the mesh being
-//! built and [`read()`]), `ascii` and `binary` (the two record decoders), `write` ([`write()`],
-//! [`write_with_properties`]).
+//! Modules: `header` (the header and the record layout it declares), `sink` (the mesh being
+//! built from decoded records), `ascii` and `binary` (the two record decoders), `read`
+//! ([`read()`]), `write` ([`write()`], [`write_with_properties`]).
 
 mod ascii;
 mod binary;
 mod header;
 mod read;
+mod sink;
 mod write;
 
 pub use read::read;

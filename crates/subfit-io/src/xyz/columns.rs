@@ -24,7 +24,7 @@
 //!
 //! Cost: O(rows × columns), one pass per candidate group.
 
-use super::Table;
+use super::table::Table;
 
 /// How colour values map to 8 bits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

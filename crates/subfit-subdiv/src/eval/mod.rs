@@ -45,11 +45,13 @@
 //! * `evaluator` — [`Evaluator`]: construction, the walk down the memoised tree, batches.
 //! * `shape` — interned local topologies below the memoised levels and the sparse refinement
 //!   steps between them (Stam 1998's repeated local subdivision matrices).
+//! * `chain` — those steps computed on first use and evaluation rows pulled back through them.
 //! * `descend` — the walk below the memoised levels, local refinement where it cannot be
 //!   used, and limits at irregular vertices.
 //! * `random` — seeded random parameters ([`random_samples`]).
 
 mod basis;
+mod chain;
 mod descend;
 mod evaluator;
 mod memo;

@@ -22,7 +22,7 @@
 //! [`SmoothBudget::max_sag`] whose smooth regions predict an RMS deviation from the facets,
 //! over the whole surface, within [`SmoothBudget::max_rms`].
 
-use super::Facets;
+use super::facets::Facets;
 use subfit_mesh::vec3::{cross, norm, sub};
 
 /// Edges turning by at least this (degrees) are creases whatever their sag: a curved face

@@ -6,7 +6,7 @@
 
 use subfit_mesh::vec3::{dot, norm, sub};
 
-use super::{FacetEdge, PlanarRegion};
+use super::elements::{FacetEdge, PlanarRegion};
 
 /// The planar region of every face and the regions. `tol` is the flat tolerance of
 /// [`super::Facets::new`].
