@@ -83,13 +83,11 @@ pub use arap::Arap;
 pub use coverage::{CoverSum, Coverage, FEATURE_WEIGHT};
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
-pub use foot_point_term::{
-    FootPointSource, FootPointTerm, FootSample, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN,
-};
+pub use foot_point_term::{FootPointTerm, FootSample, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN};
 pub use imls_term::{ImlsSample, ImlsTerm};
 pub use options::{
-    FillOrdering, FitOptions, LinearSolver, Method, Optimizer, StepControl, Variant,
-    FIRST_ORDER_STEPS,
+    FillOrdering, FitOptions, FootPointSource, LinearSolver, Method, Optimizer, StepControl,
+    Variant, FIRST_ORDER_STEPS,
 };
 pub use pcg::PcgStats;
 pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};
