@@ -18,8 +18,9 @@
 
 use std::time::{Duration, Instant};
 
-use subfit_measure::data_samples;
-use subfit_mesh::{PolyMesh, Polygons};
+use subfit_measure::data_samples::DataSamples;
+use subfit_measure::{data_samples, TwoSided};
+use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::Target;
 
@@ -27,9 +28,9 @@ use crate::enrich::FieldCage;
 use crate::error::FitError;
 use crate::options::FitOptions;
 use crate::polish::polish_best;
-use crate::report::{IterationRow, StopReason};
+use crate::report::{ErrorStats, IterationRow, StopReason};
 use crate::stage_flips::flip_pass;
-use crate::stage_measure::{measure, Best, Topo};
+use crate::stage_measure::{measure, Best, Measurement, Topo};
 use crate::stage_options::{face_score, StageOptions};
 use crate::stage_refine::{refine_step, Splitter};
 use crate::stage_report::{StageEvent, StageReport, StageStop, StagesReport, StagesResult};
@@ -122,68 +123,197 @@ pub fn fit_stages(
 ) -> Result<StagesResult, FitError> {
     stages.validate()?;
     let t0 = Instant::now();
-    let data = data_samples(target, stages.data_samples);
-    let mut mesh = PolyMesh::new(mesh.positions.clone(), mesh.faces.clone());
-    let mut tags = base.tags.clone();
-    let mut lambda = stages.lambda_start;
-    // Refinement depth of every face (0 for the initial faces).
-    let mut depth = vec![0u8; mesh.faces.len()];
-    // The points local enrichment added ([`crate::enrich`]): a field around one is diffuse.
-    let mut enriched: Vec<bool> = Vec::new();
-    let mut reports: Vec<StageReport> = Vec::new();
-    let mut initial = None;
-    let mut stop = StageStop::Limit;
-    let mut used = 0;
-    let mut best: Option<Best> = None;
-    let mut since_best = 0;
-    // The badness of the last stage that improved by more than STALL_GAIN.
-    let mut stall_base = f64::INFINITY;
-    // Control points and judged RMS of the last stage, and refinements in a row that did not
-    // pay (REFINE_PAYOFF).
-    let mut last_rms: Option<(usize, f64)> = None;
-    let mut unpaid = 0;
-    // Whether data → surface met the tolerances at the last measurement: until it does, a
-    // stage does not stop at the one-sided tolerance.
-    let mut data_met = !stages.two_sided;
-    // Vertices the last change touched, for a local stage.
-    let mut touched: Option<Vec<bool>> = None;
+    let mut run = StageRun::new(target, mesh, base, stages);
     let mut topo: Option<Topo<'_>> = None;
     for stage in 0..stages.max_stages {
-        if used >= stages.max_iterations {
+        if run.used >= stages.max_iterations {
             break;
         }
+        if !run.stage(stage, &mut topo, &mut progress)? {
+            break;
+        }
+    }
+    run.finish(t0, &mut progress)
+}
+
+/// The progress callback of [`fit_stages`], passed on to its phases.
+type Progress<'p> = Option<&'p mut dyn FnMut(StageEvent<'_>)>;
+
+/// The state [`fit_stages`] carries from stage to stage: the cage, the `λ` schedule, the log,
+/// the best cage measured and the counters of the stopping rules.
+struct StageRun<'a> {
+    target: &'a Target,
+    base: &'a FitOptions,
+    stages: &'a StageOptions,
+    data: DataSamples,
+    mesh: PolyMesh,
+    tags: Tags,
+    lambda: f64,
+    /// Refinement depth of every face (0 for the initial faces).
+    depth: Vec<u8>,
+    /// The points local enrichment added ([`crate::enrich`]): a field around one is diffuse.
+    enriched: Vec<bool>,
+    reports: Vec<StageReport>,
+    initial: Option<(ErrorStats, TwoSided)>,
+    stop: StageStop,
+    /// Iterations used over all stages.
+    used: usize,
+    best: Option<Best>,
+    since_best: usize,
+    /// The badness of the last stage that improved by more than STALL_GAIN.
+    stall_base: f64,
+    /// Control points and judged RMS of the last stage, and refinements in a row that did not
+    /// pay (REFINE_PAYOFF).
+    last_rms: Option<(usize, f64)>,
+    unpaid: usize,
+    /// Whether data → surface met the tolerances at the last measurement: until it does, a
+    /// stage does not stop at the one-sided tolerance.
+    data_met: bool,
+    /// Vertices the last change touched, for a local stage.
+    touched: Option<Vec<bool>>,
+}
+
+impl<'a> StageRun<'a> {
+    /// The state before the first stage: a copy of `mesh`, the data samples of `target`, `λ`
+    /// at its start.
+    fn new(
+        target: &'a Target,
+        mesh: &PolyMesh,
+        base: &'a FitOptions,
+        stages: &'a StageOptions,
+    ) -> Self {
+        let data = data_samples(target, stages.data_samples);
+        let mesh = PolyMesh::new(mesh.positions.clone(), mesh.faces.clone());
+        let depth = vec![0u8; mesh.faces.len()];
+        Self {
+            target,
+            base,
+            stages,
+            data,
+            mesh,
+            tags: base.tags.clone(),
+            lambda: stages.lambda_start,
+            depth,
+            enriched: Vec::new(),
+            reports: Vec::new(),
+            initial: None,
+            stop: StageStop::Limit,
+            used: 0,
+            best: None,
+            since_best: 0,
+            stall_base: f64::INFINITY,
+            last_rms: None,
+            unpaid: 0,
+            data_met: !stages.two_sided,
+            touched: None,
+        }
+    }
+
+    /// Stage `stage`: fit and measure the cage ([`Self::fit`]), keep it if it is the best
+    /// ([`Self::record`]), change it where it misses ([`Self::change_cage`]) and decide
+    /// whether to go on (true) or stop ([`Self::ends`]). `topo` is the fitter of the current
+    /// topology, dropped when the cage's faces change.
+    fn stage(
+        &mut self,
+        stage: usize,
+        topo: &mut Option<Topo<'a>>,
+        progress: &mut Progress<'_>,
+    ) -> Result<bool, FitError> {
+        let stages = self.stages;
         let ts = Instant::now();
         let stage_opts = FitOptions {
-            tags: tags.clone(),
-            ..base.clone()
+            tags: self.tags.clone(),
+            ..self.base.clone()
         };
         let fresh = topo.is_none();
-        let t = match &mut topo {
+        let t = match topo {
             Some(t) => t,
-            None => topo.insert(Topo::new(target, &mesh, &stage_opts)?),
+            None => topo.insert(Topo::new(self.target, &self.mesh, &stage_opts)?),
         };
-        let (tol_rms, tol_max) = if data_met {
+        let n = self.mesh.num_vertices();
+        let (mut report, m, last) = self.fit(stage, t, fresh, progress)?;
+        self.record(stage, n, last, &m);
+        let judged = m.judged;
+        let next_lambda = (self.lambda * stages.lambda_factor).max(stages.lambda_end);
+        let mut changed = next_lambda < self.lambda;
+        // Change the cage only if an iteration of a later stage can fit the change.
+        let room = self.used < stages.max_iterations && stage + 1 < stages.max_stages;
+        if stages.met(&last, &m.judged) {
+            self.stop = StageStop::Tolerance;
+        } else if room
+            && (self.base.scheme != Scheme::Loop || self.mesh.faces.is_triangles())
+            && (stages.refine || stages.edge_flips)
+        {
+            let (cage_changed, faces_changed) =
+                self.change_cage(t, &stage_opts, &mut report, m, last, n)?;
+            changed |= cage_changed;
+            if faces_changed {
+                *topo = None;
+            }
+        }
+        report.time = ts.elapsed();
+        if let Some(p) = progress.as_mut() {
+            p(StageEvent::Stage(&report));
+        }
+        let ran_out = report.fit.stop == StopReason::MaxIterations;
+        self.reports.push(report);
+        if self.stop == StageStop::Tolerance {
+            return Ok(false);
+        }
+        if !room {
+            self.stop = StageStop::Limit;
+            return Ok(false);
+        }
+        if self.ends(n, next_lambda, changed, ran_out, &last, &judged) {
+            return Ok(false);
+        }
+        self.lambda = next_lambda;
+        Ok(true)
+    }
+
+    /// Runs the fitter `t` on the cage at the current `λ` — only on the region around the last
+    /// change when [`StageOptions::local`] — and measures the result both ways. Returns the
+    /// stage's report (no mesh changes yet), the measurement and the fit's last errors.
+    fn fit(
+        &mut self,
+        stage: usize,
+        t: &mut Topo<'a>,
+        fresh: bool,
+        progress: &mut Progress<'_>,
+    ) -> Result<(StageReport, Measurement, ErrorStats), FitError> {
+        let stages = self.stages;
+        let (tol_rms, tol_max) = if self.data_met {
             (stages.tolerance_rms, stages.tolerance_max)
         } else {
             (0.0, 0.0)
         };
         t.fitter.set_stage(
-            lambda,
+            self.lambda,
             stages
                 .iterations_per_stage
-                .min(stages.max_iterations - used),
+                .min(stages.max_iterations - self.used),
             tol_rms,
             tol_max,
             stages.stall,
         );
-        let n = mesh.num_vertices();
-        let active = touched
+        let n = self.mesh.num_vertices();
+        let active = self
+            .touched
             .take()
-            .and_then(|seed| local_region(&mesh.faces, seed, stages.local_rings));
+            .and_then(|seed| local_region(&self.mesh.faces, seed, stages.local_rings));
         let active_points = active.as_ref().map(|a| a.iter().filter(|&&x| x).count());
         t.fitter.set_active(active)?;
-        let initial_two_sided = match initial {
-            None => Some(measure(t, &mesh.faces, &mesh.positions, &data, stages).two_sided),
+        let initial_two_sided = match self.initial {
+            None => Some(
+                measure(
+                    t,
+                    &self.mesh.faces,
+                    &self.mesh.positions,
+                    &self.data,
+                    stages,
+                )
+                .two_sided,
+            ),
             Some(_) => None,
         };
         let fit = {
@@ -192,26 +322,33 @@ pub fn fit_stages(
                     p(StageEvent::Iteration { stage, row });
                 }
             };
-            let mut fit = t.fitter.run(&mut mesh.positions, Some(&mut cb))?;
+            let mut fit = t.fitter.run(&mut self.mesh.positions, Some(&mut cb))?;
             if !fresh {
                 // The operator, pattern and symbolic analysis of the last stage were reused.
                 fit.setup = Duration::ZERO;
             }
             fit
         };
-        used += fit.iterations.len().max(1);
+        self.used += fit.iterations.len().max(1);
         let last = fit.last();
-        let m = measure(t, &mesh.faces, &mesh.positions, &data, stages);
-        initial.get_or_insert((fit.initial, initial_two_sided.unwrap_or(m.two_sided)));
-        data_met = !stages.two_sided
+        let m = measure(
+            t,
+            &self.mesh.faces,
+            &self.mesh.positions,
+            &self.data,
+            stages,
+        );
+        self.initial
+            .get_or_insert((fit.initial, initial_two_sided.unwrap_or(m.two_sided)));
+        self.data_met = !stages.two_sided
             || m.judged
                 .data_to_surface
                 .within(stages.tolerance_rms, stages.tolerance_max);
-        let mut report = StageReport {
+        let report = StageReport {
             stage,
-            lambda,
+            lambda: self.lambda,
             num_control_points: n,
-            num_faces: mesh.faces.len(),
+            num_faces: self.mesh.faces.len(),
             fit,
             two_sided: m.two_sided,
             flips_tried: 0,
@@ -222,119 +359,140 @@ pub fn fit_stages(
             polish: None,
             time: Duration::ZERO,
         };
+        Ok((report, m, last))
+    }
+
+    /// Updates the stopping rules' counters with stage `stage`'s cage (`n` control points,
+    /// errors `last`, measurement `m`) and keeps it if it is the best so far.
+    fn record(&mut self, stage: usize, n: usize, last: ErrorStats, m: &Measurement) {
+        let stages = self.stages;
         let badness = stages.badness(&last, &m.judged);
         let rms = stages.judged(&last, &m.judged).0;
-        if let Some((n0, r0)) = last_rms.filter(|&(n0, _)| n > n0 && stages.refine_payoff > 0.0) {
+        if let Some((n0, r0)) = self
+            .last_rms
+            .filter(|&(n0, _)| n > n0 && stages.refine_payoff > 0.0)
+        {
             let misses = stages.tolerance_rms > 0.0 && rms > stages.tolerance_rms;
             let paid = rms <= r0 * (n0 as f64 / n as f64).powf(stages.refine_payoff);
-            unpaid = if misses && !paid { unpaid + 1 } else { 0 };
+            self.unpaid = if misses && !paid { self.unpaid + 1 } else { 0 };
         }
-        last_rms = Some((n, rms));
-        let improved = best.as_ref().is_none_or(|b| badness < b.badness);
-        if badness < stall_base * (1.0 - STALL_GAIN) {
-            stall_base = badness;
-            since_best = 0;
+        self.last_rms = Some((n, rms));
+        let improved = self.best.as_ref().is_none_or(|b| badness < b.badness);
+        if badness < self.stall_base * (1.0 - STALL_GAIN) {
+            self.stall_base = badness;
+            self.since_best = 0;
         } else {
-            since_best += 1;
+            self.since_best += 1;
         }
         if improved {
-            best = Some(Best {
+            self.best = Some(Best {
                 stage,
                 badness,
-                mesh: mesh.clone(),
-                tags: tags.clone(),
+                mesh: self.mesh.clone(),
+                tags: self.tags.clone(),
                 errors: last,
                 two_sided: m.two_sided,
                 judged: m.judged,
             });
         }
-        let next_lambda = (lambda * stages.lambda_factor).max(stages.lambda_end);
-        let mut changed = next_lambda < lambda;
-        // Change the cage only if an iteration of a later stage can fit the change.
-        let room = used < stages.max_iterations && stage + 1 < stages.max_stages;
-        if stages.met(&last, &m.judged) {
-            stop = StageStop::Tolerance;
-        } else if room
-            && (base.scheme != Scheme::Loop || mesh.faces.is_triangles())
-            && (stages.refine || stages.edge_flips)
-        {
-            let unmet = stages.unmet(&last, &m.judged);
-            let mut score: Vec<f64> = m
-                .surface_faces
-                .iter()
-                .zip(&m.data_faces)
-                .map(|(s, d)| face_score(s, stages, unmet).max(face_score(d, stages, unmet)))
-                .collect();
-            let mut seed = stages.local.then(|| vec![false; n]);
-            let before = mesh.faces.clone();
-            let mut per_face = (m.surface_faces, m.data_faces);
-            let mut inserted = 0;
-            if unmet.1 {
-                let cage = FieldCage {
-                    mesh: &mut mesh,
-                    tags: &tags,
-                    score: &mut score,
-                    depth: &mut depth,
-                    per_face: &mut per_face,
-                    enriched: &mut enriched,
-                };
-                inserted = cage.enrich(&m.points, stages, unmet.0);
-                report.local_points = inserted;
-                changed |= inserted > 0;
-            }
-            // Flips are judged on the measured cage: not in a stage that inserted points.
-            if stages.edge_flips && inserted == 0 {
-                let (tried, kept) = flip_pass(
-                    t.fitter.term(),
-                    &mut mesh,
-                    (&per_face.0, &per_face.1),
-                    &mut score,
-                    stages,
-                    unmet,
-                    &stage_opts,
-                )?;
-                report.flips_tried = tried;
-                report.flips_kept = kept;
-                changed |= kept > 0;
-                if let Some(seed) = seed.as_mut() {
-                    mark_flipped(seed, &before, &mesh.faces);
-                }
-            }
-            if stages.refine && n < stages.max_control_points {
-                let how = Splitter::for_options(&stage_opts);
-                let step = StageOptions {
-                    growth: needed_growth(stages, stages.judged(&last, &m.two_sided).0, unmet),
-                    ..stages.clone()
-                };
-                if let Some(r) = refine_step(&mesh, &tags, &score, &depth, &step, &how)? {
-                    changed |= r.stats.new_points > 0;
-                    tags = r.tags;
-                    mesh = r.mesh;
-                    depth = r.per_face;
-                    report.refine = Some(r.stats);
-                }
-            }
-            if mesh.faces != before {
-                topo = None;
-            }
-            if let Some(mut seed) = seed {
-                mark_refined(&mut seed, n, &mesh.faces, mesh.num_vertices());
-                touched = seed.contains(&true).then_some(seed);
+    }
+
+    /// Changes the measured cage (`n` control points, errors `last`, measurement `m`) where it
+    /// misses: local enrichment when the maximum is missed, edge flips that lower the error,
+    /// then red-green or polygon refinement of the faces above the tolerance; fills in the
+    /// report's counts. Returns whether the cage changed and whether its faces did (then the
+    /// fitter of the old topology is stale).
+    fn change_cage(
+        &mut self,
+        t: &Topo<'a>,
+        stage_opts: &FitOptions,
+        report: &mut StageReport,
+        m: Measurement,
+        last: ErrorStats,
+        n: usize,
+    ) -> Result<(bool, bool), FitError> {
+        let stages = self.stages;
+        let mut changed = false;
+        let unmet = stages.unmet(&last, &m.judged);
+        let mut score: Vec<f64> = m
+            .surface_faces
+            .iter()
+            .zip(&m.data_faces)
+            .map(|(s, d)| face_score(s, stages, unmet).max(face_score(d, stages, unmet)))
+            .collect();
+        let mut seed = stages.local.then(|| vec![false; n]);
+        let before = self.mesh.faces.clone();
+        let mut per_face = (m.surface_faces, m.data_faces);
+        let mut inserted = 0;
+        if unmet.1 {
+            let cage = FieldCage {
+                mesh: &mut self.mesh,
+                tags: &self.tags,
+                score: &mut score,
+                depth: &mut self.depth,
+                per_face: &mut per_face,
+                enriched: &mut self.enriched,
+            };
+            inserted = cage.enrich(&m.points, stages, unmet.0);
+            report.local_points = inserted;
+            changed |= inserted > 0;
+        }
+        // Flips are judged on the measured cage: not in a stage that inserted points.
+        if stages.edge_flips && inserted == 0 {
+            let (tried, kept) = flip_pass(
+                t.fitter.term(),
+                &mut self.mesh,
+                (&per_face.0, &per_face.1),
+                &mut score,
+                stages,
+                unmet,
+                stage_opts,
+            )?;
+            report.flips_tried = tried;
+            report.flips_kept = kept;
+            changed |= kept > 0;
+            if let Some(seed) = seed.as_mut() {
+                mark_flipped(seed, &before, &self.mesh.faces);
             }
         }
-        report.time = ts.elapsed();
-        if let Some(p) = progress.as_mut() {
-            p(StageEvent::Stage(&report));
+        if stages.refine && n < stages.max_control_points {
+            let how = Splitter::for_options(stage_opts);
+            let step = StageOptions {
+                growth: needed_growth(stages, stages.judged(&last, &m.two_sided).0, unmet),
+                ..stages.clone()
+            };
+            if let Some(r) = refine_step(&self.mesh, &self.tags, &score, &self.depth, &step, &how)?
+            {
+                changed |= r.stats.new_points > 0;
+                self.tags = r.tags;
+                self.mesh = r.mesh;
+                self.depth = r.per_face;
+                report.refine = Some(r.stats);
+            }
         }
-        let ran_out = report.fit.stop == StopReason::MaxIterations;
-        reports.push(report);
-        if stop == StageStop::Tolerance {
-            break;
+        let faces_changed = self.mesh.faces != before;
+        if let Some(mut seed) = seed {
+            mark_refined(&mut seed, n, &self.mesh.faces, self.mesh.num_vertices());
+            self.touched = seed.contains(&true).then_some(seed);
         }
-        if !room {
-            stop = StageStop::Limit;
-            break;
-        }
+        Ok((changed, faces_changed))
+    }
+
+    /// Whether the stages end after a stage of `n` control points that left the cage with
+    /// errors `last` and judged distances `judged`, `λ` going to `next_lambda`; sets
+    /// [`Self::stop`] when they do. `changed`: whether `λ` or the cage changes; `ran_out`:
+    /// whether the stage's fit ran out of iterations.
+    fn ends(
+        &mut self,
+        n: usize,
+        next_lambda: f64,
+        changed: bool,
+        ran_out: bool,
+        last: &ErrorStats,
+        judged: &TwoSided,
+    ) -> bool {
+        let stages = self.stages;
+        let lambda = self.lambda;
         // With the control-point budget spent and λ at its end only flips change the cage; a
         // stage there that did not gain more than STALL_GAIN ends the fit. (The bunny's points
         // at 4,667 control points: IMLS's stages 3–4 and SDM's 3–7 came after their best or
@@ -345,68 +503,78 @@ pub fn fit_stages(
         // with more at the same `λ` even when nothing else changes: with a cage at its budget
         // from the start (`--max-control-points` at the initial cage's size) the stages
         // otherwise end after the `λ` schedule, two or three stages short of convergence.
-        let going = since_best == 0 && ran_out;
-        let diminishing = unpaid >= UNPAID_REFINEMENTS;
+        let going = self.since_best == 0 && ran_out;
+        let diminishing = self.unpaid >= UNPAID_REFINEMENTS;
         let hopeless = stages.must_reach
             && next_lambda >= lambda
-            && stages.points_to_reach(&last, &m.judged, n) > stages.max_control_points as f64;
+            && stages.points_to_reach(last, judged, n) > stages.max_control_points as f64;
         if (!changed && !going)
-            || (spent && since_best > 0)
-            || since_best >= STALL_STAGES
+            || (spent && self.since_best > 0)
+            || self.since_best >= STALL_STAGES
             || diminishing
             || hopeless
         {
-            stop = if hopeless {
+            self.stop = if hopeless {
                 StageStop::Hopeless
-            } else if mesh.num_vertices() >= stages.max_control_points {
+            } else if self.mesh.num_vertices() >= stages.max_control_points {
                 StageStop::Budget
             } else if diminishing {
                 StageStop::Diminishing
             } else {
                 StageStop::Stalled
             };
-            break;
+            return true;
         }
-        lambda = next_lambda;
+        false
     }
-    let (initial, initial_two_sided) = initial.unwrap_or_default();
-    let mut best = best.ok_or_else(|| FitError::BadInput("no stage was run".into()))?;
-    let lambda = reports.get(best.stage).map_or(lambda, |r| r.lambda);
-    let left = stages
-        .iterations_per_stage
-        .min(stages.max_iterations.saturating_sub(used));
-    let stage = reports.len();
-    if let Some(r) = polish_best(
-        target,
-        base,
-        stages,
-        &mut best,
-        &data,
-        stage,
-        lambda,
-        left,
-        &mut progress,
-    )? {
-        if r.polish == Some(true) && stages.met(&best.errors, &best.judged) {
-            stop = StageStop::Tolerance;
+
+    /// The last step, the polish of the best cage ([`crate::polish`]) with the iterations
+    /// left, and the result: the best cage and the log (`t0`: when [`fit_stages`] started).
+    fn finish(self, t0: Instant, progress: &mut Progress<'_>) -> Result<StagesResult, FitError> {
+        let stages = self.stages;
+        let mut stop = self.stop;
+        let mut reports = self.reports;
+        let (initial, initial_two_sided) = self.initial.unwrap_or_default();
+        let mut best = self
+            .best
+            .ok_or_else(|| FitError::BadInput("no stage was run".into()))?;
+        let lambda = reports.get(best.stage).map_or(self.lambda, |r| r.lambda);
+        let left = stages
+            .iterations_per_stage
+            .min(stages.max_iterations.saturating_sub(self.used));
+        let stage = reports.len();
+        if let Some(r) = polish_best(
+            self.target,
+            self.base,
+            stages,
+            &mut best,
+            &self.data,
+            stage,
+            lambda,
+            left,
+            progress,
+        )? {
+            if r.polish == Some(true) && stages.met(&best.errors, &best.judged) {
+                stop = StageStop::Tolerance;
+            }
+            reports.push(r);
         }
-        reports.push(r);
+        Ok(StagesResult {
+            mesh: best.mesh,
+            tags: best.tags,
+            report: StagesReport {
+                initial,
+                initial_two_sided,
+                last: best.errors,
+                two_sided: best.two_sided,
+                best_stage: best.stage,
+                data_samples: self.data.kind,
+                stages: reports,
+                stop,
+                time: t0.elapsed(),
+            },
+        })
     }
-    Ok(StagesResult {
-        mesh: best.mesh,
-        tags: best.tags,
-        report: StagesReport {
-            initial,
-            initial_two_sided,
-            last: best.errors,
-            two_sided: best.two_sided,
-            best_stage: best.stage,
-            data_samples: data.kind,
-            stages: reports,
-            stop,
-            time: t0.elapsed(),
-        },
-    })
 }
 
 /// How fast the RMS error falls with the control points of a refined cage, `RMS ∝ n^−order`:
