@@ -12,7 +12,7 @@ use crate::remesh::FaceError;
 use crate::report::ErrorStats;
 
 /// Options of the stage driver; the per-iteration options (method, step control, sample
-/// level, scheme) come from a [`FitOptions`].
+/// level, scheme) come from a [`crate::FitOptions`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct StageOptions {
     /// `λ` of the first stage (the papers: 1e-3).
@@ -80,19 +80,19 @@ pub struct StageOptions {
     /// always uses its points). Default 0.
     pub data_samples: usize,
     /// The error power of the last step, a polish of the best cage towards a lower maximum
-    /// error ([`crate::polish`]; [`FitOptions::error_power`]); kept only when it lowers the
+    /// error ([`crate::polish`]; [`crate::FitOptions::error_power`]); kept only when it lowers the
     /// maximum without costing RMS. Default 3; 2 or less turns it off. Valid: `≤ 8`.
     pub polish_power: f64,
     /// The rate below which a refinement does not pay: [`crate::UNPAID_REFINEMENTS`] refinements in a
     /// row that lower the judged RMS by less than `n^−refine_payoff` in the control points `n`,
-    /// while it misses its tolerance, end the stages ([`StageStop::Diminishing`]). Default
+    /// while it misses its tolerance, end the stages ([`crate::StageStop::Diminishing`]). Default
     /// [`REFINE_PAYOFF`]; 0 turns the rule off.
     pub refine_payoff: f64,
     /// The fit is of use only if it meets its tolerances within
     /// [`Self::max_control_points`] (a later start that can win only so): once `λ` is at
     /// its end, a stage from which even the best rate of approximation
     /// ([`Self::points_to_reach`]) needs more control points than the budget ends the
-    /// stages ([`StageStop::Hopeless`]). Default off.
+    /// stages ([`crate::StageStop::Hopeless`]). Default off.
     pub must_reach: bool,
     /// Local enrichment ([`crate::enrich`], Lavoué et al. 2005 §5.2): an error field of which
     /// fewer than [`Self::local_field_share`] of the error points are at least this fraction
@@ -272,11 +272,13 @@ impl StageOptions {
 /// for an RMS of 8.9e-4 → 7.6e-4 of the diagonal (tolerance 7.5e-4).
 pub const REFINE_PAYOFF: f64 = 0.15;
 
-/// Lavoué et al.'s "close to `d_max`": the error points at or above this fraction of the
-/// field's maximum count towards its peak share.
+/// Local enrichment ([`crate::enrich`]; Lavoué et al. 2005 §5.2): Lavoué et al.'s "close to
+/// `d_max`", the error points at or above this fraction of the field's maximum count towards
+/// its peak share.
 pub const LOCAL_FIELD_PEAK: f64 = 0.8;
-/// Lavoué et al.'s threshold on the share of a field's error points close to its maximum:
-/// below it the field is local (one control point), else diffuse.
+/// Local enrichment ([`crate::enrich`]; Lavoué et al. 2005 §5.2): Lavoué et al.'s threshold on
+/// the share of a field's error points close to its maximum: below it the field is local (one
+/// control point), else diffuse.
 pub const LOCAL_FIELD_SHARE: f64 = 0.5;
 
 /// How far above the tolerance a face is (`> 1`: too large), counting only the tolerances the
