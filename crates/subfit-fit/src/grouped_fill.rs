@@ -79,11 +79,15 @@ fn is_subset(a: &[u32], b: &[u32]) -> bool {
     a.iter().all(|x| it.by_ref().any(|y| y == x))
 }
 
-/// The hosts of the samples of `c` (`m × n`): its distinct supports (sample `k` has the
-/// support `dist_of[k]`), then, largest first, each support joins the first host containing
-/// it or becomes a host (`host_of_dist`, `u32::MAX` for an empty support; `host_sup`, the
-/// hosts' supports). `None` when a host would exceed [`MAX_HOST`] points.
-fn host_supports(c: &StencilMatrix) -> Option<(Vec<u32>, Vec<u32>, Vec<&[u32]>)> {
+/// What [`host_supports`] returns: the distinct support of every sample (`dist_of`), the host
+/// of every distinct support (`host_of_dist`, `u32::MAX` for an empty one) and the hosts'
+/// supports (`host_sup`).
+type HostSupports<'c> = (Vec<u32>, Vec<u32>, Vec<&'c [u32]>);
+
+/// The hosts of the samples of `c` (`m × n`): its distinct supports, then, largest first, each
+/// support joins the first host containing it or becomes a host ([`HostSupports`]). `None`
+/// when a host would exceed [`MAX_HOST`] points.
+fn host_supports(c: &StencilMatrix) -> Option<HostSupports<'_>> {
     let (m, n) = (c.nrows(), c.ncols());
     // Distinct supports, then hosts: largest first, each joins the first host containing it.
     let mut distinct: HashMap<&[u32], u32> = HashMap::new();
