@@ -272,13 +272,13 @@ impl StageOptions {
 /// for an RMS of 8.9e-4 → 7.6e-4 of the diagonal (tolerance 7.5e-4).
 pub const REFINE_PAYOFF: f64 = 0.15;
 
-/// Local enrichment ([`crate::enrich`]; Lavoué et al. 2005 §5.2): Lavoué et al.'s "close to
-/// `d_max`", the error points at or above this fraction of the field's maximum count towards
-/// its peak share.
+/// The default [`StageOptions::local_field_peak`] (local enrichment, Lavoué et al. 2005 §5.2):
+/// Lavoué et al.'s "close to `d_max`", the error points at or above this fraction of the
+/// field's maximum count towards its peak share.
 pub const LOCAL_FIELD_PEAK: f64 = 0.8;
-/// Local enrichment ([`crate::enrich`]; Lavoué et al. 2005 §5.2): Lavoué et al.'s threshold on
-/// the share of a field's error points close to its maximum: below it the field is local (one
-/// control point), else diffuse.
+/// The default [`StageOptions::local_field_share`] (local enrichment, Lavoué et al. 2005 §5.2):
+/// Lavoué et al.'s threshold on the share of a field's error points close to its maximum:
+/// below it the field is local (one control point), else diffuse.
 pub const LOCAL_FIELD_SHARE: f64 = 0.5;
 
 /// How far above the tolerance a face is (`> 1`: too large), counting only the tolerances the

@@ -1,5 +1,5 @@
 //! Multi-stage fitting (Cheng et al. 2007 §II-B step 8, §II-E, §II-F and Table IV; Cheng et
-//! al. 2004 §4.4–4.6; DESIGN.md §3.5): a sequence of [`Fitter`] runs in which the smoothing
+//! al. 2004 §4.4–4.6; DESIGN.md §3.5): a sequence of [`crate::Fitter`] runs in which the smoothing
 //! weight `λ` is lowered from stage to stage (default 1e-3 → 1e-5, ×0.1 per stage) and, when
 //! a stage stalls above the tolerance, the control mesh is changed where the error is large:
 //! edge flips that lower the error are kept, then the faces with large error are split 1-to-4
@@ -109,7 +109,7 @@ pub const UNPAID_REFINEMENTS: usize = 2;
 /// tolerances set (the two-sided `E_rms` when none is) — never one refined and not yet
 /// optimized: no refinement or flip is made when no iteration or stage is left to fit it.
 ///
-/// Errors: those of [`Fitter::new`] and [`Fitter::run`]; invalid stage options. Cost: per topology one [`Fitter`] setup (sampling
+/// Errors: those of [`crate::Fitter::new`] and [`crate::Fitter::run`]; invalid stage options. Cost: per topology one [`crate::Fitter`] setup (sampling
 /// operator, symbolic analysis); per stage its iterations and one measurement (the last
 /// iteration's projections reused, a BVH over the samples' tessellation and one query per data
 /// sample); flips cost one more sampling operator and a projection of the samples of the faces

@@ -87,7 +87,7 @@ impl DeformationGraph {
     /// variant that took the nearest in space among the nodes not much farther round than
     /// through — a cross-section as one piece — tracked the dance worse: drift RMS 1.10 %
     /// against 0.78 %, and the generated tube's spin no better). Points
-    /// other than the samples ([`deform`], markers) take the skinning of their nearest sample.
+    /// other than the samples ([`super::deform`], markers) take the skinning of their nearest sample.
     /// Cost: [`Self::interior`] plus one Dijkstra per node over the samples.
     ///
     /// # Panics
