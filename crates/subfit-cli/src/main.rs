@@ -19,6 +19,7 @@ macro_rules! out {
 }
 
 mod cli;
+mod cli_bench;
 mod cli_output;
 mod commands;
 mod hints;

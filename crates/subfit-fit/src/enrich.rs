@@ -47,14 +47,7 @@ use crate::error_field::{
     error_fields, scores_of_fields, two_sided_max, ErrorField, VertexFaces, FIELD_THRESHOLD,
 };
 use crate::remesh::FaceError;
-use crate::stages::StageOptions;
-
-/// Lavoué et al.'s "close to `d_max`": the error points at or above this fraction of the
-/// field's maximum count towards its peak share.
-pub const LOCAL_FIELD_PEAK: f64 = 0.8;
-/// Lavoué et al.'s threshold on the share of a field's error points close to its maximum:
-/// below it the field is local (one control point), else diffuse.
-pub const LOCAL_FIELD_SHARE: f64 = 0.5;
+use crate::stage_options::StageOptions;
 
 /// The error points of a measured cage: each level-`l` sub-face of `op` (its largest corner
 /// error, `err2` being the squared errors of its vertices) and each data point (`to_surface`;

@@ -48,7 +48,7 @@ use subfit_mesh::vec3::dot;
 use subfit_target::{FootPoint, Target};
 
 use crate::coverage::{CoverSum, Coverage};
-use crate::options::FitOptions;
+use crate::options::{FitOptions, FootPointSource, Method};
 use crate::term::{add_mat, mul, DataTerm, Mat3, IDENTITY};
 
 /// The smallest weight `(e_k / r)^(p−2)` a sample gets with an error power `p > 2` (see the
@@ -59,34 +59,6 @@ pub const POWER_WEIGHT_MIN: f64 = 0.05;
 /// The largest weight a sample gets with an error power `p > 2`: one sample (an outlier the
 /// cleaning left, a spike) cannot take over the fit.
 pub const POWER_WEIGHT_MAX: f64 = 20.0;
-
-/// The error term (distance measure) used to build the quadratic model (Cheng 2007 §II-D).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Point distance (eq. 3), `Q = I`: the classic alternating method, linear convergence.
-    Pdm,
-    /// Tangent distance (eq. 4), `Q = N Nᵀ`: a Gauss-Newton step; unstable without damping.
-    Tdm,
-    /// Squared distance (eq. 6), `Q = N Nᵀ + [α1]₊ T1 T1ᵀ + [α2]₊ T2 T2ᵀ`: a (modified) Newton
-    /// step. The default.
-    #[default]
-    Sdm,
-    /// The IMLS distance of Xie et al. 2023 (eq. 2–4): not a foot-point term — the fitter
-    /// takes [`crate::ImlsTerm`] for it (through [`crate::AnyTerm`]). A [`FootPointTerm`] given
-    /// it measures foot-point distances (how the pipeline compares fits of every method) and
-    /// models them as TD, the foot-point analogue of IMLS's `∇f ∇fᵀ`.
-    Imls,
-}
-
-/// The source of foot points.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum FootPointSource {
-    /// The exact closest point on the target's triangles when it has them, else the quadrics.
-    #[default]
-    Auto,
-    /// Always the local quadrics of the data points.
-    Quadric,
-}
 
 /// `Q_k` of `method` for one foot point (see the module docs). Cost: O(1).
 pub fn error_matrix(method: Method, foot: &FootPoint) -> Mat3 {

@@ -79,6 +79,207 @@ fn is_subset(a: &[u32], b: &[u32]) -> bool {
     a.iter().all(|x| it.by_ref().any(|y| y == x))
 }
 
+/// What [`host_supports`] returns: the distinct support of every sample (`dist_of`), the host
+/// of every distinct support (`host_of_dist`, `u32::MAX` for an empty one) and the hosts'
+/// supports (`host_sup`).
+type HostSupports<'c> = (Vec<u32>, Vec<u32>, Vec<&'c [u32]>);
+
+/// The hosts of the samples of `c` (`m × n`): its distinct supports, then, largest first, each
+/// support joins the first host containing it or becomes a host ([`HostSupports`]). `None`
+/// when a host would exceed [`MAX_HOST`] points.
+fn host_supports(c: &StencilMatrix) -> Option<HostSupports<'_>> {
+    let (m, n) = (c.nrows(), c.ncols());
+    // Distinct supports, then hosts: largest first, each joins the first host containing it.
+    let mut distinct: HashMap<&[u32], u32> = HashMap::new();
+    let mut dist_of = Vec::with_capacity(m);
+    let mut supports: Vec<&[u32]> = Vec::new();
+    for k in 0..m {
+        let idx = c.row(k).0;
+        let next = supports.len() as u32;
+        let d = *distinct.entry(idx).or_insert(next);
+        if d == next {
+            supports.push(idx);
+        }
+        dist_of.push(d);
+    }
+    drop(distinct);
+    let mut order: Vec<u32> = (0..supports.len() as u32).collect();
+    order.sort_by(|&a, &b| {
+        let (a, b) = (supports[a as usize], supports[b as usize]);
+        b.len().cmp(&a.len()).then(a.cmp(b))
+    });
+    let mut host_of_dist = vec![u32::MAX; supports.len()];
+    let mut host_sup: Vec<&[u32]> = Vec::new();
+    let mut by_vertex: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for &d in &order {
+        let s = supports[d as usize];
+        let Some(&first) = s.first() else {
+            continue;
+        };
+        let found = by_vertex[first as usize]
+            .iter()
+            .copied()
+            .find(|&h| is_subset(s, host_sup[h as usize]));
+        host_of_dist[d as usize] = match found {
+            Some(h) => h,
+            None => {
+                if s.len() > MAX_HOST {
+                    return None;
+                }
+                let h = host_sup.len() as u32;
+                host_sup.push(s);
+                for &v in s {
+                    by_vertex[v as usize].push(h);
+                }
+                h
+            }
+        };
+    }
+    Some((dist_of, host_of_dist, host_sup))
+}
+
+/// The nonzeros of `c`'s samples in host order (`smp`, host `h`'s in
+/// `smp[smp_ptr[h]..smp_ptr[h + 1]]`, its support `sup[sup_ptr[h]..sup_ptr[h + 1]]`): the
+/// fields `nz_ptr`, `wts` and `local` of [`Groups`].
+fn host_nonzeros(
+    c: &StencilMatrix,
+    sup: &[u32],
+    sup_ptr: &[usize],
+    smp: &[u32],
+    smp_ptr: &[usize],
+) -> (Vec<usize>, Vec<f64>, Vec<u8>) {
+    let nh = sup_ptr.len() - 1;
+    let mut nz_ptr = Vec::with_capacity(smp.len() + 1);
+    let mut wts = Vec::with_capacity(c.nnz());
+    let mut local = Vec::with_capacity(c.nnz());
+    nz_ptr.push(0);
+    for h in 0..nh {
+        let hs = &sup[sup_ptr[h]..sup_ptr[h + 1]];
+        for &k in &smp[smp_ptr[h]..smp_ptr[h + 1]] {
+            let (idx, w) = c.row(k as usize);
+            let mut p = 0;
+            for &i in idx {
+                while hs[p] != i {
+                    p += 1;
+                }
+                local.push(p as u8);
+            }
+            wts.extend_from_slice(w);
+            nz_ptr.push(wts.len());
+        }
+    }
+    (nz_ptr, wts, local)
+}
+
+/// The chunks of hosts (`chunk_host` of [`Groups`]): consecutive hosts until a chunk holds at
+/// least [`CHUNK_SAMPLES`] samples (`smp_ptr`: the hosts' sample ranges).
+fn chunks(smp_ptr: &[usize]) -> Vec<usize> {
+    let nh = smp_ptr.len() - 1;
+    let mut chunk_host = vec![0usize];
+    let mut count = 0;
+    for h in 0..nh {
+        count += smp_ptr[h + 1] - smp_ptr[h];
+        if count >= CHUNK_SAMPLES {
+            chunk_host.push(h + 1);
+            count = 0;
+        }
+    }
+    if *chunk_host.last().unwrap_or(&0) != nh {
+        chunk_host.push(nh);
+    }
+    chunk_host
+}
+
+/// What [`pair_slots`] returns: `pair_ptr`, `pair_slot`, `part_ptr` (of [`Groups`]) and the
+/// block entry of `H` of every part.
+type PairSlots = (Vec<usize>, Vec<u32>, Vec<usize>, Vec<u32>);
+
+/// The part slot of every pair of a host's points, per chunk of hosts ([`PairSlots`]). `None`
+/// when a pair misses the pattern (block rows `brow` per block column `bcol_ptr`).
+fn pair_slots(
+    chunk_host: &[usize],
+    sup: &[u32],
+    sup_ptr: &[usize],
+    bcol_ptr: &[usize],
+    brow: &[u32],
+) -> Option<PairSlots> {
+    let nh = sup_ptr.len() - 1;
+    let nblocks = brow.len();
+    let mut mark = vec![u32::MAX; nblocks];
+    let mut pair_ptr = Vec::with_capacity(nh + 1);
+    let mut pair_slot = Vec::new();
+    let mut part_ptr = vec![0usize];
+    let mut part_entry: Vec<u32> = Vec::new();
+    pair_ptr.push(0);
+    for w in chunk_host.windows(2) {
+        let base = part_entry.len();
+        for h in w[0]..w[1] {
+            let hs = &sup[sup_ptr[h]..sup_ptr[h + 1]];
+            for (qi, &j) in hs.iter().enumerate() {
+                for &i in &hs[..=qi] {
+                    let col = &brow[bcol_ptr[j as usize]..bcol_ptr[j as usize + 1]];
+                    let e = bcol_ptr[j as usize] + col.binary_search(&i).ok()?;
+                    if mark[e] == u32::MAX || (mark[e] as usize) < base {
+                        mark[e] = part_entry.len() as u32;
+                        part_entry.push(e as u32);
+                    }
+                    pair_slot.push(mark[e] - base as u32);
+                }
+            }
+            pair_ptr.push(pair_slot.len());
+        }
+        part_ptr.push(part_entry.len());
+    }
+    Some((pair_ptr, pair_slot, part_ptr, part_entry))
+}
+
+/// The gradient's part slot of every host point, per chunk (`vslot`, `vpart_ptr` of
+/// [`Groups`]), and the control point (of `n`) of every part.
+fn vertex_slots(
+    chunk_host: &[usize],
+    sup: &[u32],
+    sup_ptr: &[usize],
+    n: usize,
+) -> (Vec<u32>, Vec<usize>, Vec<u32>) {
+    let mut vmark = vec![u32::MAX; n];
+    let mut vslot = vec![0u32; sup.len()];
+    let mut vpart_ptr = vec![0usize];
+    let mut vpart_vertex: Vec<u32> = Vec::new();
+    for w in chunk_host.windows(2) {
+        let base = vpart_vertex.len();
+        for x in sup_ptr[w[0]]..sup_ptr[w[1]] {
+            let j = sup[x] as usize;
+            if vmark[j] == u32::MAX || (vmark[j] as usize) < base {
+                vmark[j] = vpart_vertex.len() as u32;
+                vpart_vertex.push(j as u32);
+            }
+            vslot[x] = vmark[j] - base as u32;
+        }
+        vpart_ptr.push(vpart_vertex.len());
+    }
+    (vslot, vpart_ptr, vpart_vertex)
+}
+
+/// The reduction map of parts onto their targets: part `x` adds to target `targets[x]` (of
+/// `len`); returns (`ptr`, `parts`) with target `t` summing `parts[ptr[t]..ptr[t + 1]]`, in
+/// part order (the `contrib` and `vcontrib` maps of [`Groups`]).
+fn gather_map(targets: &[u32], len: usize) -> (Vec<usize>, Vec<u32>) {
+    let mut ptr = vec![0usize; len + 1];
+    for &e in targets {
+        ptr[e as usize + 1] += 1;
+    }
+    for e in 0..len {
+        ptr[e + 1] += ptr[e];
+    }
+    let mut fill = ptr.clone();
+    let mut parts = vec![0u32; targets.len()];
+    for (x, &e) in targets.iter().enumerate() {
+        parts[fill[e as usize]] = x as u32;
+        fill[e as usize] += 1;
+    }
+    (ptr, parts)
+}
+
 impl Groups {
     /// Groups the samples of `c` (`m × n`) for the pattern with block rows `brow` per block
     /// column (`bcol_ptr`, `n + 1`). `None` when a host would exceed [`MAX_HOST`] points or a
@@ -86,53 +287,7 @@ impl Groups {
     /// Cost: O(nnz(C) + Σ_hosts s² log) time, O(nnz(C) + Σ_hosts s²) memory.
     pub fn new(c: &StencilMatrix, bcol_ptr: &[usize], brow: &[u32]) -> Option<Self> {
         let (m, n) = (c.nrows(), c.ncols());
-        // Distinct supports, then hosts: largest first, each joins the first host containing it.
-        let mut distinct: HashMap<&[u32], u32> = HashMap::new();
-        let mut dist_of = Vec::with_capacity(m);
-        let mut supports: Vec<&[u32]> = Vec::new();
-        for k in 0..m {
-            let idx = c.row(k).0;
-            let next = supports.len() as u32;
-            let d = *distinct.entry(idx).or_insert(next);
-            if d == next {
-                supports.push(idx);
-            }
-            dist_of.push(d);
-        }
-        drop(distinct);
-        let mut order: Vec<u32> = (0..supports.len() as u32).collect();
-        order.sort_by(|&a, &b| {
-            let (a, b) = (supports[a as usize], supports[b as usize]);
-            b.len().cmp(&a.len()).then(a.cmp(b))
-        });
-        let mut host_of_dist = vec![u32::MAX; supports.len()];
-        let mut host_sup: Vec<&[u32]> = Vec::new();
-        let mut by_vertex: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for &d in &order {
-            let s = supports[d as usize];
-            let Some(&first) = s.first() else {
-                continue;
-            };
-            let found = by_vertex[first as usize]
-                .iter()
-                .copied()
-                .find(|&h| is_subset(s, host_sup[h as usize]));
-            host_of_dist[d as usize] = match found {
-                Some(h) => h,
-                None => {
-                    if s.len() > MAX_HOST {
-                        return None;
-                    }
-                    let h = host_sup.len() as u32;
-                    host_sup.push(s);
-                    for &v in s {
-                        by_vertex[v as usize].push(h);
-                    }
-                    h
-                }
-            };
-        }
-        drop(by_vertex);
+        let (dist_of, host_of_dist, host_sup) = host_supports(c)?;
         // Hosts ordered by their first control point (locality of the touched columns).
         let mut hosts: Vec<u32> = (0..host_sup.len() as u32).collect();
         hosts.sort_by_key(|&h| (host_sup[h as usize][0], h));
@@ -169,107 +324,15 @@ impl Groups {
             smp[next[h]] = k as u32;
             next[h] += 1;
         }
-        let mut nz_ptr = Vec::with_capacity(smp.len() + 1);
-        let mut wts = Vec::with_capacity(c.nnz());
-        let mut local = Vec::with_capacity(c.nnz());
-        nz_ptr.push(0);
-        for h in 0..nh {
-            let hs = &sup[sup_ptr[h]..sup_ptr[h + 1]];
-            for &k in &smp[smp_ptr[h]..smp_ptr[h + 1]] {
-                let (idx, w) = c.row(k as usize);
-                let mut p = 0;
-                for &i in idx {
-                    while hs[p] != i {
-                        p += 1;
-                    }
-                    local.push(p as u8);
-                }
-                wts.extend_from_slice(w);
-                nz_ptr.push(wts.len());
-            }
-        }
+        let (nz_ptr, wts, local) = host_nonzeros(c, &sup, &sup_ptr, &smp, &smp_ptr);
         // Chunks, part slots of the pairs, and the reduction map.
-        let mut chunk_host = vec![0usize];
-        let mut count = 0;
-        for h in 0..nh {
-            count += smp_ptr[h + 1] - smp_ptr[h];
-            if count >= CHUNK_SAMPLES {
-                chunk_host.push(h + 1);
-                count = 0;
-            }
-        }
-        if *chunk_host.last().unwrap_or(&0) != nh {
-            chunk_host.push(nh);
-        }
-        let nblocks = brow.len();
-        let mut mark = vec![u32::MAX; nblocks];
-        let mut pair_ptr = Vec::with_capacity(nh + 1);
-        let mut pair_slot = Vec::new();
-        let mut part_ptr = vec![0usize];
-        let mut part_entry: Vec<u32> = Vec::new();
-        pair_ptr.push(0);
-        for w in chunk_host.windows(2) {
-            let base = part_entry.len();
-            for h in w[0]..w[1] {
-                let hs = &sup[sup_ptr[h]..sup_ptr[h + 1]];
-                for (qi, &j) in hs.iter().enumerate() {
-                    for &i in &hs[..=qi] {
-                        let col = &brow[bcol_ptr[j as usize]..bcol_ptr[j as usize + 1]];
-                        let e = bcol_ptr[j as usize] + col.binary_search(&i).ok()?;
-                        if mark[e] == u32::MAX || (mark[e] as usize) < base {
-                            mark[e] = part_entry.len() as u32;
-                            part_entry.push(e as u32);
-                        }
-                        pair_slot.push(mark[e] - base as u32);
-                    }
-                }
-                pair_ptr.push(pair_slot.len());
-            }
-            part_ptr.push(part_entry.len());
-        }
+        let chunk_host = chunks(&smp_ptr);
+        let (pair_ptr, pair_slot, part_ptr, part_entry) =
+            pair_slots(&chunk_host, &sup, &sup_ptr, bcol_ptr, brow)?;
         // The same for the gradient's parts, one per control point touched by a chunk.
-        let mut vmark = vec![u32::MAX; n];
-        let mut vslot = vec![0u32; sup.len()];
-        let mut vpart_ptr = vec![0usize];
-        let mut vpart_vertex: Vec<u32> = Vec::new();
-        for w in chunk_host.windows(2) {
-            let base = vpart_vertex.len();
-            for x in sup_ptr[w[0]]..sup_ptr[w[1]] {
-                let j = sup[x] as usize;
-                if vmark[j] == u32::MAX || (vmark[j] as usize) < base {
-                    vmark[j] = vpart_vertex.len() as u32;
-                    vpart_vertex.push(j as u32);
-                }
-                vslot[x] = vmark[j] - base as u32;
-            }
-            vpart_ptr.push(vpart_vertex.len());
-        }
-        let mut vcontrib_ptr = vec![0usize; n + 1];
-        for &j in &vpart_vertex {
-            vcontrib_ptr[j as usize + 1] += 1;
-        }
-        for j in 0..n {
-            vcontrib_ptr[j + 1] += vcontrib_ptr[j];
-        }
-        let mut vfill = vcontrib_ptr.clone();
-        let mut vcontrib = vec![0u32; vpart_vertex.len()];
-        for (x, &j) in vpart_vertex.iter().enumerate() {
-            vcontrib[vfill[j as usize]] = x as u32;
-            vfill[j as usize] += 1;
-        }
-        let mut contrib_ptr = vec![0usize; nblocks + 1];
-        for &e in &part_entry {
-            contrib_ptr[e as usize + 1] += 1;
-        }
-        for e in 0..nblocks {
-            contrib_ptr[e + 1] += contrib_ptr[e];
-        }
-        let mut fill = contrib_ptr.clone();
-        let mut contrib = vec![0u32; part_entry.len()];
-        for (x, &e) in part_entry.iter().enumerate() {
-            contrib[fill[e as usize]] = x as u32;
-            fill[e as usize] += 1;
-        }
+        let (vslot, vpart_ptr, vpart_vertex) = vertex_slots(&chunk_host, &sup, &sup_ptr, n);
+        let (vcontrib_ptr, vcontrib) = gather_map(&vpart_vertex, n);
+        let (contrib_ptr, contrib) = gather_map(&part_entry, brow.len());
         Some(Self {
             sup_ptr,
             smp_ptr,

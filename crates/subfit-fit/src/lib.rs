@@ -55,7 +55,6 @@ mod assemble;
 mod coverage;
 mod enrich;
 mod error;
-pub use enrich::{LOCAL_FIELD_PEAK, LOCAL_FIELD_SHARE};
 mod error_field;
 mod fitter;
 mod foot_point_term;
@@ -72,7 +71,10 @@ pub mod silhouette;
 mod smooth;
 mod solve;
 mod stage_flips;
+mod stage_measure;
+mod stage_options;
 mod stage_refine;
+mod stage_report;
 mod stages;
 mod surface_term;
 mod term;
@@ -83,22 +85,20 @@ pub use arap::Arap;
 pub use coverage::{CoverSum, Coverage, FEATURE_WEIGHT};
 pub use error::{FitError, FitPhase};
 pub use fitter::{fit, FitResult, Fitter};
-pub use foot_point_term::{
-    FootPointSource, FootPointTerm, FootSample, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN,
-};
+pub use foot_point_term::{FootPointTerm, FootSample, POWER_WEIGHT_MAX, POWER_WEIGHT_MIN};
 pub use imls_term::{ImlsSample, ImlsTerm};
 pub use options::{
-    FillOrdering, FitOptions, LinearSolver, Method, Optimizer, StepControl, Variant,
-    FIRST_ORDER_STEPS,
+    FillOrdering, FitOptions, FootPointSource, LinearSolver, Method, Optimizer, StepControl,
+    Variant, FIRST_ORDER_STEPS,
 };
 pub use pcg::PcgStats;
 pub use refine_polygons::{refine_polygons, PolyRefinement, TriangleSplit};
 pub use remesh::RefineStats;
 pub use report::{ErrorStats, FitReport, IterationRow, PhaseTimings, StopReason};
-pub use stages::{
-    fit_stages, judged_with_boundary, StageEvent, StageOptions, StageReport, StageStop,
-    StagesReport, StagesResult, REFINE_PAYOFF, STALL_GAIN, STALL_STAGES, UNPAID_REFINEMENTS,
-};
+pub use stage_measure::judged_with_boundary;
+pub use stage_options::{StageOptions, LOCAL_FIELD_PEAK, LOCAL_FIELD_SHARE, REFINE_PAYOFF};
+pub use stage_report::{StageEvent, StageReport, StageStop, StagesReport, StagesResult};
+pub use stages::{fit_stages, STALL_GAIN, STALL_STAGES, UNPAID_REFINEMENTS};
 pub use surface_term::{fan_triangles, SurfaceTerm, WeightedSurfaceTerm};
 pub use term::{DataTerm, Mat3};
 

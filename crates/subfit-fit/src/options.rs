@@ -1,15 +1,42 @@
-//! Options of the fitting loop (Cheng et al. 2007, §II-B, §II-E, §III-C; DESIGN.md §3.4).
+//! Options of the fitting loop and of its error term (Cheng et al. 2007, §II-B, §II-D, §II-E,
+//! §III-C; DESIGN.md §3.4).
 
 use std::sync::Arc;
 
 use subfit_mesh::{Cancel, Tags};
 use subfit_subdiv::{BoundaryRule, Options, Scheme};
 
-use crate::foot_point_term::FootPointSource;
 use crate::surface_term::WeightedSurfaceTerm;
 
-pub use crate::foot_point_term::Method;
 pub use crate::ordering::FillOrdering;
+
+/// The error term (distance measure) used to build the quadratic model (Cheng 2007 §II-D).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Point distance (eq. 3), `Q = I`: the classic alternating method, linear convergence.
+    Pdm,
+    /// Tangent distance (eq. 4), `Q = N Nᵀ`: a Gauss-Newton step; unstable without damping.
+    Tdm,
+    /// Squared distance (eq. 6), `Q = N Nᵀ + [α1]₊ T1 T1ᵀ + [α2]₊ T2 T2ᵀ`: a (modified) Newton
+    /// step. The default.
+    #[default]
+    Sdm,
+    /// The IMLS distance of Xie et al. 2023 (eq. 2–4): not a foot-point term — the fitter
+    /// takes [`crate::ImlsTerm`] for it (through [`crate::AnyTerm`]). A [`crate::FootPointTerm`] given
+    /// it measures foot-point distances (how the pipeline compares fits of every method) and
+    /// models them as TD, the foot-point analogue of IMLS's `∇f ∇fᵀ`.
+    Imls,
+}
+
+/// The source of foot points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FootPointSource {
+    /// The exact closest point on the target's triangles when it has them, else the quadrics.
+    #[default]
+    Auto,
+    /// Always the local quadrics of the data points.
+    Quadric,
+}
 
 /// How the damped normal equations are solved each iteration.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

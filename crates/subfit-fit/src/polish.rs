@@ -33,7 +33,9 @@ use subfit_target::Target;
 use crate::error::FitError;
 use crate::options::FitOptions;
 use crate::report::IterationRow;
-use crate::stages::{measure, Best, StageEvent, StageOptions, StageReport, Topo};
+use crate::stage_measure::{measure, Best, Topo};
+use crate::stage_options::StageOptions;
+use crate::stage_report::{StageEvent, StageReport};
 
 /// A polished cage replaces the best one only when it lowers the judged maximum error by more
 /// than this fraction.

@@ -142,6 +142,26 @@ pub fn refine_red_green_with_parents(
                 .push(t[(i + 2) % 3]);
         }
     }
+    let (red, mut split) = red_closure(&tris, marked);
+    let mut positions = vertex_points(mesh, &tris, &opposite, &red, &split);
+    edge_points(mesh, &tris, &opposite, &mut split, &mut positions);
+    let mut stats = RefineStats {
+        marked: marked.iter().filter(|&&m| m).count(),
+        new_points: split.len(),
+        ..RefineStats::default()
+    };
+    let (out, parents) = split_faces(&tris, &red, &split, &mut stats);
+    Some((
+        PolyMesh::new(positions, Polygons::from_triangles(&out)),
+        stats,
+        parents,
+    ))
+}
+
+/// The red-green closure of `marked` over `tris`: the faces split 1-to-4 (red: the marked
+/// ones and every face with two or more split edges) and the split edges (each mapped to
+/// `u32::MAX`, its new point not numbered yet).
+fn red_closure(tris: &[[u32; 3]], marked: &[bool]) -> (Vec<bool>, HashMap<(u32, u32), u32>) {
     let mut red: Vec<bool> = marked.to_vec();
     red.resize(tris.len(), false);
     let mut split: HashMap<(u32, u32), u32> = HashMap::new();
@@ -169,13 +189,25 @@ pub fn refine_red_green_with_parents(
             break;
         }
     }
+    (red, split)
+}
+
+/// The old points after the refinement: Loop's vertex point where all faces around are red,
+/// Loop's boundary vertex point where both boundary edges are split, else unchanged.
+fn vertex_points(
+    mesh: &PolyMesh,
+    tris: &[[u32; 3]],
+    opposite: &HashMap<(u32, u32), Vec<u32>>,
+    red: &[bool],
+    split: &HashMap<(u32, u32), u32>,
+) -> Vec<[f64; 3]> {
     // Old points whose faces are all split 1-to-4 take Loop's vertex point, so that where the
     // refinement is uniform the limit surface does not change at all; elsewhere they stay.
     let nv = mesh.num_vertices();
     let mut all_red = vec![true; nv];
     let mut on_boundary = vec![false; nv];
     let mut ring: Vec<Vec<u32>> = vec![Vec::new(); nv];
-    for (t, &r) in tris.iter().zip(&red) {
+    for (t, &r) in tris.iter().zip(red) {
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
             all_red[a as usize] &= r;
@@ -195,7 +227,7 @@ pub fn refine_red_green_with_parents(
     // Boundary neighbours and incident faces, for the boundary rule below.
     let mut boundary_ring: Vec<Vec<u32>> = vec![Vec::new(); nv];
     let mut incident = vec![0u32; nv];
-    for t in &tris {
+    for t in tris {
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
             incident[a as usize] += 1;
@@ -241,8 +273,20 @@ pub fn refine_red_green_with_parents(
                         .sum::<f64>()
         });
     }
+    positions
+}
+
+/// Numbers the new points of the split edges and appends them to `positions`: Loop's edge
+/// points (3/8, 3/8, 1/8, 1/8; midpoints on boundary edges).
+fn edge_points(
+    mesh: &PolyMesh,
+    tris: &[[u32; 3]],
+    opposite: &HashMap<(u32, u32), Vec<u32>>,
+    split: &mut HashMap<(u32, u32), u32>,
+    positions: &mut Vec<[f64; 3]>,
+) {
     // New points, in a deterministic order: by first appearance over faces and corners.
-    for t in &tris {
+    for t in tris {
         for i in 0..3 {
             let (a, b) = (t[i], t[(i + 1) % 3]);
             if let Some(id) = split.get_mut(&key(a, b)) {
@@ -264,14 +308,19 @@ pub fn refine_red_green_with_parents(
             }
         }
     }
-    let mut stats = RefineStats {
-        marked: marked.iter().filter(|&&m| m).count(),
-        new_points: split.len(),
-        ..RefineStats::default()
-    };
+}
+
+/// The refined triangles — red faces 1-to-4, faces with one split edge halved (green), the
+/// rest kept — with the parent face of each; counts the red and green faces into `stats`.
+fn split_faces(
+    tris: &[[u32; 3]],
+    red: &[bool],
+    split: &HashMap<(u32, u32), u32>,
+    stats: &mut RefineStats,
+) -> (Vec<[u32; 3]>, Vec<u32>) {
     let mut out = Vec::with_capacity(tris.len() + 3 * split.len());
     let mut parents = Vec::with_capacity(tris.len() + 3 * split.len());
-    for (f, (t, &r)) in tris.iter().zip(&red).enumerate() {
+    for (f, (t, &r)) in tris.iter().zip(red).enumerate() {
         let mid = |i: usize| split.get(&key(t[i], t[(i + 1) % 3])).copied();
         if r {
             stats.red += 1;
@@ -288,11 +337,7 @@ pub fn refine_red_green_with_parents(
         }
         parents.resize(out.len(), f as u32);
     }
-    Some((
-        PolyMesh::new(positions, Polygons::from_triangles(&out)),
-        stats,
-        parents,
-    ))
+    (out, parents)
 }
 
 /// An interior edge `(a, b)` shared by triangles `(a, b, c)` and `(b, a, d)` that may be

@@ -9,7 +9,7 @@ use subfit_subdiv::sampling_operator;
 use crate::error::FitError;
 use crate::options::FitOptions;
 use crate::remesh::{apply_flips, face_errors, face_owners, independent_flips, FaceError};
-use crate::stages::{face_score, StageOptions};
+use crate::stage_options::{face_score, StageOptions};
 use crate::term::DataTerm;
 
 /// Tries independent edge flips on faces scoring above the tolerance with the current

@@ -14,7 +14,7 @@ use crate::error::FitError;
 use crate::options::FitOptions;
 use crate::refine_polygons::refine_polygons;
 use crate::remesh::{refine_red_green_with_parents, RefineStats};
-use crate::stages::StageOptions;
+use crate::stage_options::StageOptions;
 
 /// A refined cage: what was done, a value per new face (its parent, or its depth) and the
 /// carried tags.

@@ -3,9 +3,12 @@
 
 use super::*;
 use crate::remesh::refine_red_green;
+use crate::report::ErrorStats;
+use crate::stage_measure::judged_with_boundary;
 use crate::stage_refine::{carry_tags, FEATURE_PRIORITY};
+use subfit_measure::TwoSided;
 use subfit_mesh::shapes::octahedron_mesh;
-use subfit_mesh::SHARPNESS_INFINITE;
+use subfit_mesh::{Tags, SHARPNESS_INFINITE};
 
 /// A crease on a split edge passes to both halves; one on an unsplit edge stays.
 #[test]

@@ -181,6 +181,85 @@ fn event<'py>(py: Python<'py>, p: &Progress<'_>) -> PyResult<Bound<'py, PyDict>>
     Ok(d)
 }
 
+/// The `quads` argument of [`fit`] as a [`subfit::QuadLayout`].
+fn quad_layout(quads: &str) -> PyResult<subfit::QuadLayout> {
+    Ok(match quads.to_ascii_lowercase().as_str() {
+        "field" => subfit::QuadLayout::Field,
+        "paired" => subfit::QuadLayout::Paired,
+        "only" => subfit::QuadLayout::Only,
+        _ => {
+            return Err(value_error(format!(
+                "quads must be \"field\", \"paired\" or \"only\", got {quads:?}"
+            )))
+        }
+    })
+}
+
+/// The target of [`fit`]: `points` (`#V by 3`) with `faces` (a mesh) or without (a point
+/// cloud), and the unit `normals` (`#V by 3`, none zero) when given.
+fn target_mesh(
+    points: &PyReadonlyArray2<'_, f64>,
+    faces: Option<&FaceArrays<'_>>,
+    normals: Option<&PyReadonlyArray2<'_, f64>>,
+) -> PyResult<PolyMesh> {
+    let positions = vec3s("points", points, subfit::target::MIN_POINTS)?;
+    let n = positions.len();
+    let mut mesh = match faces {
+        Some((c, i)) => PolyMesh::new(positions, polygons(c, i, n)?),
+        None => PolyMesh::point_cloud(positions, None),
+    };
+    if let Some(nr) = normals {
+        let nr = vec3s("normals", nr, 0)?;
+        if nr.len() != n {
+            return Err(value_error(format!(
+                "normals must have one row per point: {} rows for {n} points",
+                nr.len()
+            )));
+        }
+        if let Some(i) = nr.iter().position(|v| v.iter().all(|&x| x == 0.0)) {
+            return Err(value_error(format!("normals[{i}] is zero")));
+        }
+        mesh.normals = Some(nr);
+    }
+    Ok(mesh)
+}
+
+/// Sets the initial cage of `opts` from [`fit`]'s `init_method` (`"auto"`, `"qem"` or
+/// `"curvature-lines"`) and `init` (a given cage: vertices `#C by 3`, faces), which excludes
+/// `control_points`.
+fn initial_cage(
+    opts: &mut FitScanOptions,
+    init_method: Option<&str>,
+    init: Option<&(PyReadonlyArray2<'_, f64>, FaceArrays<'_>)>,
+    control_points: Option<i64>,
+) -> PyResult<()> {
+    match init_method {
+        None | Some("auto") => {}
+        Some("qem") => opts.init = InitialCage::Qem,
+        Some("curvature-lines") => opts.init = InitialCage::CurvatureLines,
+        Some(other) => {
+            return Err(value_error(format!(
+                "init must be a cage, \"auto\", \"qem\" or \"curvature-lines\", got {other:?}"
+            )))
+        }
+    }
+    if let Some((v, (c, i))) = init {
+        if control_points.is_some() {
+            return Err(value_error(
+                "control_points sets the size of the automatic initial cage; it cannot be used with init",
+            ));
+        }
+        let cage = vec3s("init vertices", v, 4)?;
+        let faces = polygons(c, i, cage.len())?;
+        opts.init = InitialCage::Given {
+            mesh: PolyMesh::new(cage, faces),
+            tags: Tags::new(),
+            name: "init".into(),
+        };
+    }
+    Ok(())
+}
+
 /// Runs the pipeline on arrays (see the Python `subfit.fit` for the documented API).
 #[pyfunction]
 #[pyo3(signature = (
@@ -256,59 +335,9 @@ pub fn fit(
         (imls_radius, arap),
     )?;
     opts.fit.facing = facing;
-    opts.quads = match quads.to_ascii_lowercase().as_str() {
-        "field" => subfit::QuadLayout::Field,
-        "paired" => subfit::QuadLayout::Paired,
-        "only" => subfit::QuadLayout::Only,
-        _ => {
-            return Err(value_error(format!(
-                "quads must be \"field\", \"paired\" or \"only\", got {quads:?}"
-            )))
-        }
-    };
-    let positions = vec3s("points", &points, subfit::target::MIN_POINTS)?;
-    let n = positions.len();
-    let mut mesh = match &faces {
-        Some((c, i)) => PolyMesh::new(positions, polygons(c, i, n)?),
-        None => PolyMesh::point_cloud(positions, None),
-    };
-    if let Some(nr) = &normals {
-        let nr = vec3s("normals", nr, 0)?;
-        if nr.len() != n {
-            return Err(value_error(format!(
-                "normals must have one row per point: {} rows for {n} points",
-                nr.len()
-            )));
-        }
-        if let Some(i) = nr.iter().position(|v| v.iter().all(|&x| x == 0.0)) {
-            return Err(value_error(format!("normals[{i}] is zero")));
-        }
-        mesh.normals = Some(nr);
-    }
-    match init_method {
-        None | Some("auto") => {}
-        Some("qem") => opts.init = InitialCage::Qem,
-        Some("curvature-lines") => opts.init = InitialCage::CurvatureLines,
-        Some(other) => {
-            return Err(value_error(format!(
-                "init must be a cage, \"auto\", \"qem\" or \"curvature-lines\", got {other:?}"
-            )))
-        }
-    }
-    if let Some((v, (c, i))) = &init {
-        if control_points.is_some() {
-            return Err(value_error(
-                "control_points sets the size of the automatic initial cage; it cannot be used with init",
-            ));
-        }
-        let cage = vec3s("init vertices", v, 4)?;
-        let faces = polygons(c, i, cage.len())?;
-        opts.init = InitialCage::Given {
-            mesh: PolyMesh::new(cage, faces),
-            tags: Tags::new(),
-            name: "init".into(),
-        };
-    }
+    opts.quads = quad_layout(quads)?;
+    let mesh = target_mesh(&points, faces.as_ref(), normals.as_ref())?;
+    initial_cage(&mut opts, init_method, init.as_ref(), control_points)?;
     let cancel = Cancel::new();
     opts.cancel = cancel.clone();
     let name = name.unwrap_or_else(|| "<array>".into());

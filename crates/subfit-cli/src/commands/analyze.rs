@@ -78,6 +78,38 @@ enum Found {
     Cloud(subfit::target::CloudFeatures, f64),
 }
 
+impl Found {
+    /// What the summary says of these features (found at `angle_deg`).
+    fn summary(&self, angle_deg: f64) -> FeatureSummary {
+        match self {
+            Found::Mesh(f, seconds) => FeatureSummary {
+                source: "mesh",
+                angle_deg,
+                sharp_edges: f.edges.len(),
+                sharp_edges_before_cleaning: f.raw_edges,
+                curves: f.curves.len(),
+                closed_curves: f.curves.iter().filter(|c| c.closed).count(),
+                corners: f.corners.len(),
+                darts: f.darts.len(),
+                feature_points: None,
+                seconds: *seconds,
+            },
+            Found::Cloud(f, seconds) => FeatureSummary {
+                source: "cloud",
+                angle_deg,
+                sharp_edges: f.segments().len(),
+                sharp_edges_before_cleaning: f.segments().len(),
+                curves: f.curves.len(),
+                closed_curves: f.curves.iter().filter(|c| c.closed).count(),
+                corners: f.corners.len(),
+                darts: f.darts,
+                feature_points: Some(f.feature_points),
+                seconds: *seconds,
+            },
+        }
+    }
+}
+
 #[derive(Serialize)]
 struct Timings {
     read: f64,
@@ -119,39 +151,7 @@ fn phase_name(p: Phase) -> &'static str {
 }
 
 pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
-    let neighborhood = match (a.neighbors, a.radius) {
-        (_, Some(r)) if !(r.is_finite() && r > 0.0 && r < 1.0) => {
-            bail!("--radius must be in (0, 1) (unit-cube units), got {r}")
-        }
-        (_, Some(r)) => Neighborhood::Radius(r),
-        (Some(k), None) => Neighborhood::Knn(k as usize),
-        (None, None) => TargetOptions::default().neighborhood,
-    };
-    for out in a.output.iter().chain(&a.features) {
-        if subfit::io::Format::from_path(out) != Some(subfit::io::Format::Ply) {
-            bail!(
-                "{}: the analysis outputs are PLY files (.ply)",
-                out.display()
-            );
-        }
-    }
-    if !(a.feature_angle.is_finite() && a.feature_angle > 0.0 && a.feature_angle < 180.0) {
-        bail!(
-            "--feature-angle must be in (0, 180) degrees, got {}",
-            a.feature_angle
-        );
-    }
-    let options = TargetOptions {
-        neighborhood,
-        jet_degree: a.jet_degree,
-        normals: if a.estimate_normals {
-            NormalSource::Estimate
-        } else {
-            NormalSource::Auto
-        },
-        cancel: crate::interrupt::token(),
-        ..TargetOptions::default()
-    };
+    let options = target_options(&a)?;
 
     let t_read = std::time::Instant::now();
     let (mut mesh, _) = crate::progress::load(&a.target)?;
@@ -187,9 +187,77 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
     }
 
     let attrs = target.point_attributes();
+    let summary = summarize(&a, &target, &attrs, features.as_ref(), read);
+
+    if let Some(out) = &a.output {
+        write_points(out, &attrs)?;
+    }
+    match (&a.features, &features) {
+        (Some(out), Some(Found::Mesh(f, _))) => write_features(out, &mesh.positions, f)?,
+        (Some(out), Some(Found::Cloud(f, _))) => write_cloud_features(out, &target, f)?,
+        _ => {}
+    }
+    if a.json {
+        out!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        print_text(&summary, a.output.as_deref());
+        if let Some(out) = &a.features {
+            out!("wrote         {}", out.display());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The target options `a` asks for, with its flags checked first.
+fn target_options(a: &AnalyzeArgs) -> anyhow::Result<TargetOptions> {
+    let neighborhood = match (a.neighbors, a.radius) {
+        (_, Some(r)) if !(r.is_finite() && r > 0.0 && r < 1.0) => {
+            bail!("--radius must be in (0, 1) (unit-cube units), got {r}")
+        }
+        (_, Some(r)) => Neighborhood::Radius(r),
+        (Some(k), None) => Neighborhood::Knn(k as usize),
+        (None, None) => TargetOptions::default().neighborhood,
+    };
+    for out in a.output.iter().chain(&a.features) {
+        if subfit::io::Format::from_path(out) != Some(subfit::io::Format::Ply) {
+            bail!(
+                "{}: the analysis outputs are PLY files (.ply)",
+                out.display()
+            );
+        }
+    }
+    if !(a.feature_angle.is_finite() && a.feature_angle > 0.0 && a.feature_angle < 180.0) {
+        bail!(
+            "--feature-angle must be in (0, 180) degrees, got {}",
+            a.feature_angle
+        );
+    }
+    Ok(TargetOptions {
+        neighborhood,
+        jet_degree: a.jet_degree,
+        normals: if a.estimate_normals {
+            NormalSource::Estimate
+        } else {
+            NormalSource::Auto
+        },
+        cancel: crate::interrupt::token(),
+        ..TargetOptions::default()
+    })
+}
+
+/// The summary of the analysis of `a.target`: `target`'s statistics and timings, the
+/// curvature quantiles of its point attributes `attrs`, the features found, and the seconds
+/// it took to read (`read`).
+fn summarize(
+    a: &AnalyzeArgs,
+    target: &Target,
+    attrs: &subfit::target::PointAttributes,
+    features: Option<&Found>,
+    read: f64,
+) -> Summary {
     let s = target.stats();
     let t = &s.timings;
-    let summary = Summary {
+    Summary {
         file: a.target.display().to_string(),
         input_points: s.input_points,
         points: s.points,
@@ -219,32 +287,7 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
         k1_quantiles: quantiles(&attrs.k1),
         k2_quantiles: quantiles(&attrs.k2),
         scale_to_original: target.normalization().length_to_original(1.0),
-        features: features.as_ref().map(|found| match found {
-            Found::Mesh(f, seconds) => FeatureSummary {
-                source: "mesh",
-                angle_deg: a.feature_angle,
-                sharp_edges: f.edges.len(),
-                sharp_edges_before_cleaning: f.raw_edges,
-                curves: f.curves.len(),
-                closed_curves: f.curves.iter().filter(|c| c.closed).count(),
-                corners: f.corners.len(),
-                darts: f.darts.len(),
-                feature_points: None,
-                seconds: *seconds,
-            },
-            Found::Cloud(f, seconds) => FeatureSummary {
-                source: "cloud",
-                angle_deg: a.feature_angle,
-                sharp_edges: f.segments().len(),
-                sharp_edges_before_cleaning: f.segments().len(),
-                curves: f.curves.len(),
-                closed_curves: f.curves.iter().filter(|c| c.closed).count(),
-                corners: f.corners.len(),
-                darts: f.darts,
-                feature_points: Some(f.feature_points),
-                seconds: *seconds,
-            },
-        }),
+        features: features.map(|found| found.summary(a.feature_angle)),
         timings: Timings {
             read,
             validate: t.validate.as_secs_f64(),
@@ -260,25 +303,7 @@ pub fn run(a: AnalyzeArgs) -> anyhow::Result<ExitCode> {
             mesh_index: t.mesh_index.as_secs_f64(),
             total: t.total.as_secs_f64(),
         },
-    };
-
-    if let Some(out) = &a.output {
-        write_points(out, &attrs)?;
     }
-    match (&a.features, &features) {
-        (Some(out), Some(Found::Mesh(f, _))) => write_features(out, &mesh.positions, f)?,
-        (Some(out), Some(Found::Cloud(f, _))) => write_cloud_features(out, &target, f)?,
-        _ => {}
-    }
-    if a.json {
-        out!("{}", serde_json::to_string_pretty(&summary)?);
-    } else {
-        print_text(&summary, a.output.as_deref());
-        if let Some(out) = &a.features {
-            out!("wrote         {}", out.display());
-        }
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 fn write_points(out: &std::path::Path, at: &subfit::target::PointAttributes) -> anyhow::Result<()> {

@@ -143,86 +143,114 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
         "monotone"
     );
     for ex in chosen {
-        let [ax, by, cz] = ex.axes;
-        let shape = Shape::Ellipsoid {
-            a: ax,
-            b: by,
-            c: cz,
-        };
-        let cloud = shape.sample(a.points as usize, 0.0, 7);
-        let target = Target::from_points(
-            &cloud.positions,
-            cloud.normals.as_deref(),
-            &TargetOptions::default(),
-        )
-        .context("building the ellipsoid target")?;
-        let cage = cheng_ellipsoid_cage(ax, by, cz, ex.far);
-        let control = PolyMesh::new(
-            cage.positions
-                .iter()
-                .map(|&p| target.to_normalized(p))
-                .collect(),
-            cage.faces.clone(),
-        );
-        let mut series = Vec::new();
-        let mut reports = Vec::new();
-        for (label, variant, lambda) in &ex.runs {
-            let opts = FitOptions::variant(*variant)
-                .with_lambda(*lambda)
-                .with_max_iterations(a.iterations as usize);
-            let report = fit(&target, &control, &opts)
-                .with_context(|| format!("example {} {label}", ex.number))?
-                .report;
-            bar.inc(1);
-            let curve = curve(&report);
-            let reached = report.iterations_to_rms(TOLERANCE);
-            let monotone = is_monotone(&report);
-            bar.suspend(|| {
-                out!(
-                    "{:<8} {:<14} {:>10} {:>12.3e} {:>12.3e} {:>10}",
-                    ex.number,
-                    label,
-                    reached.map_or("-".to_string(), |k| k.to_string()),
-                    report.initial.e_rms,
-                    report.last().e_rms,
-                    monotone
-                )
-            });
-            summary.push(json!({
-                "example": ex.number, "run": label, "variant": variant.name(), "lambda": lambda,
-                "far": ex.far, "axes": ex.axes, "iterations_to_tolerance": reached,
-                "tolerance": TOLERANCE, "initial_e_rms": report.initial.e_rms,
-                "final_e_rms": report.last().e_rms, "objective_monotone": monotone,
-                "iterations": report.iterations.len(), "stop": format!("{:?}", report.stop),
-                "e_rms": curve.iter().map(|p| p.1).collect::<Vec<_>>(),
-            }));
-            series.push(Series {
-                name: label.clone(),
-                points: curve,
-            });
-            reports.push((label.clone(), report));
-        }
-        let base = a.output.join(format!("example{}", ex.number));
-        crate::interrupt::watch_dir(&base.with_extension("csv"));
-        subfit::io::write_atomic(&base.with_extension("csv"), csv(&reports).as_bytes())?;
-        let svg = log_chart(
-            ex.title,
-            "iteration",
-            "E_rms (unit cube)",
-            &series,
-            Some(TOLERANCE),
-        );
-        crate::interrupt::watch_dir(&base.with_extension("svg"));
-        subfit::io::write_atomic(&base.with_extension("svg"), svg.as_bytes())?;
-        figures.push(Block::Figure {
-            svg,
-            caption: format!(
-                "Example {}: E_rms per iteration, one line per method (exampleN.csv has the numbers).",
-                ex.number
-            ),
-        });
+        figures.push(convergence_example(ex, &a, &bar, &mut summary)?);
     }
     bar.finish_and_clear();
+    write_convergence_report(&a, &summary, figures)?;
+    out!(
+        "wrote {} (look at {})",
+        a.output.display(),
+        a.output.join("report.html").display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Runs the fits of one example, prints a line and adds a summary entry per run, and writes
+/// its error curves (`exampleN.csv`, `exampleN.svg` under the output directory); returns the
+/// figure for the report.
+fn convergence_example(
+    ex: &Example,
+    a: &ConvergenceArgs,
+    bar: &indicatif::ProgressBar,
+    summary: &mut Vec<serde_json::Value>,
+) -> anyhow::Result<Block> {
+    let [ax, by, cz] = ex.axes;
+    let shape = Shape::Ellipsoid {
+        a: ax,
+        b: by,
+        c: cz,
+    };
+    let cloud = shape.sample(a.points as usize, 0.0, 7);
+    let target = Target::from_points(
+        &cloud.positions,
+        cloud.normals.as_deref(),
+        &TargetOptions::default(),
+    )
+    .context("building the ellipsoid target")?;
+    let cage = cheng_ellipsoid_cage(ax, by, cz, ex.far);
+    let control = PolyMesh::new(
+        cage.positions
+            .iter()
+            .map(|&p| target.to_normalized(p))
+            .collect(),
+        cage.faces.clone(),
+    );
+    let mut series = Vec::new();
+    let mut reports = Vec::new();
+    for (label, variant, lambda) in &ex.runs {
+        let opts = FitOptions::variant(*variant)
+            .with_lambda(*lambda)
+            .with_max_iterations(a.iterations as usize);
+        let report = fit(&target, &control, &opts)
+            .with_context(|| format!("example {} {label}", ex.number))?
+            .report;
+        bar.inc(1);
+        let curve = curve(&report);
+        let reached = report.iterations_to_rms(TOLERANCE);
+        let monotone = is_monotone(&report);
+        bar.suspend(|| {
+            out!(
+                "{:<8} {:<14} {:>10} {:>12.3e} {:>12.3e} {:>10}",
+                ex.number,
+                label,
+                reached.map_or("-".to_string(), |k| k.to_string()),
+                report.initial.e_rms,
+                report.last().e_rms,
+                monotone
+            )
+        });
+        summary.push(json!({
+            "example": ex.number, "run": label, "variant": variant.name(), "lambda": lambda,
+            "far": ex.far, "axes": ex.axes, "iterations_to_tolerance": reached,
+            "tolerance": TOLERANCE, "initial_e_rms": report.initial.e_rms,
+            "final_e_rms": report.last().e_rms, "objective_monotone": monotone,
+            "iterations": report.iterations.len(), "stop": format!("{:?}", report.stop),
+            "e_rms": curve.iter().map(|p| p.1).collect::<Vec<_>>(),
+        }));
+        series.push(Series {
+            name: label.clone(),
+            points: curve,
+        });
+        reports.push((label.clone(), report));
+    }
+    let base = a.output.join(format!("example{}", ex.number));
+    crate::interrupt::watch_dir(&base.with_extension("csv"));
+    subfit::io::write_atomic(&base.with_extension("csv"), csv(&reports).as_bytes())?;
+    let svg = log_chart(
+        ex.title,
+        "iteration",
+        "E_rms (unit cube)",
+        &series,
+        Some(TOLERANCE),
+    );
+    crate::interrupt::watch_dir(&base.with_extension("svg"));
+    subfit::io::write_atomic(&base.with_extension("svg"), svg.as_bytes())?;
+    Ok(Block::Figure {
+        svg,
+        caption: format!(
+            "Example {}: E_rms per iteration, one line per method (exampleN.csv has the numbers).",
+            ex.number
+        ),
+    })
+}
+
+/// Writes `report.html` (a table of the runs and the error curves) and `summary.json` into
+/// the output directory.
+fn write_convergence_report(
+    a: &ConvergenceArgs,
+    summary: &[serde_json::Value],
+    figures: Vec<Block>,
+) -> anyhow::Result<()> {
     let rows = summary
         .iter()
         .map(|r| {
@@ -287,12 +315,7 @@ fn convergence(a: ConvergenceArgs) -> anyhow::Result<ExitCode> {
         &a.output.join("summary.json"),
         (serde_json::to_string_pretty(&doc)? + "\n").as_bytes(),
     )?;
-    out!(
-        "wrote {} (look at {})",
-        a.output.display(),
-        a.output.join("report.html").display()
-    );
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// `(iteration, E_rms)` of the current (best accepted) control points after each iteration,

@@ -14,7 +14,8 @@
 
 use rayon::prelude::*;
 
-use super::{Camera, Image, SoftOptions};
+use super::camera::Camera;
+use super::image::{Image, SoftOptions};
 
 /// Side of a square tile, pixels.
 pub(super) const TILE: usize = 32;

@@ -17,7 +17,7 @@ use subfit_mesh::vec3::dot;
 use subfit_target::neighbors::PointIndex;
 use subfit_target::Target;
 
-use super::TrackOptions;
+use super::options::TrackOptions;
 
 /// The frame points used by the data → model correspondences, with their unit normals.
 pub(super) struct DataPoints {

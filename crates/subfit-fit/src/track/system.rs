@@ -6,10 +6,8 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use subfit_mesh::vec3::{dot as dot3, sub};
 
-use super::{v, DeformationGraph, Marker, NodeMotion, Skin, TrackOptions};
-
-/// Unknowns per node: `A` row-major (9), then `t` (3).
-pub(super) const PER: usize = 12;
+use super::model::{v, DeformationGraph, NodeMotion, Skin, PER};
+use super::options::{Marker, TrackOptions};
 
 /// A dense symmetric normal system `H x = b` over `12 m` unknowns; only the upper triangle
 /// of `H` (row ≤ column) is accumulated.

@@ -1,6 +1,10 @@
 //! Unit tests of the tracking step: the second-order projector, extrapolation, fits to known
 //! correspondences.
 
+use nalgebra::Matrix3;
+use subfit_mesh::vec3::{dot as dot3, sub};
+
+use super::model::v;
 use super::*;
 
 /// The largest entry of `(I − Π_k) f` over all nodes `k` (`f` one value a node).
