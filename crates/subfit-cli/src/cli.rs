@@ -231,6 +231,14 @@ pub struct FitArgs {
     /// their tolerance.
     #[arg(long)]
     pub facing: bool,
+    /// The chordal tolerance, for CAD exports (STL/OBJ tessellations): fit the part the facets
+    /// stand for, not the facets. The fit aims at the facets' curved interpolant (PN triangles
+    /// through the vertices with the surface's normals), which the facets cut by up to their
+    /// chord height; curved faces come out smooth, planes and creases stay. Errors are measured
+    /// against the interpolant; the report says how far the facets lie from it. No effect on a
+    /// mesh not recognised as a tessellation (a warning says so).
+    #[arg(long)]
+    pub chordal: bool,
     /// The control-point budget: the initial cage and every refinement stay within it (exit
     /// code 2 when the target's topology needs more) [default: 5000]. A budget given without
     /// --tolerance and --max-error is spent on the best cage it holds: the tolerance is then

@@ -65,7 +65,7 @@ pub(crate) fn fit_start(
     };
     let mut on_event = |e: subfit_fit::StageEvent<'_>| notify.stage_event(e);
     let result = fit_stages(
-        &prepared.target,
+        prepared.fit_target(),
         &start.cage,
         &fit,
         &working,
@@ -83,7 +83,7 @@ pub(crate) fn fit_start(
     options.cancel.check().map_err(|_| Error::Interrupted)?;
     let t_measure = Instant::now();
     let measured = measure_final(
-        &prepared.target,
+        prepared.fit_target(),
         &prepared.file_vertices,
         &result,
         &fit,

@@ -32,6 +32,7 @@
 //! - [`report`]: error colours, plots, the preview image, report.html.
 
 pub mod choose;
+pub mod chordal;
 mod closing;
 mod error;
 mod fit_start;

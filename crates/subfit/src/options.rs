@@ -125,6 +125,13 @@ pub struct FitScanOptions {
     /// Initial-mesh options (`expected_genus` and `expected_boundary_loops` are set from the faces
     /// with `as_points`).
     pub init_options: InitOptions,
+    /// The chordal tolerance: fit the part a tessellation stands for rather than its facets.
+    /// When the target is recognised as a tessellation (a CAD export), the fit and the
+    /// measurements aim at its curved interpolant
+    /// ([`subfit_target::tessellation::curved_interpolant`], PN triangles through its vertices
+    /// with the surface's normals), which the facets cut by up to their chord height; its
+    /// curved faces may then come out smooth whatever their sag. Default false: the facets.
+    pub chordal: bool,
     /// The error mapped to red in `error.ply` (normalized units). Default `None`: the final
     /// surface → data `E_max`.
     pub error_scale: Option<f64>,
@@ -160,6 +167,7 @@ impl Default for FitScanOptions {
                 one_sided_refine: subfit_init::ONE_SIDED_REFINE,
                 ..InitOptions::default()
             },
+            chordal: false,
             error_scale: None,
             cancel: Cancel::default(),
         }

@@ -367,6 +367,11 @@ pub struct OptionsSummary {
     /// The optimizer (`GaussNewton`, `Adam`, `Lbfgs`; `--optimizer`).
     #[serde(default)]
     pub optimizer: String,
+    /// Under the chordal tolerance (`--chordal`), each facet of the tessellation was cut into
+    /// this many squared triangles of its curved interpolant, which the fit aimed at and the
+    /// errors are measured against; `None`: the input as given.
+    #[serde(default)]
+    pub chordal_levels: Option<usize>,
 }
 
 /// One stage.

@@ -14,6 +14,7 @@ use subfit_init::InitOptions;
 use subfit_mesh::{HalfEdgeMesh, PolyMesh, Polygons};
 use subfit_target::{Target, TargetOptions};
 
+use crate::chordal::{chordal_target, ChordalTarget};
 use crate::error::Error;
 use crate::options::{FitScanOptions, Input};
 use crate::pipeline_report::{Reorientation, Topology};
@@ -45,6 +46,9 @@ pub struct Prepared {
     pub diagonal: f64,
     /// What the repairs and the analysis told (also in every report).
     pub(crate) warnings: Vec<String>,
+    /// Under the chordal tolerance, the curved interpolant of a tessellation: what the stages
+    /// fit and the final measure measures ([`crate::chordal`]).
+    pub(crate) chordal: Option<ChordalTarget>,
     /// Seconds spent reading the input.
     pub(crate) read_seconds: f64,
     /// Seconds spent analysing it ([`subfit_target::TargetStats`]'s total).
@@ -66,6 +70,12 @@ impl Prepared {
     /// Seconds spent reading and analysing the input.
     pub fn read_and_analyse_seconds(&self) -> f64 {
         self.read_seconds + self.preprocess_seconds
+    }
+
+    /// The target the stages fit and the final measure measures: the curved interpolant under
+    /// the chordal tolerance, else the target.
+    pub(crate) fn fit_target(&self) -> &Arc<Target> {
+        self.chordal.as_ref().map_or(&self.target, |c| &c.target)
     }
 
     /// Whether the target is a mesh with boundary loops.
@@ -153,6 +163,24 @@ pub(crate) fn prepare(
         notify.warn(&mut warnings, msg);
     }
     let diagonal = bbox_diagonal(target.points());
+    let chordal = if options.chordal && !mesh.faces.is_empty() {
+        let c = chordal_target(&target, &target_options).map_err(|e| Error::target(&name, e))?;
+        let msg = match &c {
+            Some(c) => format!(
+                "{name}: the chordal tolerance: fitted and measured against the curved interpolant of the facets (PN triangles, {}² per facet), from which the facets lie up to {:.3e} ({:.3}% of the diagonal)",
+                c.levels,
+                target.normalization().length_to_original(c.facet_deviation),
+                100.0 * c.facet_deviation / diagonal
+            ),
+            None => format!(
+                "{name} is not recognised as a CAD tessellation (or has too many faces to cut): the chordal tolerance does not apply, its facets are fitted"
+            ),
+        };
+        notify.warn(&mut warnings, msg);
+        c
+    } else {
+        None
+    };
     let file_vertices = file_vertices
         .into_iter()
         .map(|p| target.to_normalized(p))
@@ -167,6 +195,7 @@ pub(crate) fn prepare(
         target: Arc::new(target),
         diagonal,
         warnings,
+        chordal,
         read_seconds,
         preprocess_seconds,
     })

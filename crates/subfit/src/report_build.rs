@@ -185,5 +185,6 @@ fn options_summary(p: &ReportParts<'_>) -> OptionsSummary {
             subfit_fit::Optimizer::Lbfgs { .. } => "Lbfgs",
         }
         .into(),
+        chordal_levels: p.prepared.chordal.as_ref().map(|c| c.levels),
     }
 }

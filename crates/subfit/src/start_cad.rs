@@ -22,7 +22,9 @@
 use std::sync::Arc;
 
 use subfit_init::{cad_cage, CadOptions};
-use subfit_target::tessellation::{classify_edges, EdgeClass, Facets, SmoothBudget};
+use subfit_target::tessellation::{
+    classify_edges, classify_edges_chordal, EdgeClass, Facets, SmoothBudget,
+};
 
 use crate::error::Error;
 use crate::options::{FitScanOptions, InitialCage};
@@ -151,7 +153,13 @@ pub(crate) fn cad_start(
     } else {
         smooth_budget(prepared, options)
     };
-    let features = classify_edges(points, facets, &smooth_budget);
+    let features = if prepared.chordal.is_some() && !faceted {
+        // The chordal tolerance: the fit aims at the curved interpolant, which the facets cut
+        // by their sag; a curved face is smooth whatever its deviation from the facets.
+        classify_edges_chordal(points, facets)
+    } else {
+        classify_edges(points, facets, &smooth_budget)
+    };
     if features.count(EdgeClass::Crease) == 0 {
         return Err(Error::Budget(format!(
             "{name}: a tessellation without creases (no CAD start)"

@@ -117,6 +117,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
             ..StageOptions::default()
         },
         error_scale: a.error_scale,
+        chordal: a.chordal,
         init_options: InitOptions {
             features: a.features.options(),
             semi_sharp: a.features.semi_sharp,

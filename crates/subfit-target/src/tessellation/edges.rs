@@ -48,6 +48,57 @@ impl SmoothBudget {
     };
 }
 
+/// Under the chordal tolerance, an edge of a curved face sags by about the exporter's chord
+/// height; one that sags by more than this many chord heights is a designed edge (a chamfer
+/// between wide planes, the kink between a fillet and its plane) and stays a crease.
+pub const CHORDAL_SAGS: f64 = 3.0;
+
+impl SmoothBudget {
+    /// The chordal tolerance's budget for `facets` over `positions`: an edge that turns by
+    /// less than [`MAX_SMOOTH_ANGLE_DEG`] is smooth when its sag is within [`CHORDAL_SAGS`]
+    /// exporter's chord heights ([`chord_height`]), whatever the deviation from the facets
+    /// adds up to: the limit aims at the curved part, not at the facets.
+    pub fn chordal(positions: &[[f64; 3]], facets: &Facets) -> Self {
+        let open = Self {
+            max_sag: f64::INFINITY,
+            max_rms: f64::INFINITY,
+        };
+        let h = classify_edges(positions, facets, &open).chord_height;
+        Self {
+            max_sag: CHORDAL_SAGS * h,
+            max_rms: f64::INFINITY,
+        }
+    }
+}
+
+/// Under the chordal tolerance, an edge is smooth only between sides at most this many times
+/// as wide across it as it is long: the facets of a curved face are strips along it (a
+/// cylinder's) or about square (a sphere's), while two wide planes meeting at a shallow angle
+/// (the walls of an embossed letter at a corner of 40°) are a designed edge, whatever their
+/// sag says.
+pub const CHORDAL_STRIP_RATIO: f64 = 2.0;
+
+/// The classes of [`classify_edges`] under the chordal tolerance: the budget of
+/// [`SmoothBudget::chordal`], and a smooth edge between sides wider than
+/// [`CHORDAL_STRIP_RATIO`] times its length a crease.
+pub fn classify_edges_chordal(positions: &[[f64; 3]], facets: &Facets) -> FacetFeatures {
+    let mut features = classify_edges(positions, facets, &SmoothBudget::chordal(positions, facets));
+    let widths = side_widths(positions, facets);
+    for (i, e) in facets.edges.iter().enumerate() {
+        if features.class[i] != EdgeClass::Smooth {
+            continue;
+        }
+        let len = norm(sub(
+            positions[e.ends[1] as usize],
+            positions[e.ends[0] as usize],
+        ));
+        if widths[i][0].max(widths[i][1]) > CHORDAL_STRIP_RATIO * len {
+            features.class[i] = EdgeClass::Crease;
+        }
+    }
+    features
+}
+
 /// The class of an interior edge of a tessellation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EdgeClass {

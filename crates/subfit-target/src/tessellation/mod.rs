@@ -25,13 +25,16 @@
 //!
 //! Units are those of the positions given (the target's unit cube in the pipeline).
 
+mod curved;
 mod edges;
 mod elements;
 mod facets;
 mod planes;
 
+pub use curved::{curved_interpolant, facet_deviation, MIN_PLANE_FACES};
 pub use edges::{
-    chord_height, classify_edges, EdgeClass, FacetFeatures, SmoothBudget, MAX_SMOOTH_ANGLE_DEG,
+    chord_height, classify_edges, classify_edges_chordal, EdgeClass, FacetFeatures, SmoothBudget,
+    CHORDAL_SAGS, CHORDAL_STRIP_RATIO, MAX_SMOOTH_ANGLE_DEG,
 };
 pub use elements::{FacetEdge, PlanarRegion};
 pub use facets::{Facets, TessellationStats, FLAT_EDGE_SHARE, PLANAR_AREA_SHARE, SLIVER_ASPECT};
