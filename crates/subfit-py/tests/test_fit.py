@@ -111,6 +111,34 @@ def test_facing_is_an_option_and_reaches_the_report(fitted):
         assert ellipsoid_distance(m.surface().sample(2)).max() < 1e-2
 
 
+def test_chordal_fits_the_part_a_coarse_export_stands_for():
+    # A cylinder of radius 1 exported with 16 segments, capped by fans: the chordal fit's
+    # limit surface lies closer to the true cylinder than the facets (at mid-height).
+    m, h = 16, 2.0
+    angles = 2 * np.pi * np.arange(m) / m
+    ring = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    pos = np.concatenate(
+        [np.c_[ring, np.zeros(m)], np.c_[ring, np.full(m, h)], [[0, 0, 0], [0, 0, h]]]
+    )
+    tris = []
+    for i in range(m):
+        j = (i + 1) % m
+        tris += [[i, j, m + j], [i, m + j, m + i], [2 * m, j, i], [2 * m + 1, m + i, m + j]]
+    tris = np.array(tris)
+    plain = subfit.fit(pos, faces=tris)
+    curved = subfit.fit(pos, faces=tris, chordal=True)
+    assert plain.report["options"]["chordal_levels"] is None
+    assert curved.report["options"]["chordal_levels"] == 4
+    assert curved.num_control_points <= len(pos)
+
+    def radial_error(f):
+        p = f.surface().sample(3)
+        side = np.abs(p[:, 2] - h / 2) < 0.25 * h
+        return np.sqrt(np.mean((np.hypot(p[side, 0], p[side, 1]) - 1.0) ** 2))
+
+    assert radial_error(curved) < 0.5 * radial_error(plain)
+
+
 def test_mesh_target_and_given_initial_cage(fitted):
     # A dense triangle mesh (the fitted limit tessellation) as the target.
     pos, tris = fitted.surface().tessellation(3)

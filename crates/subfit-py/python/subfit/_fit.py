@@ -246,7 +246,10 @@ def fit(
         ``max_iterations`` (100), ``stage_iterations`` (6), ``one_sided`` (False),
         ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),
         ``facing`` (False; ``--facing``: inside thin parts of a closed mesh, a sample that sank
-        past the middle is pulled by the wall facing its own way),
+        past the middle is pulled by the wall facing its own way), ``chordal`` (False;
+        ``--chordal``: for a CAD tessellation, fit the part its facets stand for — their curved
+        interpolant, PN triangles through the vertices — rather than the facets; errors are
+        measured against it and ``report["options"]["chordal_levels"]`` says it applied),
         ``refine`` (True; ``--no-refine``), ``edge_flips`` (True; ``--no-flips``),
         ``max_depth`` (5), ``local`` (False), ``local_rings`` (2), ``local_field_peak`` (0.8),
         ``local_field_share`` (0.5; 0 turns local enrichment off), ``error_scale``,

@@ -46,6 +46,7 @@ def fit(
     one_sided: bool = False,
     coverage: float = 1.0,
     facing: bool = False,
+    chordal: bool = False,
     refine: bool = True,
     edge_flips: bool = True,
     max_depth: int = 5,
