@@ -21,8 +21,8 @@ use crate::vec3::{dot, unit};
 mod control_meshes;
 
 pub use control_meshes::{
-    cheng_ellipsoid_cage, cube_mesh, geodesic_sphere, gridded_box, l_prism, octahedron_mesh,
-    rounded_prism, torus_mesh,
+    capped_cylinder, cheng_ellipsoid_cage, cube_mesh, geodesic_sphere, gridded_box, l_prism,
+    octahedron_mesh, rounded_prism, torus_mesh,
 };
 
 /// An analytic closed surface.

@@ -5,31 +5,13 @@
 
 use std::collections::HashMap;
 
+use subfit_mesh::shapes;
 use subfit_target::tessellation::{curved_interpolant, facet_deviation, Facets};
 
-/// A closed cylinder of radius 1 and height `h` (axis z, from 0), `m` segments, the side as
-/// quads split in two, the caps as fans around their centres; outward orientation.
+/// The capped cylinder of radius 1 and height `h`, `m` segments (as an exporter cuts it).
 fn capped_cylinder(m: usize, h: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut p = Vec::new();
-    for z in [0.0, h] {
-        for i in 0..m {
-            let a = std::f64::consts::TAU * i as f64 / m as f64;
-            p.push([a.cos(), a.sin(), z]);
-        }
-    }
-    let (bottom, top) = (p.len() as u32, p.len() as u32 + 1);
-    p.push([0.0, 0.0, 0.0]);
-    p.push([0.0, 0.0, h]);
-    let mut t = Vec::new();
-    for i in 0..m {
-        let j = (i + 1) % m;
-        let (a, b, c, d) = (i as u32, j as u32, (m + j) as u32, (m + i) as u32);
-        t.push([a, b, c]);
-        t.push([a, c, d]);
-        t.push([bottom, b, a]);
-        t.push([top, d, c]);
-    }
-    (p, t)
+    let c = shapes::capped_cylinder(1.0, h, m);
+    (c.positions, c.faces.triangulate_fan())
 }
 
 /// Distance of `x` to the capped cylinder's surface.

@@ -5,7 +5,7 @@
 #![allow(clippy::print_stderr)] // the figures are printed
 
 use subfit::measure::MeshDistance;
-use subfit::mesh::shapes::gridded_box;
+use subfit::mesh::shapes::{capped_cylinder, gridded_box};
 use subfit::mesh::{PolyMesh, Polygons};
 use subfit::subdiv::sampling_operator;
 use subfit::{fit_scan, FitScanOptions, Fitted, Input};
@@ -13,26 +13,9 @@ use subfit::{fit_scan, FitScanOptions, Fitted, Input};
 const R: f64 = 10.0;
 const H: f64 = 20.0;
 
-/// The capped cylinder of radius `R` and height `H` (axis z from 0) exported with `m`
-/// segments: the side as quads split in two, the caps as fans around their centres.
+/// The capped cylinder of radius `R` and height `H` exported with `m` segments.
 fn export(m: usize) -> PolyMesh {
-    let mut p = Vec::new();
-    for z in [0.0, H] {
-        for i in 0..m {
-            let a = std::f64::consts::TAU * i as f64 / m as f64;
-            p.push([R * a.cos(), R * a.sin(), z]);
-        }
-    }
-    let (bottom, top) = (p.len() as u32, p.len() as u32 + 1);
-    p.push([0.0, 0.0, 0.0]);
-    p.push([0.0, 0.0, H]);
-    let mut t = Vec::new();
-    for i in 0..m {
-        let j = (i + 1) % m;
-        let (a, b, c, d) = (i as u32, j as u32, (m + j) as u32, (m + i) as u32);
-        t.extend([[a, b, c], [a, c, d], [bottom, b, a], [top, d, c]]);
-    }
-    PolyMesh::new(p, Polygons::from_triangles(&t))
+    capped_cylinder(R, H, m)
 }
 
 /// Distance of `x` to the true cylinder's surface.

@@ -1,6 +1,6 @@
 //! Simple control meshes for tests, examples and benchmarks: a torus grid, the octahedron and
 //! Cheng et al. 2007's 14-vertex ellipsoid cage built on it (Examples 1–10), a geodesic
-//! sphere, cubes and boxes, an L-shaped and a rounded prism. Re-exported from
+//! sphere, cubes and boxes, a capped cylinder, an L-shaped and a rounded prism. Re-exported from
 //! [`crate::shapes`].
 
 use crate::polygons::{PolyMesh, Polygons};
@@ -140,6 +140,35 @@ pub fn cube_mesh(h: f64) -> PolyMesh {
         [1, 3, 7, 5],
     ];
     PolyMesh::new(pos, Polygons::from_quads(&quads))
+}
+
+/// A closed cylinder of radius `r` and height `h` (axis z, from 0) as a CAD exporter
+/// tessellates it with `m` segments: the side as `m` quads split in two (long strips), each cap
+/// as a fan of `m` triangles around its centre; outward orientation, `2m + 2` vertices (the
+/// rings first, bottom then top, then the two centres). The CAD-like shape of a curved face
+/// cut by chords (sag `r (1 − cos(π/m))`) between two planes.
+///
+/// # Panics
+/// If `m` is below 3.
+pub fn capped_cylinder(r: f64, h: f64, m: usize) -> PolyMesh {
+    assert!(m >= 3, "a cylinder needs at least 3 segments");
+    let mut p = Vec::with_capacity(2 * m + 2);
+    for z in [0.0, h] {
+        for i in 0..m {
+            let a = std::f64::consts::TAU * i as f64 / m as f64;
+            p.push([r * a.cos(), r * a.sin(), z]);
+        }
+    }
+    let (bottom, top) = (p.len() as u32, p.len() as u32 + 1);
+    p.push([0.0, 0.0, 0.0]);
+    p.push([0.0, 0.0, h]);
+    let mut t = Vec::with_capacity(4 * m);
+    for i in 0..m {
+        let j = (i + 1) % m;
+        let (a, b, c, d) = (i as u32, j as u32, (m + j) as u32, (m + i) as u32);
+        t.extend([[a, b, c], [a, c, d], [bottom, b, a], [top, d, c]]);
+    }
+    PolyMesh::new(p, Polygons::from_triangles(&t))
 }
 
 /// The unit cube `[0, 1]³` with an `n × n` grid of triangle pairs on each side (outward
