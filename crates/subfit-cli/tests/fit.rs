@@ -434,3 +434,38 @@ fn facing_foot_points_are_an_option_of_fit() {
         assert_eq!(rep["target_topology"]["genus"], 0);
     }
 }
+
+/// `--chordal` reaches the fit of a CAD export (report.json `options.chordal_levels`, a
+/// warning with the facets' distance), and a mesh that is not a tessellation is fitted as
+/// given, with a warning that says so.
+#[test]
+fn the_chordal_tolerance_is_an_option_of_fit() {
+    let d = tempfile::tempdir().unwrap();
+    let part = d.path().join("cylinder.stl");
+    save(&part, &subfit::mesh::shapes::capped_cylinder(10.0, 20.0, 24));
+    let scan = d.path().join("torus.ply");
+    save(&scan, &torus_mesh(1.0, 0.4, 48, 24, true));
+    for (input, levels) in [(&part, Some(4)), (&scan, None)] {
+        let out = d.path().join("fit");
+        let r = subfit(&[
+            "fit",
+            input.to_str().unwrap(),
+            "--chordal",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&r.stderr);
+        assert!(r.status.code().is_some_and(|c| c <= 1), "{stderr}");
+        let rep = report(&out);
+        match levels {
+            Some(l) => {
+                assert_eq!(rep["options"]["chordal_levels"], l);
+                assert!(stderr.contains("curved interpolant of the facets"), "{stderr}");
+            }
+            None => {
+                assert!(rep["options"]["chordal_levels"].is_null());
+                assert!(stderr.contains("the chordal tolerance does not apply"), "{stderr}");
+            }
+        }
+    }
+}
