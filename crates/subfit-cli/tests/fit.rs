@@ -442,9 +442,19 @@ fn facing_foot_points_are_an_option_of_fit() {
 fn the_chordal_tolerance_is_an_option_of_fit() {
     let d = tempfile::tempdir().unwrap();
     let part = d.path().join("cylinder.stl");
-    save(&part, &subfit::mesh::shapes::capped_cylinder(10.0, 20.0, 24));
+    save(
+        &part,
+        &subfit::mesh::shapes::capped_cylinder(10.0, 20.0, 24),
+    );
+    // A scanned torus: its vertices off the grid's planes (no planar regions: not a
+    // tessellation; the exact grid would be one, of a torus).
+    let mut torus = torus_mesh(1.0, 0.4, 48, 24, true);
+    for (i, p) in torus.positions.iter_mut().enumerate() {
+        let s = 1.0 + 2e-3 * (17.0 * i as f64).sin();
+        *p = p.map(|x| x * s);
+    }
     let scan = d.path().join("torus.ply");
-    save(&scan, &torus_mesh(1.0, 0.4, 48, 24, true));
+    save(&scan, &torus);
     for (input, levels) in [(&part, Some(4)), (&scan, None)] {
         let out = d.path().join("fit");
         let r = subfit(&[
@@ -460,11 +470,17 @@ fn the_chordal_tolerance_is_an_option_of_fit() {
         match levels {
             Some(l) => {
                 assert_eq!(rep["options"]["chordal_levels"], l);
-                assert!(stderr.contains("curved interpolant of the facets"), "{stderr}");
+                assert!(
+                    stderr.contains("curved interpolant of the facets"),
+                    "{stderr}"
+                );
             }
             None => {
                 assert!(rep["options"]["chordal_levels"].is_null());
-                assert!(stderr.contains("the chordal tolerance does not apply"), "{stderr}");
+                assert!(
+                    stderr.contains("the chordal tolerance does not apply"),
+                    "{stderr}"
+                );
             }
         }
     }

@@ -163,7 +163,13 @@ pub(crate) fn prepare(
         notify.warn(&mut warnings, msg);
     }
     let diagonal = bbox_diagonal(target.points());
-    let chordal = if options.chordal && !mesh.faces.is_empty() {
+    let chordal = if options.chordal && mesh.faces.is_empty() {
+        let msg = format!(
+            "{name} is fitted as points: the chordal tolerance, for a tessellation's facets, does not apply"
+        );
+        notify.warn(&mut warnings, msg);
+        None
+    } else if options.chordal {
         let c = chordal_target(&target, &target_options).map_err(|e| Error::target(&name, e))?;
         let msg = match &c {
             Some(c) => format!(
