@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 
 use subfit_mesh::shapes;
-use subfit_target::tessellation::{curved_interpolant, facet_deviation, Facets};
+use subfit_target::tessellation::{curved_interpolant, Facets};
 
 /// The capped cylinder of radius 1 and height `h`, `m` segments (as an exporter cuts it).
 fn capped_cylinder(m: usize, h: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
@@ -46,7 +46,8 @@ fn the_curved_interpolant_of_a_coarse_cylinder_is_near_the_cylinder() {
     let h = 2.0;
     let (p, t) = capped_cylinder(16, h);
     let facets = Facets::new(&p, &t, 1e-12);
-    let (q, f) = curved_interpolant(&p, &facets, 4);
+    let curved_mesh = curved_interpolant(&p, &facets, 4);
+    let (q, f) = (&curved_mesh.positions, &curved_mesh.triangles);
     assert_eq!(f.len(), t.len() * 16);
     // The input's vertices first, unchanged.
     assert_eq!(&q[..p.len()], &p[..]);
@@ -70,7 +71,7 @@ fn the_curved_interpolant_of_a_coarse_cylinder_is_near_the_cylinder() {
     // Twice as many segments: the interpolant's error falls at least 8-fold (measured: 16-fold,
     // 5.5e-4 → 3.5e-5, fourth order), the facets' 4-fold.
     let (p2, t2) = capped_cylinder(32, h);
-    let (q2, _) = curved_interpolant(&p2, &Facets::new(&p2, &t2, 1e-12), 4);
+    let q2 = curved_interpolant(&p2, &Facets::new(&p2, &t2, 1e-12), 4).positions;
     let curved2 = q2
         .iter()
         .map(|&x| cylinder_distance(x, h))
@@ -78,7 +79,7 @@ fn the_curved_interpolant_of_a_coarse_cylinder_is_near_the_cylinder() {
     assert!(curved2 < curved / 8.0, "{curved2:.3e} against {curved:.3e}");
 
     // The caps stay flat, the rims where the facets put them (a crease stays straight).
-    for x in &q {
+    for x in q {
         let on_cap = x[2].abs() < 1e-12 || (x[2] - h).abs() < 1e-12;
         let inside = x[0] * x[0] + x[1] * x[1] <= 1.0 + 1e-12;
         assert!(!on_cap || inside, "a cap point {x:?} off the cap");
@@ -90,7 +91,7 @@ fn the_curved_interpolant_of_a_coarse_cylinder_is_near_the_cylinder() {
 
     // No cracks: every edge of the refined mesh has two faces.
     let mut count: HashMap<(u32, u32), usize> = HashMap::new();
-    for tri in &f {
+    for tri in f {
         for i in 0..3 {
             let (a, b) = (tri[i], tri[(i + 1) % 3]);
             *count.entry((a.min(b), a.max(b))).or_default() += 1;
@@ -102,7 +103,7 @@ fn the_curved_interpolant_of_a_coarse_cylinder_is_near_the_cylinder() {
     );
 
     // What the facets cut off: the sag, seen from the interpolant.
-    let dev = facet_deviation(&p, &facets, 4);
+    let dev = curved_mesh.facet_deviation;
     assert!(
         (dev - sag).abs() < 0.05 * sag,
         "deviation {dev:.4e}, sag {sag:.4e}"
@@ -113,7 +114,8 @@ fn the_curved_interpolant_of_a_coarse_cylinder_is_near_the_cylinder() {
 fn one_level_gives_the_facets_back() {
     let (p, t) = capped_cylinder(8, 1.0);
     let facets = Facets::new(&p, &t, 1e-12);
-    let (q, f) = curved_interpolant(&p, &facets, 1);
-    assert_eq!(q, p);
-    assert_eq!(f, t);
+    let c = curved_interpolant(&p, &facets, 1);
+    assert_eq!(c.positions, p);
+    assert_eq!(c.triangles, t);
+    assert_eq!(c.facet_deviation, 0.0);
 }

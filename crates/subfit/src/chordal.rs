@@ -11,7 +11,7 @@
 use std::sync::Arc;
 
 use subfit_mesh::{PolyMesh, Polygons};
-use subfit_target::tessellation::{curved_interpolant, facet_deviation};
+use subfit_target::tessellation::curved_interpolant;
 use subfit_target::{Target, TargetOptions};
 
 #[cfg(doc)]
@@ -53,19 +53,22 @@ pub(crate) fn chordal_target(
     if levels < 2 {
         return Ok(None);
     }
-    let (positions, triangles) = curved_interpolant(target.points(), facets, levels);
+    let curved = curved_interpolant(target.points(), facets, levels);
     let mesh = PolyMesh::new(
-        positions.iter().map(|&p| target.to_original(p)).collect(),
-        Polygons::from_triangles(&triangles),
+        curved
+            .positions
+            .iter()
+            .map(|&p| target.to_original(p))
+            .collect(),
+        Polygons::from_triangles(&curved.triangles),
     );
     let options = TargetOptions {
         normalization: Some(*target.normalization()),
         ..options.clone()
     };
-    let curved = Target::build(&mesh, &options, None)?;
     Ok(Some(ChordalTarget {
-        target: Arc::new(curved),
+        target: Arc::new(Target::build(&mesh, &options, None)?),
         levels,
-        facet_deviation: facet_deviation(target.points(), facets, levels),
+        facet_deviation: curved.facet_deviation,
     }))
 }

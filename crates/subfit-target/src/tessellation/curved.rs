@@ -37,6 +37,18 @@ use super::facets::Facets;
 /// strip of two triangles (a quad of a tessellated cylinder) is not a plane of the part.
 pub const MIN_PLANE_FACES: usize = 3;
 
+/// The curved interpolant of a tessellation ([`curved_interpolant`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CurvedInterpolant {
+    /// Its vertices: the input's first, at their indices, then the new ones.
+    pub positions: Vec<[f64; 3]>,
+    /// Its triangles, `levels²` per facet in facet order.
+    pub triangles: Vec<[u32; 3]>,
+    /// The largest distance of a facet from it over its vertices: what the facets cut off the
+    /// part, the chord height the chordal tolerance allows (0 with `levels = 1`).
+    pub facet_deviation: f64,
+}
+
 /// The curved interpolant of `facets` over `positions`, each facet cut into `levels²`
 /// triangles whose vertices lie on its PN triangle (see the module docs); `levels = 1` gives
 /// the facets back. The vertices of the input keep their indices (the first `#V`); the new
@@ -48,7 +60,7 @@ pub fn curved_interpolant(
     positions: &[[f64; 3]],
     facets: &Facets,
     levels: usize,
-) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+) -> CurvedInterpolant {
     assert!(levels > 0, "curved_interpolant: levels must be at least 1");
     let tris = &facets.triangles;
     let lines = Lines::new(positions, facets);
@@ -58,8 +70,10 @@ pub fn curved_interpolant(
         std::collections::HashMap::new();
     let mut faces = Vec::with_capacity(tris.len() * levels * levels);
     let n = levels;
+    let mut facet_deviation: f64 = 0.0;
     for (f, t) in tris.iter().enumerate() {
         let patch = PnTriangle::of_face(positions, *t, normals[f], &lines);
+        let corner = t.map(|v| positions[v as usize]);
         // Grid index (i, j) with i + j ≤ n: barycentric (n − i − j, i, j) / n.
         let mut grid = vec![u32::MAX; (n + 1) * (n + 2) / 2];
         let at = |i: usize, j: usize| i * (n + 1) - i * (i.saturating_sub(1)) / 2 + j;
@@ -82,7 +96,10 @@ pub fn curved_interpolant(
                         } else {
                             None
                         };
-                        let x = patch.at([k as f64, i as f64, j as f64].map(|w| w / n as f64));
+                        let w = [k as f64, i as f64, j as f64].map(|w| w / n as f64);
+                        let x = patch.at(w);
+                        let flat = (0..3).fold([0.0; 3], |s, c| add(s, scale(corner[c], w[c])));
+                        facet_deviation = facet_deviation.max(norm(sub(x, flat)));
                         match side {
                             None => push(&mut out, x),
                             Some((a, b, s)) => {
@@ -114,7 +131,11 @@ pub fn curved_interpolant(
             }
         }
     }
-    (out, faces)
+    CurvedInterpolant {
+        positions: out,
+        triangles: faces,
+        facet_deviation,
+    }
 }
 
 fn push(out: &mut Vec<[f64; 3]>, x: [f64; 3]) -> u32 {
@@ -361,26 +382,4 @@ impl PnTriangle {
             .iter()
             .fold([0.0; 3], |s, &(p, c)| add(s, scale(p, c)))
     }
-}
-
-/// The largest distance of a facet from its curved interpolant, sampled on the grid of
-/// `levels` per edge (at least 2): what the facets cut off the part, the chord height the
-/// chordal tolerance allows.
-pub fn facet_deviation(positions: &[[f64; 3]], facets: &Facets, levels: usize) -> f64 {
-    let n = levels.max(2);
-    let lines = Lines::new(positions, facets);
-    let normals = corner_normals(positions, facets, &lines.straight);
-    let mut largest: f64 = 0.0;
-    for (f, t) in facets.triangles.iter().enumerate() {
-        let p = t.map(|v| positions[v as usize]);
-        let patch = PnTriangle::of_face(positions, *t, normals[f], &lines);
-        for i in 0..=n {
-            for j in 0..=n - i {
-                let w = [(n - i - j) as f64, i as f64, j as f64].map(|w| w / n as f64);
-                let flat = add(add(scale(p[0], w[0]), scale(p[1], w[1])), scale(p[2], w[2]));
-                largest = largest.max(norm(sub(patch.at(w), flat)));
-            }
-        }
-    }
-    largest
 }

@@ -31,7 +31,7 @@ mod elements;
 mod facets;
 mod planes;
 
-pub use curved::{curved_interpolant, facet_deviation, MIN_PLANE_FACES};
+pub use curved::{curved_interpolant, CurvedInterpolant, MIN_PLANE_FACES};
 pub use edges::{
     chord_height, classify_edges, classify_edges_chordal, EdgeClass, FacetFeatures, SmoothBudget,
     CHORDAL_SAGS, CHORDAL_STRIP_RATIO, MAX_SMOOTH_ANGLE_DEG,
