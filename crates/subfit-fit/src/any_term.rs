@@ -113,6 +113,13 @@ impl<'t> DataTerm for AnyTerm<'t> {
         }
     }
 
+    fn measured_errors(&self, xs: &[[f64; 3]], err2: &mut [f64]) {
+        match self {
+            Self::FootPoint(t) => t.measured_errors(xs, err2),
+            Self::Imls(t) => t.measured_errors(xs, err2),
+        }
+    }
+
     fn squared_errors(&self, xs: &[[f64; 3]]) -> Vec<f64> {
         match self {
             Self::FootPoint(t) => t.squared_errors(xs),

@@ -289,8 +289,8 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
         Vec<f64>,
         Vec<subfit_measure::PointToLimit>,
     ) {
-        use subfit_measure::{vertex_areas, DistanceStats, MeshDistance, TwoSided};
-        let (samples, err2) = match self.last_at(control) {
+        use subfit_measure::{DistanceStats, MeshDistance, TwoSided};
+        let (samples, mut err2) = match self.last_at(control) {
             Some(st) => (st.samples.clone(), self.state_errors(st)),
             None => {
                 let samples = self.op.position.apply(control);
@@ -298,12 +298,14 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 (samples, err2)
             }
         };
+        self.term.measured_errors(&samples, &mut err2);
         let to_surface = MeshDistance::new(&samples, &self.op.faces).distances(&data.points);
         let d: Vec<f64> = to_surface.iter().map(|p| p.distance).collect();
         let two = TwoSided {
-            surface_to_data: DistanceStats::of_weighted(
+            surface_to_data: DistanceStats::over_surface(
                 &err2.iter().map(|x| x.max(0.0).sqrt()).collect::<Vec<_>>(),
-                &vertex_areas(&samples, &self.op.faces),
+                &samples,
+                &self.op.faces,
             ),
             data_to_surface: DistanceStats::of_samples(&d, data.boundary),
         };

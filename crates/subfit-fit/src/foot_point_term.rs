@@ -410,6 +410,10 @@ impl DataTerm for FootPointTerm<'_> {
         }
     }
 
+    fn measured_errors(&self, xs: &[[f64; 3]], err2: &mut [f64]) {
+        self.target.to_local_surface(xs, err2);
+    }
+
     fn bbox_diagonal(&self) -> f64 {
         bbox_diagonal(self.target.points())
     }

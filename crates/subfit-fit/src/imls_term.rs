@@ -219,6 +219,10 @@ impl DataTerm for ImlsTerm<'_> {
         (q, g.map(|gi| s.value * gi))
     }
 
+    fn measured_errors(&self, xs: &[[f64; 3]], err2: &mut [f64]) {
+        self.target.to_local_surface(xs, err2);
+    }
+
     fn bbox_diagonal(&self) -> f64 {
         self.diagonal
     }

@@ -82,6 +82,17 @@ pub trait DataTerm: Send + Sync {
     /// errors in [`crate::ErrorStats`].
     fn bbox_diagonal(&self) -> f64;
 
+    /// Turns the squared surface → data errors `err2` of the points `xs` (from
+    /// [`Self::squared_errors`] or a state: distances to the term's own model of the data) into
+    /// what a user measures: for a point cloud, the distance to the data's local surface,
+    /// bounded where the data ends ([`Target::to_local_surface`]). The measurements call it;
+    /// the objective does not. Default: nothing.
+    ///
+    /// [`Target::to_local_surface`]: subfit_target::Target::to_local_surface
+    fn measured_errors(&self, xs: &[[f64; 3]], err2: &mut [f64]) {
+        let _ = (xs, err2);
+    }
+
     /// Squared errors of `xs` ([`Self::squared_error`] after [`Self::project_fresh`]), in
     /// parallel, in order.
     fn squared_errors(&self, xs: &[[f64; 3]]) -> Vec<f64> {

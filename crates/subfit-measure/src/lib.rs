@@ -25,7 +25,7 @@ pub mod mesh_distance;
 pub mod tessellate;
 
 pub use data_samples::{data_samples, mesh_vertices, DataSamples, SampleKind};
-pub use distance::{vertex_areas, DistanceStats, TwoSided};
+pub use distance::{DistanceStats, TwoSided};
 pub use limit_distance::{LimitDistance, LimitDistanceError, PointToLimit};
 pub use mesh_distance::MeshDistance;
 pub use tessellate::{limit_tessellation, Chordal, LimitTessellation};

@@ -40,6 +40,7 @@ pub mod cloud_rim;
 pub mod consistency;
 mod error;
 pub mod estimate;
+mod extent;
 pub mod features;
 pub mod fillet;
 mod foot;
@@ -66,6 +67,7 @@ pub use cloud_features::{
 pub use cloud_rim::{cloud_boundary_points, RIM_GAP, RIM_NEIGHBORS};
 pub use error::TargetError;
 pub use estimate::Neighborhood;
+pub use extent::{EXTENT_NEIGHBOURS, REACH_SAMPLES};
 pub use features::{detect_features, FeatureCurve, FeatureOptions, Features};
 pub use fillet::fillet_widths;
 pub use imls::{imls_value, ImlsValue};

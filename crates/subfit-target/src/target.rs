@@ -59,6 +59,8 @@ pub struct Target {
     /// The connected component of every triangle of [`Self::mesh`] and whether each
     /// component is closed ([`Self::triangle_components`]), computed on first use.
     pub(crate) triangle_components: std::sync::OnceLock<(Vec<u32>, Vec<bool>)>,
+    /// The radius of a cloud's local surface ([`Self::data_reach`]), computed on first use.
+    pub(crate) reach: std::sync::OnceLock<f64>,
 }
 
 /// Per-point outputs for writers (e.g. the `subfit analyze` PLY): all arrays have `#P` rows, in
@@ -192,6 +194,7 @@ impl Target {
             facets,
             rim: std::sync::OnceLock::new(),
             triangle_components: std::sync::OnceLock::new(),
+            reach: std::sync::OnceLock::new(),
         })
     }
 

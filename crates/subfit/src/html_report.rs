@@ -92,11 +92,9 @@ impl Fitted {
             .map_err(|e| Error::Output(e.to_string()))?;
             let positions = op.position.apply(&cage.positions);
             let term = FootPointTerm::from_options(&self.target, &self.fit);
-            let errors = term
-                .squared_errors(&positions)
-                .into_iter()
-                .map(f64::sqrt)
-                .collect();
+            let mut err2 = term.squared_errors(&positions);
+            term.measured_errors(&positions, &mut err2);
+            let errors = err2.into_iter().map(f64::sqrt).collect();
             (positions, op.faces, errors, level)
         };
         let scale = self.error_scale();

@@ -1,14 +1,15 @@
 //! The final measurement of a fitted cage (DESIGN.md decision 11): both ways, on the limit
 //! tessellation written with it (chordal error a tenth of the fitting error, reported), with
-//! the one measurer ([`subfit_measure`]): surface → data by the fitter's foot points, data →
-//! surface from the target's data samples to the tessellation, its maximum over every input
-//! vertex too. What a user measures on
-//! limit.ply. A quad/triangle cage also gets the distance to the surface USD declares for it.
+//! the one measurer ([`subfit_measure`]): surface → data by the fitter's foot points (for a
+//! point cloud, to the data's local surface bounded where the data ends,
+//! [`subfit_target::Target::to_local_surface`]), uniform by area over the tessellation
+//! ([`DistanceStats::over_surface`]); data → surface from the target's data samples to the
+//! tessellation, its maximum over every input vertex too. What a user measures on limit.ply. A quad/triangle cage also gets the distance to the surface USD declares for it.
 
 use subfit_fit::{DataTerm, FitOptions, FootPointTerm, StagesResult};
 use subfit_measure::{
-    data_samples, limit_tessellation, mesh_vertices, vertex_areas, DistanceStats,
-    LimitTessellation, MeshDistance, TwoSided,
+    data_samples, limit_tessellation, mesh_vertices, DistanceStats, LimitTessellation,
+    MeshDistance, TwoSided,
 };
 use subfit_mesh::{PolyMesh, Tags};
 use subfit_subdiv::Scheme;
@@ -73,11 +74,9 @@ pub(crate) fn measure_final(
         last.e_max,
     )
     .map_err(|e| Error::Output(e.to_string()))?;
-    let local: Vec<f64> = term
-        .squared_errors(&tessellation.mesh.positions)
-        .into_iter()
-        .map(f64::sqrt)
-        .collect();
+    let mut err2 = term.squared_errors(&tessellation.mesh.positions);
+    term.measured_errors(&tessellation.mesh.positions, &mut err2);
+    let local: Vec<f64> = err2.into_iter().map(f64::sqrt).collect();
     let data = data_samples(target, samples);
     let surface = MeshDistance::new(&tessellation.mesh.positions, &tessellation.mesh.faces);
     let to_surface: Vec<f64> = surface
@@ -108,9 +107,10 @@ pub(crate) fn measure_final(
         data_to_surface: data_far.0,
     };
     let two_sided = TwoSided {
-        surface_to_data: DistanceStats::of_weighted(
+        surface_to_data: DistanceStats::over_surface(
             &local,
-            &vertex_areas(&tessellation.mesh.positions, &tessellation.mesh.faces),
+            &tessellation.mesh.positions,
+            &tessellation.mesh.faces,
         ),
         data_to_surface,
     };
