@@ -65,8 +65,9 @@ pub struct BenchCorpusArgs {
     pub peers: Option<PathBuf>,
     /// Take the rows of earlier scoreboards (their JSON) instead of fitting again: to add
     /// `--peers`, compare with another baseline, or refresh some rows of a scoreboard with a
-    /// later run (repeat the flag: a later file's row replaces an earlier one's). The entry
-    /// filters apply; the scoreboard lists where its rows came from.
+    /// later run (repeat the flag: a later file's row replaces an earlier one's, and keeps the
+    /// earlier row's peers, at the size they were run at, unless `--peers` judges them again).
+    /// The entry filters apply; the scoreboard lists where its rows came from.
     #[arg(long, value_name = "FILE.json")]
     pub rows: Vec<PathBuf>,
     /// Seconds one run may take before it is stopped (a row `timeout`).

@@ -75,7 +75,7 @@ pub fn run(a: BenchCorpusArgs) -> anyhow::Result<ExitCode> {
         });
         (rows, Vec::new(), None)
     } else {
-        let (rows, sources, seconds) = earlier_rows(&a.rows, &entries)?;
+        let (rows, sources, seconds) = earlier_rows(&a.rows, &entries, a.peers.is_none())?;
         (rows, sources, Some(seconds))
     };
     if let Some(p) = &a.peers {
@@ -130,12 +130,14 @@ fn runs_dir(out: &Path) -> PathBuf {
 }
 
 /// The rows of earlier scoreboards `paths` for `entries`, in the entries' order (a later
-/// file's row replaces an earlier one's), without their peers (those are judged again from
-/// `--peers`); one line per file saying which rows it gave; the wall seconds of the runs that
+/// file's row replaces an earlier one's), with their peers when `keep_peers` — a row without
+/// any taking an earlier file's for the same entry, each peer shown at the size it was run at —
+/// else without (they are judged again from `--peers`); one line per file saying which rows it gave; the wall seconds of the runs that
 /// gave rows, added. Errors: an unreadable file, or an entry none of them holds.
 fn earlier_rows(
     paths: &[PathBuf],
     entries: &[subfit_bench::Entry],
+    keep_peers: bool,
 ) -> anyhow::Result<(Vec<Row>, Vec<String>, f64)> {
     let boards = paths
         .iter()
@@ -153,7 +155,18 @@ fn earlier_rows(
                 .with_context(|| format!("no row for entry `{}` in --rows", e.name))?;
             given[k].push(e.name.clone());
             let mut row = row.clone();
-            row.peers.clear();
+            if !keep_peers {
+                row.peers.clear();
+            } else if row.peers.is_empty() {
+                // A row refreshed by a later run keeps the peers an earlier scoreboard judged.
+                if let Some(earlier) = boards[..k].iter().rev().find_map(|b| {
+                    b.rows
+                        .iter()
+                        .find(|r| r.entry == e.name && !r.peers.is_empty())
+                }) {
+                    row.peers = earlier.peers.clone();
+                }
+            }
             Ok(row)
         })
         .collect::<anyhow::Result<Vec<Row>>>()?;
