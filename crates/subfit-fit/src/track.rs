@@ -312,6 +312,7 @@ mod correspond;
 mod geodesic;
 mod model;
 mod options;
+mod start;
 mod system;
 
 pub use correspond::plane_rms_to;
@@ -320,6 +321,7 @@ use correspond::{matches, plane_rms};
 pub use model::{medial_points, DeformationGraph, NodeMotion};
 use model::{Skin, PER};
 pub use options::{Marker, TrackOptions};
+pub use start::{warm_start, Start, StartStats};
 use system::{add_markers, add_priors, FitRows, Normal};
 
 #[cfg(test)]

@@ -15,7 +15,8 @@ use std::sync::Arc;
 
 use serde::Serialize;
 use subfit_fit::track::{
-    plane_rms_to, track, DeformationGraph, Marker, NodeMotion, Samples, TrackOptions,
+    plane_rms_to, track, warm_start, DeformationGraph, Marker, NodeMotion, Samples, Start,
+    TrackOptions,
 };
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::{Normalization, Target};
@@ -134,6 +135,13 @@ pub struct TrackingReport {
     pub markers: usize,
     /// Their RMS distance to where the step put them (normalized units; 0 without markers).
     pub marker_rms: f64,
+    /// Whether the step started from a rigid alignment of the template onto the frame rather
+    /// than from the previous frames' motions or the rest ([`warm_start`]).
+    pub start_rigid: bool,
+    /// The start's symmetric truncated distance to the frame (normalized units).
+    pub start_distance: f64,
+    /// The nearest of the previous frames' motions and the rest, by the same measure.
+    pub given_distance: f64,
 }
 
 /// The step's state between frames: its graph (inside the template), the limit stencils of
@@ -222,21 +230,25 @@ impl Tracking {
             stop_rms: o.discrepancy * self.floor,
             ..o.step.clone()
         };
-        let initial = match (&self.motion, &self.before) {
-            (Some(last), Some(before)) if o.predict => Some(last.extrapolated(before)),
-            (last, _) => last.clone(),
+        let samples = Samples {
+            positions: &self.rest.0,
+            normals: &self.rest.1,
         };
+        let mut candidates = Vec::new();
+        if let (Some(last), Some(before), true) = (&self.motion, &self.before, o.predict) {
+            candidates.push(last.extrapolated(before));
+        }
+        candidates.extend(self.motion.clone());
+        candidates.push(NodeMotion::identity(self.graph.len()));
+        let (initial, start) = warm_start(&self.graph, samples, target, &candidates, &o.step);
         let markers = self.markers.get(&frame).map_or(&[][..], Vec::as_slice);
         let (moved, motion, stats) = track(
             &self.graph,
             &self.template,
-            Samples {
-                positions: &self.rest.0,
-                normals: &self.rest.1,
-            },
+            samples,
             target,
             markers,
-            initial.as_ref(),
+            Some(&initial),
             &step,
         );
         self.before = self.motion.replace(motion);
@@ -248,6 +260,9 @@ impl Tracking {
             stop_rms: step.stop_rms,
             markers: markers.len(),
             marker_rms: stats.marker_rms,
+            start_rigid: start.start == Start::Rigid,
+            start_distance: start.distance,
+            given_distance: start.given_distance,
         };
         (moved, report)
     }
