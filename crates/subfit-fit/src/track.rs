@@ -321,7 +321,7 @@ use correspond::{matches, plane_rms};
 pub use model::{medial_points, DeformationGraph, NodeMotion};
 use model::{Skin, PER};
 pub use options::{Marker, TrackOptions};
-pub use start::{warm_start, Start, StartStats};
+pub use start::{distance_to, warm_start, Start, StartStats};
 use system::{add_markers, add_priors, FitRows, Normal};
 
 #[cfg(test)]

@@ -15,8 +15,8 @@ use std::sync::Arc;
 
 use serde::Serialize;
 use subfit_fit::track::{
-    plane_rms_to, track, warm_start, DeformationGraph, Marker, NodeMotion, Samples, Start,
-    TrackOptions,
+    distance_to, plane_rms_to, track, warm_start, DeformationGraph, Marker, NodeMotion, Samples,
+    Start, TrackOptions,
 };
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::{Normalization, Target};
@@ -44,6 +44,11 @@ pub struct TrackingOptions {
     /// data's noise and tessellation), so a subject that holds still is not tracked into a
     /// slide ([`TrackOptions::stop_rms`]). 0 turns the rule off. Default 1.5.
     pub discrepancy: f64,
+    /// How far (a multiple of the least symmetric distance of a fitted cage to its own frame
+    /// so far, [`distance_to`]) the predicted start may lie from a frame before the step looks for a
+    /// nearer one among the previous frame's motion, the rest and rigid alignments
+    /// ([`warm_start`]); 0 always looks. Default 3.
+    pub restart: f64,
     /// Known places of markers over the frames (empty: none). Every marker must be seen in
     /// the first frame, which puts it on the template; in later frames it is used where it is
     /// seen. Observations of frames the sequence does not reach are ignored.
@@ -111,6 +116,7 @@ impl Default for TrackingOptions {
             predict: true,
             level: 1,
             discrepancy: 1.5,
+            restart: 3.0,
             markers: Vec::new(),
             step: TrackOptions::default(),
         }
@@ -156,6 +162,9 @@ pub(crate) struct Tracking {
     before: Option<NodeMotion>,
     /// The previous frame's point-to-plane RMS against its own frame ([`Self::settle`]).
     floor: f64,
+    /// The least symmetric distance of a fitted cage to its own frame so far ([`distance_to`]):
+    /// a frame fitted badly does not loosen the next one's test.
+    distance_floor: f64,
     /// The markers of each frame (normalized units), by frame.
     markers: BTreeMap<usize, Vec<Marker>>,
 }
@@ -207,6 +216,7 @@ impl Tracking {
             motion: None,
             before: None,
             floor: 0.0,
+            distance_floor: 0.0,
             markers,
         }
     }
@@ -216,6 +226,12 @@ impl Tracking {
     pub(crate) fn settle(&mut self, cage: &[[f64; 3]], target: &Target, o: &TrackingOptions) {
         let (samples, normals) = samples_of(&self.samples, cage);
         self.floor = plane_rms_to(&samples, &normals, target, o.step.max_distance).0;
+        let d = distance_to(&samples, target, &o.step);
+        self.distance_floor = if self.distance_floor > 0.0 {
+            self.distance_floor.min(d)
+        } else {
+            d
+        };
     }
 
     /// Carries the template onto `target` (frame `frame`, 0 the first, with its markers);
@@ -240,7 +256,8 @@ impl Tracking {
         }
         candidates.extend(self.motion.clone());
         candidates.push(NodeMotion::identity(self.graph.len()));
-        let (initial, start) = warm_start(&self.graph, samples, target, &candidates, &o.step);
+        let near = o.restart * self.distance_floor;
+        let (initial, start) = warm_start(&self.graph, samples, target, &candidates, near, &o.step);
         let markers = self.markers.get(&frame).map_or(&[][..], Vec::as_slice);
         let (moved, motion, stats) = track(
             &self.graph,
@@ -277,3 +294,4 @@ fn samples_of(stencils: &LimitStencils, cage: &[[f64; 3]]) -> (Vec<[f64; 3]>, Ve
     );
     (samples, normals)
 }
+

@@ -14,7 +14,9 @@
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rayon::prelude::*;
-use subfit_mesh::vec3::{dist2, dot};
+#[cfg(test)]
+use subfit_mesh::vec3::dist2;
+use subfit_mesh::vec3::dot;
 use subfit_target::neighbors::PointIndex;
 
 use subfit_target::Target;
@@ -114,14 +116,19 @@ fn principal_axes(p: &[[f64; 3]]) -> Matrix3<f64> {
 fn principal_starts(rest: &[[f64; 3]], data: &[[f64; 3]]) -> Vec<Rigid> {
     let (er, ed) = (principal_axes(rest), principal_axes(data));
     let (from, to) = (centroid(rest), centroid(data));
-    [[1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0, -1.0, -1.0]]
-        .iter()
-        .map(|s| Rigid {
-            rotation: ed * Matrix3::from_diagonal(&Vector3::new(s[0], s[1], s[2])) * er.transpose(),
-            from,
-            to,
-        })
-        .collect()
+    [
+        [1.0, 1.0, 1.0],
+        [-1.0, -1.0, 1.0],
+        [-1.0, 1.0, -1.0],
+        [1.0, -1.0, -1.0],
+    ]
+    .iter()
+    .map(|s| Rigid {
+        rotation: ed * Matrix3::from_diagonal(&Vector3::new(s[0], s[1], s[2])) * er.transpose(),
+        from,
+        to,
+    })
+    .collect()
 }
 
 /// Symmetric truncated distance between `a` and `b` (indexed by `ia`, `ib`):
@@ -227,7 +234,11 @@ pub(super) fn strided(n: usize, count: usize) -> Vec<usize> {
 #[cfg(test)]
 pub(super) fn farthest2(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
     b.iter()
-        .map(|y| a.iter().map(|x| dist2(*x, *y)).fold(f64::INFINITY, f64::min))
+        .map(|y| {
+            a.iter()
+                .map(|x| dist2(*x, *y))
+                .fold(f64::INFINITY, f64::min)
+        })
         .fold(0.0, f64::max)
 }
 
@@ -255,18 +266,24 @@ pub struct StartStats {
 /// Points of each side used to judge the starts and in the rigid ICP.
 const JUDGE_POINTS: usize = 1500;
 
-/// The start of a tracking step on `target`: of the `candidates` (motions of `graph`'s nodes,
-/// e.g. the previous frame's extrapolated and as it was) and rigid alignments of the rest
-/// `samples` onto the frame (trimmed ICP from the matched principal axes and from each
-/// candidate's rigid part), the one whose moved samples lie nearest the frame by the
+/// The start of a tracking step on `target`: the first of the `candidates` (motions of
+/// `graph`'s nodes, the preferred first: e.g. the previous frame's extrapolated, then as it
+/// was, then the rest) when its moved `samples` lie within `near` of the frame by the
 /// symmetric truncated distance ([`chamfer`], cap [`TrackOptions::reach_start`]: what the
-/// step's stiffest level does not reach counts alike however far). Candidates with another
-/// node count are skipped. Cost: O((#starts · ICP iterations) · P log P), P = 1,500.
+/// step's stiffest level does not reach counts alike however far); otherwise the nearest of
+/// the candidates and of rigid alignments of the rest samples onto the frame (trimmed ICP
+/// from the matched principal axes and from each candidate's rigid part). `near` is meant as
+/// a multiple of what the previous frame's fitted cage leaves on its own frame
+/// ([`distance_to`]): near the prediction, the prediction is kept (the distance cannot tell
+/// motions within the points' spacing apart). Candidates with another node count are
+/// skipped. Cost: O(P log P) for a kept start, O(#starts · ICP iterations · P log P)
+/// otherwise, P = 1,500.
 pub fn warm_start(
     graph: &DeformationGraph,
     samples: Samples<'_>,
     target: &Target,
     candidates: &[NodeMotion],
+    near: f64,
     options: &TrackOptions,
 ) -> (NodeMotion, StartStats) {
     let m = graph.len();
@@ -312,7 +329,17 @@ pub fn warm_start(
         given_distance = given_distance.min(d);
         if best.as_ref().is_none_or(|b| d < b.1.distance) {
             let start = Start::Given(i);
-            best = Some((c.clone(), StartStats { start, distance: d, given_distance }));
+            best = Some((
+                c.clone(),
+                StartStats {
+                    start,
+                    distance: d,
+                    given_distance,
+                },
+            ));
+        }
+        if best.as_ref().is_some_and(|b| b.1.distance <= near) {
+            return best.expect("set");
         }
     }
     let mut starts = principal_starts(&rest_points, &data.points);
@@ -338,10 +365,34 @@ pub fn warm_start(
         let d = judge(&motion);
         if best.as_ref().is_none_or(|b| d < b.1.distance) {
             let start = Start::Rigid;
-            best = Some((motion, StartStats { start, distance: d, given_distance }));
+            best = Some((
+                motion,
+                StartStats {
+                    start,
+                    distance: d,
+                    given_distance,
+                },
+            ));
         }
     }
     let (motion, mut stats) = best.unwrap_or_else(fallback);
     stats.given_distance = given_distance;
     (motion, stats)
+}
+
+/// The symmetric truncated distance ([`chamfer`], cap [`TrackOptions::reach_start`]) of
+/// `samples` (points of a surface, e.g. a fitted cage's limit samples) to `target`, on the
+/// point subsets [`warm_start`] judges with: what a start on a frame the cage already fits
+/// scores (the points' spacing and the fit's error), the scale of its `near`.
+pub fn distance_to(samples: &[[f64; 3]], target: &Target, options: &TrackOptions) -> f64 {
+    let data = backward::subsample(target, JUDGE_POINTS);
+    let pick: Vec<[f64; 3]> = strided(samples.len(), JUDGE_POINTS)
+        .into_iter()
+        .map(|i| samples[i])
+        .collect();
+    let cap = options.reach_start.max(options.max_distance);
+    match (PointIndex::new(&pick), PointIndex::new(&data.points)) {
+        (Some(ia), Some(ib)) => chamfer(&pick, &ia, &data.points, &ib, cap),
+        _ => f64::INFINITY,
+    }
 }
