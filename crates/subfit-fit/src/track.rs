@@ -177,7 +177,12 @@ pub fn track(
             .into_par_iter()
             .map(|i| skin.normal(i, normals[i], &motion))
             .collect();
-        let forward = matches(&moved, &moved_normals, target, level.reach);
+        let agree = if level.last {
+            correspond::AGREE
+        } else {
+            options.stiff_agreement
+        };
+        let forward = matches(&moved, &moved_normals, target, level.reach, agree);
         let rms = plane_rms(&moved, &forward);
         if it == 0 {
             stats.rms_before = rms;
@@ -198,7 +203,7 @@ pub fn track(
         // slide along the surface as no motion, and held the generated tube's spin back
         // (drift 3.2 % instead of 0.5 % of the diagonal on its first frame).
         let backward = if options.backward_weight > 0.0 && !level.last {
-            backward::matches(&moved, &moved_normals, &data, level.reach)
+            backward::matches(&moved, &moved_normals, &data, level.reach, agree)
         } else {
             Vec::new()
         };
@@ -321,7 +326,7 @@ use correspond::{matches, plane_rms};
 pub use model::{medial_points, DeformationGraph, NodeMotion};
 use model::{Skin, PER};
 pub use options::{Marker, TrackOptions};
-pub use start::{distance_to, warm_start, Start, StartStats};
+pub use start::{distance_to, motion_distance, warm_starts, Start, StartStats};
 use system::{add_markers, add_priors, FitRows, Normal};
 
 #[cfg(test)]

@@ -15,8 +15,8 @@ use std::sync::Arc;
 
 use serde::Serialize;
 use subfit_fit::track::{
-    distance_to, plane_rms_to, track, warm_start, DeformationGraph, Marker, NodeMotion, Samples,
-    Start, TrackOptions,
+    distance_to, motion_distance, plane_rms_to, track, warm_starts, DeformationGraph, Marker,
+    NodeMotion, Samples, Start, TrackOptions,
 };
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::{Normalization, Target};
@@ -47,8 +47,12 @@ pub struct TrackingOptions {
     /// How far (a multiple of the least symmetric distance of a fitted cage to its own frame
     /// so far, [`distance_to`]) the predicted start may lie from a frame before the step looks for a
     /// nearer one among the previous frame's motion, the rest and rigid alignments
-    /// ([`warm_start`]); 0 always looks. Default 3.
+    /// ([`warm_starts`]); 0 always looks. Default 3.
     pub restart: f64,
+    /// Starts tracked when the prediction is far (the rest of [`Self::restart`]): the
+    /// nearest distinct ones of [`warm_starts`], each carried onto the frame by the step, the
+    /// result nearest the frame kept ([`motion_distance`]). Default 3.
+    pub starts: usize,
     /// Known places of markers over the frames (empty: none). Every marker must be seen in
     /// the first frame, which puts it on the template; in later frames it is used where it is
     /// seen. Observations of frames the sequence does not reach are ignored.
@@ -117,6 +121,7 @@ impl Default for TrackingOptions {
             level: 1,
             discrepancy: 1.5,
             restart: 3.0,
+            starts: 3,
             markers: Vec::new(),
             step: TrackOptions::default(),
         }
@@ -142,7 +147,7 @@ pub struct TrackingReport {
     /// Their RMS distance to where the step put them (normalized units; 0 without markers).
     pub marker_rms: f64,
     /// Whether the step started from a rigid alignment of the template onto the frame rather
-    /// than from the previous frames' motions or the rest ([`warm_start`]).
+    /// than from the previous frames' motions or the rest ([`warm_starts`]).
     pub start_rigid: bool,
     /// The start's symmetric truncated distance to the frame (normalized units).
     pub start_distance: f64,
@@ -226,7 +231,7 @@ impl Tracking {
     pub(crate) fn settle(&mut self, cage: &[[f64; 3]], target: &Target, o: &TrackingOptions) {
         let (samples, normals) = samples_of(&self.samples, cage);
         self.floor = plane_rms_to(&samples, &normals, target, o.step.max_distance).0;
-        let d = distance_to(&samples, target, &o.step);
+        let d = distance_to(&samples, &normals, target, &o.step);
         self.distance_floor = if self.distance_floor > 0.0 {
             self.distance_floor.min(d)
         } else {
@@ -257,17 +262,41 @@ impl Tracking {
         candidates.extend(self.motion.clone());
         candidates.push(NodeMotion::identity(self.graph.len()));
         let near = o.restart * self.distance_floor;
-        let (initial, start) = warm_start(&self.graph, samples, target, &candidates, near, &o.step);
-        let markers = self.markers.get(&frame).map_or(&[][..], Vec::as_slice);
-        let (moved, motion, stats) = track(
+        let starts = warm_starts(
             &self.graph,
-            &self.template,
             samples,
             target,
-            markers,
-            Some(&initial),
-            &step,
+            &candidates,
+            near,
+            o.starts,
+            &o.step,
         );
+        let markers = self.markers.get(&frame).map_or(&[][..], Vec::as_slice);
+        // One start: the prediction was near. Several: each tracked, the nearest result kept.
+        let tracked: Vec<_> = starts
+            .iter()
+            .map(|(initial, start)| {
+                let (moved, motion, stats) = track(
+                    &self.graph,
+                    &self.template,
+                    samples,
+                    target,
+                    markers,
+                    Some(initial),
+                    &step,
+                );
+                let d = if starts.len() > 1 {
+                    motion_distance(&self.graph, samples, target, &motion, &o.step)
+                } else {
+                    0.0
+                };
+                (moved, motion, stats, *start, d)
+            })
+            .collect();
+        let (moved, motion, stats, start, _) = tracked
+            .into_iter()
+            .min_by(|a, b| a.4.total_cmp(&b.4))
+            .expect("at least one start");
         self.before = self.motion.replace(motion);
         let report = TrackingReport {
             matched: stats.matched,

@@ -1,4 +1,4 @@
-//! Where a tracking step starts ([`super::warm_start`]): the candidate motions a caller gives
+//! Where a tracking step starts ([`super::warm_starts`]): the candidate motions a caller gives
 //! (the previous frame's, extrapolated or not; the rest) and rigid alignments of the rest
 //! samples onto the frame, each judged by the symmetric truncated distance between the moved
 //! samples and the frame's points; the nearest is the start.
@@ -34,6 +34,11 @@ pub(super) struct Rigid {
 }
 
 impl Rigid {
+    fn turn(&self, n: [f64; 3]) -> [f64; 3] {
+        let y = self.rotation * v(n);
+        [y.x, y.y, y.z]
+    }
+
     fn apply(&self, x: [f64; 3]) -> [f64; 3] {
         let y = self.rotation * (v(x) - v(self.from)) + v(self.to);
         [y.x, y.y, y.z]
@@ -131,23 +136,56 @@ fn principal_starts(rest: &[[f64; 3]], data: &[[f64; 3]]) -> Vec<Rigid> {
     .collect()
 }
 
-/// Symmetric truncated distance between `a` and `b` (indexed by `ia`, `ib`):
-/// `sqrt(½ (mean_a min(d(a, B), cap)² + mean_b min(d(b, A), cap)²))`. A part of either that
-/// the other does not come near counts `cap`, whatever its distance. Cost O((|a| + |b|) log).
+/// Nearest points examined for one whose normal agrees (as [`backward`]'s matches).
+const CANDIDATES: usize = 4;
+
+/// Two symmetric truncated distances between point sets ([`chamfer`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Distances {
+    /// Nearest points, whatever their normals.
+    pub(super) plain: f64,
+    /// Nearest points whose normals agree.
+    pub(super) oriented: f64,
+}
+
+/// Symmetric truncated distances between `a` and `b` (indexed by `ia`, `ib`):
+/// `sqrt(½ (mean_a e(a, B)² + mean_b e(b, A)²))`, `e(x, Y)` the distance from `x` to its
+/// nearest point in `Y` (plain) or to the nearest of its [`CANDIDATES`] nearest whose normal
+/// is within 60° of its own (oriented), `cap` when that is farther or there is none. A part
+/// of either that the other does not come near counts `cap`, whatever its distance; the
+/// oriented distance counts a part that lies on the other facing the other way alike (a body
+/// turned upside down or end to end over a frame of similar extent), the plain one does not
+/// depend on the normals (thin parts whose sides lie within the candidates of each other).
+/// Cost O((|a| + |b|) log).
 pub(super) fn chamfer(
-    a: &[[f64; 3]],
+    a: &Oriented<'_>,
     ia: &PointIndex,
-    b: &[[f64; 3]],
+    b: &Oriented<'_>,
     ib: &PointIndex,
     cap: f64,
-) -> f64 {
-    let side = |p: &[[f64; 3]], index: &PointIndex| {
-        p.par_iter()
-            .map(|x| index.nearest(x).distance.min(cap).powi(2))
-            .sum::<f64>()
-            / p.len().max(1) as f64
+) -> Distances {
+    let side = |p: &Oriented<'_>, q: &Oriented<'_>, index: &PointIndex| {
+        let (plain, oriented) = (0..p.points.len())
+            .into_par_iter()
+            .map(|i| {
+                let near = index.k_nearest(&p.points[i], CANDIDATES);
+                let plain = near.first().map_or(cap, |c| c.distance.min(cap));
+                let oriented = near
+                    .into_iter()
+                    .take_while(|c| c.distance < cap)
+                    .find(|c| dot(p.normals[i], q.normals[c.index as usize]) >= 0.5)
+                    .map_or(cap, |c| c.distance);
+                (plain * plain, oriented * oriented)
+            })
+            .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
+        let n = p.points.len().max(1) as f64;
+        (plain / n, oriented / n)
     };
-    (0.5 * (side(a, ib) + side(b, ia))).sqrt()
+    let (x, y) = (side(a, b, ib), side(b, a, ia));
+    Distances {
+        plain: (0.5 * (x.0 + y.0)).sqrt(),
+        oriented: (0.5 * (x.1 + y.1)).sqrt(),
+    }
 }
 
 /// Iterations of the rigid ICP at most.
@@ -170,10 +208,7 @@ pub(super) fn icp(
         let Some(moved_index) = PointIndex::new(&moved) else {
             break;
         };
-        let turn = |n: [f64; 3]| {
-            let y = t.rotation * v(n);
-            [y.x, y.y, y.z]
-        };
+        let turn = |n: [f64; 3]| t.turn(n);
         let (mut p, mut q) = (Vec::new(), Vec::new());
         let mut sum = 0.0;
         for (i, &x) in moved.iter().enumerate() {
@@ -205,8 +240,13 @@ pub(super) fn icp(
         last = mean;
     }
     let moved: Vec<[f64; 3]> = rest.points.iter().map(|&x| t.apply(x)).collect();
-    let score = PointIndex::new(&moved).map_or(f64::INFINITY, |ix| {
-        chamfer(&moved, &ix, data.points, data_index, reach)
+    let turned: Vec<[f64; 3]> = rest.normals.iter().map(|&n| t.turn(n)).collect();
+    let moved = Oriented {
+        points: &moved,
+        normals: &turned,
+    };
+    let score = PointIndex::new(moved.points).map_or(f64::INFINITY, |ix| {
+        chamfer(&moved, &ix, data, data_index, reach).oriented
     });
     (t, score)
 }
@@ -230,19 +270,7 @@ pub(super) fn strided(n: usize, count: usize) -> Vec<usize> {
     (0..n).step_by(n.div_ceil(count.max(1)).max(1)).collect()
 }
 
-/// The largest squared distance of `b` to its nearest of `a`, for tests.
-#[cfg(test)]
-pub(super) fn farthest2(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    b.iter()
-        .map(|y| {
-            a.iter()
-                .map(|x| dist2(*x, *y))
-                .fold(f64::INFINITY, f64::min)
-        })
-        .fold(0.0, f64::max)
-}
-
-/// Where [`warm_start`] started a step.
+/// Where [`warm_starts`] started a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Start {
     /// The candidate of this index among those given.
@@ -251,7 +279,7 @@ pub enum Start {
     Rigid,
 }
 
-/// What [`warm_start`] chose and why.
+/// What [`warm_starts`] chose and why.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StartStats {
     /// The start chosen.
@@ -266,33 +294,123 @@ pub struct StartStats {
 /// Points of each side used to judge the starts and in the rigid ICP.
 const JUDGE_POINTS: usize = 1500;
 
-/// The start of a tracking step on `target`: the first of the `candidates` (motions of
-/// `graph`'s nodes, the preferred first: e.g. the previous frame's extrapolated, then as it
-/// was, then the rest) when its moved `samples` lie within `near` of the frame by the
-/// symmetric truncated distance ([`chamfer`], cap [`TrackOptions::reach_start`]: what the
-/// step's stiffest level does not reach counts alike however far); otherwise the nearest of
-/// the candidates and of rigid alignments of the rest samples onto the frame (trimmed ICP
-/// from the matched principal axes and from each candidate's rigid part). `near` is meant as
-/// a multiple of what the previous frame's fitted cage leaves on its own frame
-/// ([`distance_to`]): near the prediction, the prediction is kept (the distance cannot tell
-/// motions within the points' spacing apart). Candidates with another node count are
-/// skipped. Cost: O(P log P) for a kept start, O(#starts · ICP iterations · P log P)
-/// otherwise, P = 1,500.
-pub fn warm_start(
+/// The frame's points and the rest samples a start is judged on ([`chamfer`], cap
+/// [`TrackOptions::reach_start`]: what the step's stiffest level does not reach counts alike
+/// however far).
+struct Judge<'a> {
+    graph: &'a DeformationGraph,
+    data: backward::DataPoints,
+    index: PointIndex,
+    rest_points: Vec<[f64; 3]>,
+    rest_normals: Vec<[f64; 3]>,
+    skin: Skin,
+    cap: f64,
+}
+
+impl<'a> Judge<'a> {
+    fn new(
+        graph: &'a DeformationGraph,
+        samples: Samples<'_>,
+        target: &Target,
+        options: &TrackOptions,
+    ) -> Option<Self> {
+        let data = backward::subsample(target, JUDGE_POINTS);
+        let pick = strided(samples.positions.len(), JUDGE_POINTS);
+        if graph.is_empty() || pick.is_empty() {
+            return None;
+        }
+        let rest_points: Vec<[f64; 3]> = pick.iter().map(|&i| samples.positions[i]).collect();
+        let rest_normals = pick.iter().map(|&i| samples.normals[i]).collect();
+        let skin = graph.skin_of(&rest_points, options.skin);
+        Some(Self {
+            graph,
+            index: PointIndex::new(&data.points)?,
+            data,
+            rest_points,
+            rest_normals,
+            skin,
+            cap: options.reach_start.max(options.max_distance),
+        })
+    }
+
+    fn distances(&self, motion: &NodeMotion) -> Distances {
+        let n = self.rest_points.len();
+        let g = &self.graph.positions;
+        let points: Vec<[f64; 3]> = (0..n)
+            .into_par_iter()
+            .map(|i| self.skin.apply(i, self.rest_points[i], g, motion))
+            .collect();
+        let normals: Vec<[f64; 3]> = (0..n)
+            .into_par_iter()
+            .map(|i| self.skin.normal(i, self.rest_normals[i], motion))
+            .collect();
+        let moved = Oriented {
+            points: &points,
+            normals: &normals,
+        };
+        let frame = Oriented {
+            points: &self.data.points,
+            normals: &self.data.normals,
+        };
+        PointIndex::new(&points).map_or(
+            Distances {
+                plain: f64::INFINITY,
+                oriented: f64::INFINITY,
+            },
+            |ix| chamfer(&moved, &ix, &frame, &self.index, self.cap),
+        )
+    }
+
+    /// Rigid alignments of the rest samples onto the frame by trimmed ICP from `starts`.
+    fn aligned(&self, starts: Vec<Rigid>) -> Vec<Rigid> {
+        let rest = Oriented {
+            points: &self.rest_points,
+            normals: &self.rest_normals,
+        };
+        let frame = Oriented {
+            points: &self.data.points,
+            normals: &self.data.normals,
+        };
+        starts
+            .into_par_iter()
+            .map(|s| icp(&rest, &frame, &self.index, s, self.cap).0)
+            .collect()
+    }
+}
+
+/// Two starts whose rigid parts turn less than this apart (radians, 30°) are one start.
+const DISTINCT: f64 = std::f64::consts::PI / 6.0;
+
+/// The starts of a tracking step on `target`, nearest first, at most `count`: the first of
+/// the `candidates` (motions of `graph`'s nodes, the preferred first: e.g. the previous
+/// frame's extrapolated, then as it was, then the rest) alone when its moved `samples` lie
+/// within `near` of the frame by the plain symmetric truncated distance ([`chamfer`]);
+/// otherwise the candidates and rigid alignments of the rest samples onto the frame (trimmed
+/// ICP from the matched principal axes and from each candidate's rigid part), ordered by the
+/// oriented distance, one of each group whose rigid parts turn less than 30° apart. `near` is
+/// meant as a multiple of what a fitted cage leaves on its own frame ([`distance_to`]): near
+/// the prediction, the prediction is kept (the distance cannot tell motions within the
+/// points' spacing apart). Far from it, the distances before the step cannot tell a pose from
+/// one turned end to end when limbs moved as far as the body's width (seq-lion), so the
+/// caller tracks from several ([`motion_distance`] judges the results). Candidates with
+/// another node count are skipped. Cost: O(P log P) for a kept start,
+/// O(#starts · ICP iterations · P log P) otherwise, P = 1,500.
+pub fn warm_starts(
     graph: &DeformationGraph,
     samples: Samples<'_>,
     target: &Target,
     candidates: &[NodeMotion],
     near: f64,
+    count: usize,
     options: &TrackOptions,
-) -> (NodeMotion, StartStats) {
+) -> Vec<(NodeMotion, StartStats)> {
     let m = graph.len();
     let given: Vec<(usize, &NodeMotion)> = candidates
         .iter()
         .enumerate()
         .filter(|(_, c)| c.linear.len() == m)
         .collect();
-    let fallback = || {
+    let Some(judge) = Judge::new(graph, samples, target, options) else {
         let (i, c) = given
             .first()
             .map_or((0, NodeMotion::identity(m)), |(i, c)| (*i, (*c).clone()));
@@ -301,98 +419,111 @@ pub fn warm_start(
             distance: f64::INFINITY,
             given_distance: f64::INFINITY,
         };
-        (c, stats)
+        return vec![(c, stats)];
     };
-    let data = backward::subsample(target, JUDGE_POINTS);
-    let pick = strided(samples.positions.len(), JUDGE_POINTS);
-    let rest_points: Vec<[f64; 3]> = pick.iter().map(|&i| samples.positions[i]).collect();
-    let rest_normals: Vec<[f64; 3]> = pick.iter().map(|&i| samples.normals[i]).collect();
-    let (Some(data_index), false) = (PointIndex::new(&data.points), m == 0 || pick.is_empty())
-    else {
-        return fallback();
-    };
-    let cap = options.reach_start.max(options.max_distance);
-    let skin = graph.skin_of(&rest_points, options.skin);
-    let judge = |motion: &NodeMotion| {
-        let moved: Vec<[f64; 3]> = (0..rest_points.len())
-            .into_par_iter()
-            .map(|i| skin.apply(i, rest_points[i], &graph.positions, motion))
-            .collect();
-        PointIndex::new(&moved).map_or(f64::INFINITY, |ix| {
-            chamfer(&moved, &ix, &data.points, &data_index, cap)
-        })
-    };
-    let mut best: Option<(NodeMotion, StartStats)> = None;
-    let mut given_distance = f64::INFINITY;
+    let mut all: Vec<(NodeMotion, Start, f64)> = Vec::new();
     for &(i, c) in &given {
-        let d = judge(c);
-        given_distance = given_distance.min(d);
-        if best.as_ref().is_none_or(|b| d < b.1.distance) {
-            let start = Start::Given(i);
-            best = Some((
-                c.clone(),
-                StartStats {
-                    start,
-                    distance: d,
-                    given_distance,
-                },
-            ));
+        let d = judge.distances(c);
+        if d.plain <= near {
+            let stats = StartStats {
+                start: Start::Given(i),
+                distance: d.oriented,
+                given_distance: d.oriented,
+            };
+            return vec![(c.clone(), stats)];
         }
-        if best.as_ref().is_some_and(|b| b.1.distance <= near) {
-            return best.expect("set");
-        }
+        all.push((c.clone(), Start::Given(i), d.oriented));
     }
-    let mut starts = principal_starts(&rest_points, &data.points);
+    let given_distance = all.iter().map(|x| x.2).fold(f64::INFINITY, f64::min);
+    let mut starts = principal_starts(&judge.rest_points, &judge.data.points);
     starts.extend(
         given
             .iter()
-            .filter_map(|(_, c)| rigid_part(graph, &skin, &rest_points, c)),
+            .filter_map(|(_, c)| rigid_part(graph, &judge.skin, &judge.rest_points, c)),
     );
-    let rest = Oriented {
-        points: &rest_points,
-        normals: &rest_normals,
-    };
-    let frame = Oriented {
-        points: &data.points,
-        normals: &data.normals,
-    };
-    let aligned: Vec<Rigid> = starts
-        .into_par_iter()
-        .map(|s| icp(&rest, &frame, &data_index, s, cap).0)
-        .collect();
-    for r in aligned {
+    for r in judge.aligned(starts) {
         let motion = r.motion(&graph.positions);
-        let d = judge(&motion);
-        if best.as_ref().is_none_or(|b| d < b.1.distance) {
-            let start = Start::Rigid;
-            best = Some((
-                motion,
-                StartStats {
-                    start,
-                    distance: d,
-                    given_distance,
-                },
-            ));
+        let d = judge.distances(&motion).oriented;
+        all.push((motion, Start::Rigid, d));
+    }
+    all.sort_by(|a, b| a.2.total_cmp(&b.2));
+    let mut kept: Vec<(NodeMotion, StartStats, Option<Rigid>)> = Vec::new();
+    for (motion, start, distance) in all {
+        if kept.len() >= count.max(1) {
+            break;
+        }
+        let r = rigid_part(graph, &judge.skin, &judge.rest_points, &motion);
+        let apart = |k: &Option<Rigid>| match (k, &r) {
+            (Some(a), Some(b)) => turn_between(a, b) >= DISTINCT,
+            _ => true,
+        };
+        if kept.iter().all(|k| apart(&k.2)) {
+            let stats = StartStats {
+                start,
+                distance,
+                given_distance,
+            };
+            kept.push((motion, stats, r));
         }
     }
-    let (motion, mut stats) = best.unwrap_or_else(fallback);
-    stats.given_distance = given_distance;
-    (motion, stats)
+    kept.into_iter().map(|(m, s, _)| (m, s)).collect()
 }
 
-/// The symmetric truncated distance ([`chamfer`], cap [`TrackOptions::reach_start`]) of
-/// `samples` (points of a surface, e.g. a fitted cage's limit samples) to `target`, on the
-/// point subsets [`warm_start`] judges with: what a start on a frame the cage already fits
-/// scores (the points' spacing and the fit's error), the scale of its `near`.
-pub fn distance_to(samples: &[[f64; 3]], target: &Target, options: &TrackOptions) -> f64 {
+/// The angle (radians) of the turn between two rigid motions' rotations.
+fn turn_between(a: &Rigid, b: &Rigid) -> f64 {
+    let d = a.rotation * b.rotation.transpose();
+    (0.5 * (d.trace() - 1.0)).clamp(-1.0, 1.0).acos()
+}
+
+/// The oriented symmetric truncated distance ([`chamfer`], cap [`TrackOptions::reach_start`])
+/// of the rest `samples` moved by `motion` to `target`, on the points [`warm_starts`] judges
+/// with: how the results of steps from several starts are compared. Cost O(P log P), P =
+/// 1,500.
+pub fn motion_distance(
+    graph: &DeformationGraph,
+    samples: Samples<'_>,
+    target: &Target,
+    motion: &NodeMotion,
+    options: &TrackOptions,
+) -> f64 {
+    Judge::new(graph, samples, target, options)
+        .filter(|_| motion.linear.len() == graph.len())
+        .map_or(f64::INFINITY, |j| j.distances(motion).oriented)
+}
+
+/// The plain symmetric truncated distance ([`chamfer`], cap [`TrackOptions::reach_start`]) of
+/// `samples` (points of a surface with their unit `normals`, e.g. a fitted cage's limit
+/// samples) to `target`, on the point subsets [`warm_starts`] judges with: what a start on a
+/// frame the cage already fits scores (the points' spacing and the fit's error), the scale of
+/// its `near`.
+///
+/// # Panics
+/// If `samples` and `normals` differ in length.
+#[track_caller]
+pub fn distance_to(
+    samples: &[[f64; 3]],
+    normals: &[[f64; 3]],
+    target: &Target,
+    options: &TrackOptions,
+) -> f64 {
+    assert_eq!(samples.len(), normals.len(), "one normal per sample");
     let data = backward::subsample(target, JUDGE_POINTS);
-    let pick: Vec<[f64; 3]> = strided(samples.len(), JUDGE_POINTS)
-        .into_iter()
-        .map(|i| samples[i])
-        .collect();
+    let pick = strided(samples.len(), JUDGE_POINTS);
+    let points: Vec<[f64; 3]> = pick.iter().map(|&i| samples[i]).collect();
+    let normals: Vec<[f64; 3]> = pick.iter().map(|&i| normals[i]).collect();
     let cap = options.reach_start.max(options.max_distance);
-    match (PointIndex::new(&pick), PointIndex::new(&data.points)) {
-        (Some(ia), Some(ib)) => chamfer(&pick, &ia, &data.points, &ib, cap),
+    let (a, b) = (
+        Oriented {
+            points: &points,
+            normals: &normals,
+        },
+        Oriented {
+            points: &data.points,
+            normals: &data.normals,
+        },
+    );
+    match (PointIndex::new(a.points), PointIndex::new(b.points)) {
+        (Some(ia), Some(ib)) => chamfer(&a, &ia, &b, &ib, cap).plain,
         _ => f64::INFINITY,
     }
 }
