@@ -70,7 +70,6 @@ pub(super) fn matches(
     moved_normals: &[[f64; 3]],
     data: &DataPoints,
     reach: f64,
-    agree: f64,
 ) -> Vec<(usize, [f64; 3], [f64; 3])> {
     let Some(index) = PointIndex::new(moved) else {
         return Vec::new();
@@ -83,7 +82,7 @@ pub(super) fn matches(
                 .k_nearest(&y, CANDIDATES)
                 .into_iter()
                 .take_while(|c| c.distance <= reach)
-                .find(|c| dot(moved_normals[c.index as usize], n) >= agree)
+                .find(|c| dot(moved_normals[c.index as usize], n) >= 0.5)
                 .map(|c| (c.index as usize, y, n))
         })
         .collect()
@@ -197,7 +196,7 @@ mod tests {
             points: vec![[0.0, 0.0, 0.011], [5.0, 0.0, 0.0]],
             normals: vec![[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]],
         };
-        let m = matches(&moved, &normals, &data, 0.5, 0.5);
+        let m = matches(&moved, &normals, &data, 0.5);
         assert_eq!(m.len(), 1, "the far point is out of reach");
         assert_eq!(m[0].0, 1);
         assert!((residual(moved[1], m[0]) - 0.009).abs() < 1e-12);

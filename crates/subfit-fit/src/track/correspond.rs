@@ -21,23 +21,18 @@ pub fn plane_rms_to(
     max_distance: f64,
 ) -> (f64, usize) {
     assert_eq!(samples.len(), normals.len(), "one normal per sample");
-    let m = matches(samples, normals, target, max_distance, AGREE);
+    let m = matches(samples, normals, target, max_distance);
     (plane_rms(samples, &m), m.len())
 }
 
-/// The cosine of the largest angle between a sample's normal and its foot point's at which
-/// the pair is kept (60°, Li et al. §4).
-pub(super) const AGREE: f64 = 0.5;
-
 /// The samples with a usable foot point on `target`: (sample, foot point, target normal).
-/// Pruned as in Li et al. §4: foot points farther than `max_distance`, or whose normal's
-/// cosine with the sample's is below `agree` ([`AGREE`] unless a stiff level relaxes it).
+/// Pruned as in Li et al. §4: foot points farther than `max_distance`, or whose normal is
+/// more than 60° from the sample's.
 pub(super) fn matches(
     samples: &[[f64; 3]],
     normals: &[[f64; 3]],
     target: &Target,
     max_distance: f64,
-    agree: f64,
 ) -> Vec<(usize, [f64; 3], [f64; 3])> {
     let feet = foot_points(target, samples);
     (0..samples.len())
@@ -47,7 +42,7 @@ pub(super) fn matches(
             if !f.distance.is_finite() || f.distance.abs() > max_distance {
                 return None;
             }
-            (dot3(normals[i], f.normal) >= agree).then_some((i, f.point, f.normal))
+            (dot3(normals[i], f.normal) >= 0.5).then_some((i, f.point, f.normal))
         })
         .collect()
 }

@@ -66,10 +66,6 @@ pub struct TrackOptions {
     /// two-sided RMS 0.148 % instead of 0.162 %; on the dance of the module docs drift RMS
     /// 0.72 %, p95 1.50 % instead of 0.73 % and 1.56 % (scale 2: the cat 1.81 % / 3.83 %).
     pub robust: f64,
-    /// The cosine of the largest angle between the normals of a pair (a sample and its foot
-    /// point, a frame point and its sample) kept in the stiff levels of the annealing; the
-    /// last level keeps pairs within 60° (0.5, Li et al. 2009 §4). Default 0.5.
-    pub stiff_agreement: f64,
 }
 
 impl Default for TrackOptions {
@@ -90,7 +86,6 @@ impl Default for TrackOptions {
             level_iterations: 4,
             reach_start: 0.3,
             robust: 1.0,
-            stiff_agreement: 0.5,
         }
     }
 }

@@ -1,7 +1,9 @@
 //! Where a tracking step starts ([`super::warm_starts`]): the candidate motions a caller gives
 //! (the previous frame's, extrapolated or not; the rest) and rigid alignments of the rest
 //! samples onto the frame, each judged by the symmetric truncated distance between the moved
-//! samples and the frame's points; the nearest is the start.
+//! samples and the frame's points (with normals: a point whose nearby points face the other
+//! way counts as unmatched); the predicted start alone when it is near, the nearest few
+//! otherwise (the caller tracks from each and keeps the result nearest the frame).
 //!
 //! **Rigid alignments.** Trimmed symmetric ICP (Besl & McKay, "A method for registration of
 //! 3-D shapes", PAMI 1992; the pairs' best rotation by Kabsch's SVD, Arun, Huang & Blostein,
@@ -14,16 +16,14 @@
 
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rayon::prelude::*;
-#[cfg(test)]
-use subfit_mesh::vec3::dist2;
 use subfit_mesh::vec3::dot;
 use subfit_target::neighbors::PointIndex;
 
 use subfit_target::Target;
 
 use super::backward;
-use super::model::{v, DeformationGraph, NodeMotion, Skin};
-use super::{Samples, TrackOptions};
+use super::model::{v, DeformationGraph, NodeMotion, Samples, Skin};
+use super::options::TrackOptions;
 
 /// A rigid motion `x ↦ R (x − from) + to`.
 #[derive(Clone, Copy, Debug, PartialEq)]
