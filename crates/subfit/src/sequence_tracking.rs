@@ -330,4 +330,3 @@ fn samples_of(stencils: &LimitStencils, cage: &[[f64; 3]]) -> (Vec<[f64; 3]>, Ve
     );
     (samples, normals)
 }
-

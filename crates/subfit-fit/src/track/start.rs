@@ -385,9 +385,10 @@ const DISTINCT: f64 = std::f64::consts::PI / 6.0;
 /// the `candidates` (motions of `graph`'s nodes, the preferred first: e.g. the previous
 /// frame's extrapolated, then as it was, then the rest) alone when its moved `samples` lie
 /// within `near` of the frame by the plain symmetric truncated distance ([`chamfer`]);
-/// otherwise the candidates and rigid alignments of the rest samples onto the frame (trimmed
-/// ICP from the matched principal axes and from each candidate's rigid part), ordered by the
-/// oriented distance, one of each group whose rigid parts turn less than 30° apart. `near` is
+/// otherwise the first candidate and the nearest of the others and of rigid alignments of the
+/// rest samples onto the frame (trimmed ICP from the matched principal axes and from each
+/// candidate's rigid part) by the oriented distance, one of each group whose rigid parts turn
+/// less than 30° apart. `near` is
 /// meant as a multiple of what a fitted cage leaves on its own frame ([`distance_to`]): near
 /// the prediction, the prediction is kept (the distance cannot tell motions within the
 /// points' spacing apart). Far from it, the distances before the step cannot tell a pose from
@@ -448,6 +449,19 @@ pub fn warm_starts(
     }
     all.sort_by(|a, b| a.2.total_cmp(&b.2));
     let mut kept: Vec<(NodeMotion, StartStats, Option<Rigid>)> = Vec::new();
+    // The prediction is always tracked (its distance before the step says little when limbs
+    // moved far); the others are kept apart from each other only.
+    if let Some(first) = given.first().map(|g| Start::Given(g.0)) {
+        if let Some(k) = all.iter().position(|x| x.1 == first) {
+            let (motion, start, distance) = all.remove(k);
+            let stats = StartStats {
+                start,
+                distance,
+                given_distance,
+            };
+            kept.push((motion, stats, None));
+        }
+    }
     for (motion, start, distance) in all {
         if kept.len() >= count.max(1) {
             break;
