@@ -23,6 +23,27 @@
 //! diagonal, drift 3–6 % RMS); laid over the surface with both directions and the annealing
 //! every frame is within 0.036 % two-sided, drift RMS ≤ 0.80 % and 95th percentile ≤ 1.65 %.
 //!
+//! **Where a step starts** ([`warm_starts`]): the prediction (the previous frames' motion
+//! extrapolated) while it lies near the frame — within [`distance_to`]'s scale of what a fitted
+//! cage leaves on its own frame —, otherwise several starts: the previous motion, the rest, and
+//! rigid alignments (trimmed ICP from the matched principal axes), judged by a symmetric
+//! truncated distance that counts points facing the other way as unmatched; the caller tracks
+//! from each and keeps the result nearest the frame ([`motion_distance`]). On the corpus's
+//! seq-lion (10 unrelated poses of one lion, up to 124° apart and 7–25 % of the diagonal
+//! apart after rigid alignment) the step started from the extrapolated previous motion and
+//! its stiff levels did not turn out of it: 5 of 9 fitted frames ended turned 141–179° from
+//! the frame's true rotation and 2 about 100°, worst frame two-sided RMS 2.05 % / Hausdorff 9.73 % of the
+//! diagonal (`subfit bench corpus --category seq`). Starting from the nearest start by distance
+//! alone: 1.39 % / 8.86 %, still 6 of 9 turned end to end or upside down (the limbs moved as
+//! far as the body's width, so a pose turned over scores as near before the step); with
+//! normals in the distance and three starts tracked: 1.12 % / 6.79 %, 7 of 9 within 14° (one
+//! frame still turned over, one 31° off), drift of the worst frame 45.8 % RMS / 61.4 % p95
+//! (40.8 % / 81.3 % before); with the prediction always among the three tracked: the same
+//! worst frame, no frame turned over (the worst 56° off), drift 20.3 % / 38.8 %. The dance below and the corpus's cat keep the
+//! prediction on every frame but the first: their figures are unchanged. Three starts or five,
+//! 12 candidates instead of 4 in the oriented distance, or laxer normal agreement in the stiff
+//! levels (90°, none) did no better on seq-lion.
+//!
 //! **Model.** `m` nodes with rest positions `g_k` ([`DeformationGraph`]), each with an affine
 //! map `A_k` and a translation `t_k`; a point `x` of the rest shape moves to
 //! `x' = Σ_k w_k(x) (A_k (x − g_k) + g_k + t_k)` over its `s` nearest nodes,
@@ -116,15 +137,6 @@ pub struct TrackStats {
 /// A step of the last stiffness level that lowers the point-to-plane RMS by less than this
 /// fraction ends the step (it has converged; the fit that follows refines the rest).
 const STALL: f64 = 0.01;
-
-/// Points of the rest surface that [`track`] brings onto the frame, with their unit normals.
-#[derive(Clone, Copy, Debug)]
-pub struct Samples<'a> {
-    /// Positions in the graph's rest configuration.
-    pub positions: &'a [[f64; 3]],
-    /// Unit outward normals, one per position.
-    pub normals: &'a [[f64; 3]],
-}
 
 /// Moves `cage` (control points in the graph's rest configuration, normalized units: in a
 /// sequence the template's) onto `target` (the frame): an embedded deformation of the graph's
@@ -312,14 +324,16 @@ mod correspond;
 mod geodesic;
 mod model;
 mod options;
+mod start;
 mod system;
 
 pub use correspond::plane_rms_to;
 use correspond::{matches, plane_rms};
 
-pub use model::{medial_points, DeformationGraph, NodeMotion};
+pub use model::{medial_points, DeformationGraph, NodeMotion, Samples};
 use model::{Skin, PER};
 pub use options::{Marker, TrackOptions};
+pub use start::{distance_to, motion_distance, warm_starts, Start, StartStats};
 use system::{add_markers, add_priors, FitRows, Normal};
 
 #[cfg(test)]

@@ -9,13 +9,21 @@
 //! [`TrackingOptions::markers`] pulls them there point to point ([`subfit_fit::track::Marker`]):
 //! on frame 8 of the default motion 12 markers take the largest drift of the tracking step
 //! from 2.3 % to 1.3 %, 32 to 0.7 %.
+//!
+//! **Starts.** Each frame starts from the previous frames' motion extrapolated while that
+//! lies within [`TrackingOptions::restart`] times the least distance of a fitted cage to its
+//! own frame; a frame farther than that (poses that are not a capture's steps) is tracked from
+//! the [`TrackingOptions::starts`] nearest of the previous motion, the rest and rigid
+//! alignments, and the result nearest the frame kept ([`subfit_fit::track::warm_starts`];
+//! figures in [`subfit_fit::track`]'s module docs).
 
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
 use serde::Serialize;
 use subfit_fit::track::{
-    plane_rms_to, track, DeformationGraph, Marker, NodeMotion, Samples, TrackOptions,
+    distance_to, motion_distance, plane_rms_to, track, warm_starts, DeformationGraph, Marker,
+    NodeMotion, Samples, Start, TrackOptions,
 };
 use subfit_subdiv::{normals_from_tangents, SamplingOperator};
 use subfit_target::{Normalization, Target};
@@ -43,6 +51,15 @@ pub struct TrackingOptions {
     /// data's noise and tessellation), so a subject that holds still is not tracked into a
     /// slide ([`TrackOptions::stop_rms`]). 0 turns the rule off. Default 1.5.
     pub discrepancy: f64,
+    /// How far (a multiple of the least symmetric distance of a fitted cage to its own frame
+    /// so far, [`distance_to`]) the predicted start may lie from a frame before the step looks for a
+    /// nearer one among the previous frame's motion, the rest and rigid alignments
+    /// ([`warm_starts`]); 0 always looks. Default 3.
+    pub restart: f64,
+    /// Starts tracked when the prediction is far (the rest of [`Self::restart`]): the
+    /// nearest distinct ones of [`warm_starts`], each carried onto the frame by the step, the
+    /// result nearest the frame kept ([`motion_distance`]). Default 3.
+    pub starts: usize,
     /// Known places of markers over the frames (empty: none). Every marker must be seen in
     /// the first frame, which puts it on the template; in later frames it is used where it is
     /// seen. Observations of frames the sequence does not reach are ignored.
@@ -110,6 +127,8 @@ impl Default for TrackingOptions {
             predict: true,
             level: 1,
             discrepancy: 1.5,
+            restart: 3.0,
+            starts: 3,
             markers: Vec::new(),
             step: TrackOptions::default(),
         }
@@ -134,6 +153,13 @@ pub struct TrackingReport {
     pub markers: usize,
     /// Their RMS distance to where the step put them (normalized units; 0 without markers).
     pub marker_rms: f64,
+    /// Whether the step started from a rigid alignment of the template onto the frame rather
+    /// than from the previous frames' motions or the rest ([`warm_starts`]).
+    pub start_rigid: bool,
+    /// The start's symmetric truncated distance to the frame (normalized units).
+    pub start_distance: f64,
+    /// The nearest of the previous frames' motions and the rest, by the same measure.
+    pub given_distance: f64,
 }
 
 /// The step's state between frames: its graph (inside the template), the limit stencils of
@@ -148,6 +174,9 @@ pub(crate) struct Tracking {
     before: Option<NodeMotion>,
     /// The previous frame's point-to-plane RMS against its own frame ([`Self::settle`]).
     floor: f64,
+    /// The least symmetric distance of a fitted cage to its own frame so far ([`distance_to`]):
+    /// a frame fitted badly does not loosen the next one's test.
+    distance_floor: f64,
     /// The markers of each frame (normalized units), by frame.
     markers: BTreeMap<usize, Vec<Marker>>,
 }
@@ -199,6 +228,7 @@ impl Tracking {
             motion: None,
             before: None,
             floor: 0.0,
+            distance_floor: 0.0,
             markers,
         }
     }
@@ -208,6 +238,12 @@ impl Tracking {
     pub(crate) fn settle(&mut self, cage: &[[f64; 3]], target: &Target, o: &TrackingOptions) {
         let (samples, normals) = samples_of(&self.samples, cage);
         self.floor = plane_rms_to(&samples, &normals, target, o.step.max_distance).0;
+        let d = distance_to(&samples, &normals, target, &o.step);
+        self.distance_floor = if self.distance_floor > 0.0 {
+            self.distance_floor.min(d)
+        } else {
+            d
+        };
     }
 
     /// Carries the template onto `target` (frame `frame`, 0 the first, with its markers);
@@ -222,23 +258,52 @@ impl Tracking {
             stop_rms: o.discrepancy * self.floor,
             ..o.step.clone()
         };
-        let initial = match (&self.motion, &self.before) {
-            (Some(last), Some(before)) if o.predict => Some(last.extrapolated(before)),
-            (last, _) => last.clone(),
+        let samples = Samples {
+            positions: &self.rest.0,
+            normals: &self.rest.1,
         };
-        let markers = self.markers.get(&frame).map_or(&[][..], Vec::as_slice);
-        let (moved, motion, stats) = track(
+        let mut candidates = Vec::new();
+        if let (Some(last), Some(before), true) = (&self.motion, &self.before, o.predict) {
+            candidates.push(last.extrapolated(before));
+        }
+        candidates.extend(self.motion.clone());
+        candidates.push(NodeMotion::identity(self.graph.len()));
+        let near = o.restart * self.distance_floor;
+        let starts = warm_starts(
             &self.graph,
-            &self.template,
-            Samples {
-                positions: &self.rest.0,
-                normals: &self.rest.1,
-            },
+            samples,
             target,
-            markers,
-            initial.as_ref(),
-            &step,
+            &candidates,
+            near,
+            o.starts,
+            &o.step,
         );
+        let markers = self.markers.get(&frame).map_or(&[][..], Vec::as_slice);
+        // One start: the prediction was near. Several: each tracked, the nearest result kept.
+        let tracked: Vec<_> = starts
+            .iter()
+            .map(|(initial, start)| {
+                let (moved, motion, stats) = track(
+                    &self.graph,
+                    &self.template,
+                    samples,
+                    target,
+                    markers,
+                    Some(initial),
+                    &step,
+                );
+                let d = if starts.len() > 1 {
+                    motion_distance(&self.graph, samples, target, &motion, &o.step)
+                } else {
+                    0.0
+                };
+                (moved, motion, stats, *start, d)
+            })
+            .collect();
+        let (moved, motion, stats, start, _) = tracked
+            .into_iter()
+            .min_by(|a, b| a.4.total_cmp(&b.4))
+            .expect("at least one start");
         self.before = self.motion.replace(motion);
         let report = TrackingReport {
             matched: stats.matched,
@@ -248,6 +313,9 @@ impl Tracking {
             stop_rms: step.stop_rms,
             markers: markers.len(),
             marker_rms: stats.marker_rms,
+            start_rigid: start.start == Start::Rigid,
+            start_distance: start.distance,
+            given_distance: start.given_distance,
         };
         (moved, report)
     }

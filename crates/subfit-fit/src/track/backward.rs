@@ -21,8 +21,8 @@ use super::options::TrackOptions;
 
 /// The frame points used by the data → model correspondences, with their unit normals.
 pub(super) struct DataPoints {
-    points: Vec<[f64; 3]>,
-    normals: Vec<[f64; 3]>,
+    pub(super) points: Vec<[f64; 3]>,
+    pub(super) normals: Vec<[f64; 3]>,
 }
 
 /// Seed of the area samples of a mesh frame (any fixed value: the step is deterministic).

@@ -307,6 +307,15 @@ pub fn medial_points(samples: &[[f64; 3]], normals: &[[f64; 3]]) -> Vec<[f64; 3]
         .collect()
 }
 
+/// Points of the rest surface that [`super::track`] brings onto the frame, with their unit normals.
+#[derive(Clone, Copy, Debug)]
+pub struct Samples<'a> {
+    /// Positions in the graph's rest configuration.
+    pub positions: &'a [[f64; 3]],
+    /// Unit outward normals, one per position.
+    pub normals: &'a [[f64; 3]],
+}
+
 /// Per-node affine motions of one tracking step: `x ↦ A_k (x − g_k) + g_k + t_k`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NodeMotion {
