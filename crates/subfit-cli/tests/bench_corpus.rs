@@ -81,6 +81,46 @@ fn a_plain_folder_is_scored_and_its_rows_reused() {
     assert_eq!(a["rows"][0]["judge"], row["judge"]);
     assert!(a["sources"][0].as_str().unwrap().contains("board.json"));
 
+    // A row refreshed by a later file keeps the peers an earlier file judged for it.
+    let committed: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../bench/corpus-baseline.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let peer = committed["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find_map(|r| r["peers"].as_array().and_then(|p| p.first()).cloned())
+        .expect("a peer in the committed baseline");
+    let mut peered = b.clone();
+    peered["rows"][0]["peers"] = serde_json::json!([peer.clone()]);
+    let peered_path = d.path().join("peered.json");
+    std::fs::write(&peered_path, serde_json::to_vec(&peered).unwrap()).unwrap();
+    let merged = d.path().join("merged.json");
+    let r = bench(
+        &models,
+        &merged,
+        &[
+            "--rows",
+            peered_path.to_str().unwrap(),
+            "--rows",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let m = board(&merged);
+    assert_eq!(m["rows"][0]["peers"], serde_json::json!([peer]));
+    assert_eq!(m["rows"][0]["judge"], row["judge"]);
+
     // Against a baseline ten times better, the row is an error regression: exit 1.
     let mut base = b.clone();
     base["rows"][0]["judge"]["rms_fraction"] = serde_json::json!(rms / 10.0);
