@@ -59,6 +59,33 @@ CANVAS_STATS = """
 """
 
 
+# A browser that dies while starting, before it has opened anything, says nothing about the
+# report: start it again (at most this many times), and say so on stderr. A loaded CI machine
+# once refused the fork of Chromium's GPU process ("Zygote could not fork: process_type
+# gpu-process"), which took the browser down at launch. (--in-process-gpu, which avoids that
+# fork, leaves SwiftShader's page load hanging: not an option.)
+LAUNCH_ATTEMPTS = 3
+
+
+def launch(playwright, chromium):
+    """Starts headless Chromium, again if it died while starting (a refused fork under load)."""
+    for attempt in range(1, LAUNCH_ATTEMPTS + 1):
+        try:
+            return playwright.chromium.launch(
+                executable_path=chromium, headless=True, args=CHROMIUM_ARGS
+            )
+        except Exception as e:  # noqa: BLE001 - retried, then raised
+            if attempt == LAUNCH_ATTEMPTS:
+                raise
+            first = str(e).splitlines()[0] if str(e) else type(e).__name__
+            print(
+                f"Chromium did not start (attempt {attempt} of {LAUNCH_ATTEMPTS}): {first}",
+                file=sys.stderr,
+            )
+            time.sleep(1.0)
+    raise AssertionError("unreachable")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("report")
@@ -83,9 +110,7 @@ def main():
     requests = []
     result = {"report": str(report), "bytes": report.stat().st_size}
     with sync_playwright() as p:
-        browser = p.chromium.launch(
-            executable_path=args.chromium, headless=True, args=CHROMIUM_ARGS
-        )
+        browser = launch(p, args.chromium)
         width, height = (int(v) for v in args.viewport.split("x"))
         page = browser.new_page(viewport={"width": width, "height": height})
         page.on(
