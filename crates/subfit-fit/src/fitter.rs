@@ -307,7 +307,7 @@ impl<'t, T: DataTerm> Fitter<'t, T> {
                 &samples,
                 &self.op.faces,
             ),
-            data_to_surface: DistanceStats::of_samples(&d, data.boundary),
+            data_to_surface: DistanceStats::of_samples(&d, data.extremes()),
         };
         (two, err2, to_surface)
     }

@@ -75,11 +75,15 @@ pub(crate) fn measure(
     let surface_faces = face_errors(faces, op, &err2);
     let mut data_faces = vec![FaceError::default(); faces.len()];
     let rim_from = to_surface.len() - data.boundary.min(to_surface.len());
+    let uniform = data.uniform();
     let scale = rim_scale(stages);
     for (i, p) in to_surface.iter().enumerate() {
         let e = &mut data_faces[topo.owners[p.face as usize] as usize];
-        e.sum_sq += p.distance * p.distance;
-        e.count += 1;
+        // The mesh's vertices count for a face's maximum, not its RMS.
+        if i < uniform || i >= rim_from {
+            e.sum_sq += p.distance * p.distance;
+            e.count += 1;
+        }
         let d = if i >= rim_from {
             scale * p.distance
         } else {

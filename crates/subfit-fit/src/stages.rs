@@ -19,7 +19,7 @@
 use std::time::{Duration, Instant};
 
 use subfit_measure::data_samples::DataSamples;
-use subfit_measure::{data_samples, TwoSided};
+use subfit_measure::{data_samples_with_vertices, TwoSided};
 use subfit_mesh::{PolyMesh, Polygons, Tags};
 use subfit_subdiv::Scheme;
 use subfit_target::Target;
@@ -101,7 +101,8 @@ pub const UNPAID_REFINEMENTS: usize = 2;
 /// level; its `λ`, tolerances and iteration limits are replaced by those of `stages`.
 ///
 /// After each stage's fit the cage is measured both ways (surface → data with fresh
-/// projections; data → surface from the target's data samples, [`subfit_measure::data_samples()`],
+/// projections; data → surface from the target's data samples and, for the maximum, its vertices
+/// ([`subfit_measure::data_samples_with_vertices()`]),
 /// to the tessellation of the limit samples); the tolerances are judged on both
 /// ([`StageOptions::two_sided`]), and the refinement marks the faces that miss them in either
 /// direction, so data the surface leaves uncovered gets control points. The cage returned is
@@ -182,7 +183,7 @@ impl<'a> StageRun<'a> {
         base: &'a FitOptions,
         stages: &'a StageOptions,
     ) -> Self {
-        let data = data_samples(target, stages.data_samples);
+        let data = data_samples_with_vertices(target, stages.data_samples);
         let mesh = PolyMesh::new(mesh.positions.clone(), mesh.faces.clone());
         let depth = vec![0u8; mesh.faces.len()];
         Self {

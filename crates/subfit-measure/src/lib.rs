@@ -24,7 +24,9 @@ pub mod limit_distance;
 pub mod mesh_distance;
 pub mod tessellate;
 
-pub use data_samples::{data_samples, mesh_vertices, DataSamples, SampleKind};
+pub use data_samples::{
+    data_samples, data_samples_with_vertices, mesh_vertices, DataSamples, SampleKind,
+};
 pub use distance::{DistanceStats, TwoSided};
 pub use limit_distance::{LimitDistance, LimitDistanceError, PointToLimit};
 pub use mesh_distance::MeshDistance;
