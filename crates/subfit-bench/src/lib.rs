@@ -45,7 +45,7 @@ pub struct Settings {
     pub judge: judge::JudgeOptions,
     /// Entries scored at once.
     pub jobs: usize,
-    /// Flags added to every `subfit fit` (e.g. `--facing`), to score an option before it
+    /// Flags added to every `subfit fit` (e.g. `--no-facing`), to score an option before it
     /// becomes a default; empty: the defaults.
     pub fit_args: Vec<String>,
 }

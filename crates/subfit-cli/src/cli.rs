@@ -227,10 +227,13 @@ pub struct FitArgs {
     /// Inside the thin parts of a closed mesh (limbs, tentacles, plates), pull a sample that
     /// sank past the middle by the wall facing its own way, not the nearer opposite wall
     /// (foot points that face the sample; sheets and single views keep the closest point).
-    /// Helps thin-limbed sculpts; off by default, as it also moved two reference fits above
-    /// their tolerance.
-    #[arg(long)]
+    /// The default; `--no-facing` takes the plain closest point, as the papers.
+    #[arg(long, overrides_with = "no_facing")]
     pub facing: bool,
+    /// Foot points are the plain closest points, also inside thin parts (the papers' rule;
+    /// see `--facing`, the default).
+    #[arg(long, overrides_with = "facing")]
+    pub no_facing: bool,
     /// The chordal tolerance, for CAD exports (STL/OBJ tessellations): fit the part the facets
     /// stand for, not the facets. The fit aims at the facets' curved interpolant (PN triangles
     /// through the vertices with the surface's normals), which the facets cut by up to their

@@ -81,7 +81,7 @@ pub struct BenchCorpusArgs {
     #[arg(long)]
     pub subfit: Option<PathBuf>,
     /// A flag added to every `subfit fit` of the corpus, to score an option before it becomes
-    /// a default (repeat it: `--fit-arg --facing`, `--fit-arg --coverage --fit-arg 0`); the
+    /// a default (repeat it: `--fit-arg --no-facing`, `--fit-arg --coverage --fit-arg 0`); the
     /// scoreboard records them. Sequences are run as they are.
     #[arg(long = "fit-arg", value_name = "ARG", allow_hyphen_values = true)]
     pub fit_args: Vec<String>,

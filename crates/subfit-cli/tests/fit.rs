@@ -402,7 +402,7 @@ fn catmull_clark_fits_start_from_a_quad_dominant_cage() {
     assert_eq!(r.status.code(), Some(2));
 }
 
-/// `--facing` reaches the fit (report.json `options.facing`) and a thin limb — a capsule 6 %
+/// `--facing` (the default) and `--no-facing` reach the fit (report.json `options.facing`) and a thin limb — a capsule 6 %
 /// of its length thick — is fitted within the tolerance with it, genus kept.
 #[test]
 fn facing_foot_points_are_an_option_of_fit() {
@@ -419,9 +419,8 @@ fn facing_foot_points_are_an_option_of_fit() {
             "--sample-level",
             "2",
         ];
-        if facing {
-            args.push("--facing");
-        }
+        // `--facing` is the default and still accepted; `--no-facing` turns it off.
+        args.push(if facing { "--facing" } else { "--no-facing" });
         let r = subfit(&args);
         assert_eq!(
             r.status.code(),

@@ -233,8 +233,9 @@ pub struct FitOptions {
     /// Whether a mesh target's foot points face the sample's side inside thin parts
     /// ([`subfit_target::Target::mesh_foot_points_facing`]): a sample whose surface has sunk
     /// past the middle of a limb is pulled by the wall on its own side, not the nearer
-    /// opposite one. Default false (the papers' closest point); `subfit fit --facing` and
-    /// Python's `fit(facing=True)` turn it on.
+    /// opposite one. Default false here (the papers' closest point); `subfit::FitScanOptions`
+    /// turns it on (`subfit fit` and Python's `fit` with it; `--no-facing`, `facing=False`
+    /// turn it off).
     pub facing: bool,
     /// The data's sharp feature curves as segments (normalized units), e.g. the sharp edges
     /// [`subfit_target::detect_features`] finds on a mesh target: with [`Self::coverage`] > 0

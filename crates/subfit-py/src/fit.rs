@@ -266,7 +266,7 @@ fn initial_cage(
     points, faces=None, normals=None, *, scheme="auto", method="sdm", step="lm",
     tolerance=None, max_error=None, max_control_points=None, control_points=None,
     as_points=false, init=None, init_method=None, lambda_start=1e-3, lambda_end=None, sample_level=3,
-    max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, facing=false, chordal=false,
+    max_iterations=100, stage_iterations=6, one_sided=false, coverage=1.0, facing=true, chordal=false,
     refine=true, edge_flips=true,
     max_depth=5, local=false, local_rings=None, local_field_peak=0.8, local_field_share=0.5,
     error_scale=None, imls_radius=None, arap=0.0, quads="field", name=None, progress=None

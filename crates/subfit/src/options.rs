@@ -152,6 +152,7 @@ impl Default for FitScanOptions {
             quads: QuadLayout::default(),
             fit: FitOptions {
                 coverage: 1.0,
+                facing: true,
                 ..FitOptions::default()
             },
             stages: StageOptions::default(),

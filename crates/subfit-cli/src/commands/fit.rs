@@ -99,7 +99,7 @@ pub fn options(a: &FitArgs) -> anyhow::Result<FitScanOptions> {
                 OptimizerArg::Lbfgs => Optimizer::Lbfgs { memory: 7 },
             },
             coverage: a.coverage,
-            facing: a.facing,
+            facing: !a.no_facing,
             imls_radius: a.imls_radius,
             arap: a.arap,
             ..defaults.fit.clone()

@@ -245,8 +245,8 @@ def fit(
         ``lambda_start`` (1e-3, ``--lambda``), ``lambda_end``, ``sample_level`` (3),
         ``max_iterations`` (100), ``stage_iterations`` (6), ``one_sided`` (False),
         ``coverage`` (1.0: weight of the data → surface part of the objective; 0 fits one-sided),
-        ``facing`` (False; ``--facing``: inside thin parts of a closed mesh, a sample that sank
-        past the middle is pulled by the wall facing its own way), ``chordal`` (False;
+        ``facing`` (True; False is ``--no-facing``: inside thin parts of a closed mesh, a sample
+        that sank past the middle is pulled by the wall facing its own way), ``chordal`` (False;
         ``--chordal``: for a CAD tessellation, fit the part its facets stand for — their curved
         interpolant, PN triangles through the vertices — rather than the facets; errors are
         measured against it and ``report["options"]["chordal_levels"]`` says it applied),

@@ -45,7 +45,7 @@ def fit(
     stage_iterations: int = 6,
     one_sided: bool = False,
     coverage: float = 1.0,
-    facing: bool = False,
+    facing: bool = True,
     chordal: bool = False,
     refine: bool = True,
     edge_flips: bool = True,
