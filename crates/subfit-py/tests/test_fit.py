@@ -105,9 +105,11 @@ def test_quads_only_gives_an_all_quad_cage_and_bad_layouts_are_refused():
 def test_facing_is_an_option_and_reaches_the_report(fitted):
     # A mesh target (the fitted tessellation): facing foot points apply to meshes.
     pos, tris = fitted.surface().tessellation(2)
-    for facing in (False, True):
-        m = subfit.fit(pos, faces=tris, facing=facing, max_control_points=600, max_iterations=10)
-        assert m.report["options"]["facing"] is facing
+    # None: left to the default, which is on (as `subfit fit`; `--no-facing` is False).
+    for facing in (False, None):
+        given = {} if facing is None else {"facing": facing}
+        m = subfit.fit(pos, faces=tris, max_control_points=600, max_iterations=10, **given)
+        assert m.report["options"]["facing"] is (facing is None)
         assert ellipsoid_distance(m.surface().sample(2)).max() < 1e-2
 
 
