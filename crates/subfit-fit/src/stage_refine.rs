@@ -50,15 +50,17 @@ impl Splitter {
         marked: &[bool],
     ) -> Result<Option<Refined<u32>>, FitError> {
         Ok(match self {
-            Self::RedGreen => refine_red_green_with_parents(mesh, marked).map(|(m, stats, p)| {
-                let tags = carry_tags(tags, mesh.num_vertices(), &m.faces);
-                Refined {
-                    mesh: m,
-                    stats,
-                    per_face: p,
-                    tags,
-                }
-            }),
+            Self::RedGreen => {
+                refine_red_green_with_parents(mesh, tags, marked).map(|(m, stats, p)| {
+                    let tags = carry_tags(tags, mesh.num_vertices(), &m.faces);
+                    Refined {
+                        mesh: m,
+                        stats,
+                        per_face: p,
+                        tags,
+                    }
+                })
+            }
             Self::Polygons(opts) => {
                 let r = refine_polygons(mesh, tags, marked, opts)?;
                 Some(Refined {
