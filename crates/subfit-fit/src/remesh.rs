@@ -657,14 +657,20 @@ mod tests {
         let (refined, _, _) = refine_red_green_with_parents(&mesh, &tags, &all).unwrap();
         let (smooth, _) = refine_red_green(&mesh, &all).unwrap();
         let p = &refined.positions;
-        for v in 0..4 {
-            assert!(p[v][2].abs() < 1e-15, "equator point {v} left its plane: {:?}", p[v]);
+        for (v, q) in p.iter().enumerate().take(4) {
+            assert!(
+                q[2].abs() < 1e-15,
+                "equator point {v} left its plane: {q:?}"
+            );
             // 3/4 of itself and 1/8 of each neighbour on the equator: 0.75 of its radius.
-            let r = (p[v][0] * p[v][0] + p[v][1] * p[v][1]).sqrt();
+            let r = (q[0] * q[0] + q[1] * q[1]).sqrt();
             assert!((r - 0.75).abs() < 1e-15, "equator point {v} at radius {r}");
         }
         assert_eq!(p[4], mesh.positions[4], "the tagged corner stays");
-        assert_ne!(smooth.positions[4], mesh.positions[4], "Loop's mask moves it");
+        assert_ne!(
+            smooth.positions[4], mesh.positions[4],
+            "Loop's mask moves it"
+        );
         // The equator's new points are its edges' midpoints (in its plane); without the tags
         // they are Loop's edge points, pulled off it by the poles.
         let mut on_equator = 0;
