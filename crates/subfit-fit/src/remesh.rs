@@ -274,12 +274,7 @@ fn vertex_points(
                 && incident[v] > 1
                 && br.iter().all(|&w| split.contains_key(&key(v as u32, w)))
             {
-                let (p, a, b) = (
-                    mesh.positions[v],
-                    mesh.positions[br[0] as usize],
-                    mesh.positions[br[1] as usize],
-                );
-                positions[v] = std::array::from_fn(|k| 0.75 * p[k] + 0.125 * (a[k] + b[k]));
+                positions[v] = curve_point(mesh, v, br);
             }
             continue;
         }
@@ -290,12 +285,7 @@ fn vertex_points(
         if sharp.len() == 2 {
             // A crease point: the crease curve's rule when both its crease edges are split.
             if sharp.iter().all(|&w| split.contains_key(&key(v as u32, w))) {
-                let (p, a, b) = (
-                    mesh.positions[v],
-                    mesh.positions[sharp[0] as usize],
-                    mesh.positions[sharp[1] as usize],
-                );
-                positions[v] = std::array::from_fn(|k| 0.75 * p[k] + 0.125 * (a[k] + b[k]));
+                positions[v] = curve_point(mesh, v, sharp);
             }
             continue;
         }
@@ -314,6 +304,17 @@ fn vertex_points(
         });
     }
     positions
+}
+
+/// Loop's vertex point of `v` on a curve (a boundary or a sharp crease) through its two curve
+/// neighbours `ends`: (1/8, 3/4, 1/8).
+fn curve_point(mesh: &PolyMesh, v: usize, ends: &[u32]) -> [f64; 3] {
+    let (p, a, b) = (
+        mesh.positions[v],
+        mesh.positions[ends[0] as usize],
+        mesh.positions[ends[1] as usize],
+    );
+    std::array::from_fn(|k| 0.75 * p[k] + 0.125 * (a[k] + b[k]))
 }
 
 /// Numbers the new points of the split edges and appends them to `positions`: Loop's edge
